@@ -1,0 +1,149 @@
+"""Side-by-side throughput of mjlab tasks on one GPU: bare simulator step rate and PPO iteration time.
+
+Runs every task in one process so the numbers compare (same device, same driver, same warm-up):
+
+    python scripts/gpu/bench_tasks.py --tasks Mjlab-Velocity-Flat-Unitree-G1 [TASK ...] \
+        --num-envs 4096 --iterations 40 --out $OUT/bench.json
+
+For each task it reports
+* ``sim_physics_steps_per_s``: ``env.sim.step()`` (one physics substep for every world, CUDA graph) timed
+  over many calls, i.e. the simulator's ceiling without managers, observations or the policy;
+* ``ppo_env_steps_per_s``, ``ppo_s_per_iteration``, ``ppo_collection_s``, ``ppo_learning_s``: medians over
+  the PPO iterations after the first ``--warmup`` ones, read from rsl-rl's own timers.
+
+Project tasks register themselves when their package is imported (``--import gmloco.train``).
+"""
+
+from __future__ import annotations
+
+import argparse
+import importlib
+import json
+import os
+import statistics
+import sys
+import tempfile
+import time
+from dataclasses import asdict
+from pathlib import Path
+
+
+def _parse() -> argparse.Namespace:
+    p = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    p.add_argument("--tasks", nargs="+", default=["Mjlab-Velocity-Flat-Unitree-G1"])
+    p.add_argument("--import", dest="imports", nargs="*", default=[], help="modules that register tasks")
+    p.add_argument("--num-envs", type=int, default=4096)
+    p.add_argument("--iterations", type=int, default=40, help="PPO iterations per task")
+    p.add_argument("--warmup", type=int, default=5, help="PPO iterations left out of the medians")
+    p.add_argument("--sim-steps", type=int, default=400, help="physics substeps timed for the sim rate")
+    p.add_argument("--device", default="cuda:0")
+    p.add_argument("--out", type=Path, default=Path("bench.json"))
+    return p.parse_args()
+
+
+def _sync() -> None:
+    import torch
+    import warp as wp
+
+    wp.synchronize()
+    if torch.cuda.is_available():
+        torch.cuda.synchronize()
+
+
+def bench_sim(env, steps: int) -> dict[str, float]:
+    """Time bare physics substeps of an already built env [physics steps/s summed over worlds]."""
+    for _ in range(20):
+        env.sim.step()
+    _sync()
+    t0 = time.perf_counter()
+    for _ in range(steps):
+        env.sim.step()
+    _sync()
+    dt = time.perf_counter() - t0
+    return {"sim_physics_steps_per_s": steps * env.num_envs / dt, "sim_s_per_substep": dt / steps}
+
+
+def bench_ppo(
+    task: str, num_envs: int, iterations: int, warmup: int, sim_steps: int, device: str
+) -> dict[str, float]:
+    """Build the task's env and runner as mjlab's train script does, then time PPO iterations."""
+    from mjlab.envs import ManagerBasedRlEnv
+    from mjlab.rl import MjlabOnPolicyRunner, RslRlVecEnvWrapper
+    from mjlab.tasks.registry import load_env_cfg, load_rl_cfg, load_runner_cls
+
+    env_cfg = load_env_cfg(task)
+    env_cfg.scene.num_envs = num_envs
+    rl_cfg = load_rl_cfg(task)
+    rl_cfg.logger = "tensorboard"
+    t_build = time.perf_counter()
+    env = ManagerBasedRlEnv(cfg=env_cfg, device=device)
+    build_s = time.perf_counter() - t_build
+    sim = bench_sim(env, sim_steps)
+    env.reset()
+    wrapped = RslRlVecEnvWrapper(env, clip_actions=rl_cfg.clip_actions)
+    runner_cls = load_runner_cls(task) or MjlabOnPolicyRunner
+    log_dir = tempfile.mkdtemp(prefix="bench_")
+    runner = runner_cls(wrapped, asdict(rl_cfg), log_dir, device)
+    times: list[tuple[float, float]] = []
+    rewards: list[float] = []
+    original_log = runner.logger.log
+
+    def _log(*args, **kwargs):  # record rsl-rl's own collection/learning timers
+        times.append((kwargs["collect_time"], kwargs["learn_time"]))
+        if len(runner.logger.rewbuffer) > 0:
+            rewards.append(statistics.mean(runner.logger.rewbuffer))
+        return original_log(*args, **kwargs)
+
+    runner.logger.log = _log
+    t0 = time.perf_counter()
+    runner.learn(num_learning_iterations=iterations, init_at_random_ep_len=True)
+    wall = time.perf_counter() - t0
+    steady = times[warmup:] or times
+    collect = statistics.median(t[0] for t in steady)
+    learn = statistics.median(t[1] for t in steady)
+    steps_per_iter = rl_cfg.num_steps_per_env * num_envs
+    env.close()
+    return {
+        **sim,
+        "build_s": build_s,
+        "ppo_iterations": len(times),
+        "ppo_wall_s": wall,
+        "ppo_collection_s": collect,
+        "ppo_learning_s": learn,
+        "ppo_s_per_iteration": collect + learn,
+        "ppo_env_steps_per_s": steps_per_iter / (collect + learn),
+        "ppo_collection_env_steps_per_s": steps_per_iter / collect,
+        "ppo_mean_reward_last": rewards[-1] if rewards else float("nan"),
+        "num_steps_per_env": rl_cfg.num_steps_per_env,
+    }
+
+
+def main() -> None:
+    """Benchmark every requested task and write one JSON summary."""
+    args = _parse()
+    os.environ.setdefault("MUJOCO_GL", "disable")
+    os.environ.setdefault("WANDB_MODE", "offline")
+    import mjlab.tasks  # noqa: F401  (registers the stock tasks)
+    import torch
+
+    for mod in args.imports:
+        importlib.import_module(mod)
+    results: dict[str, object] = {
+        "device": torch.cuda.get_device_name(0) if torch.cuda.is_available() else "cpu",
+        "num_envs": args.num_envs,
+        "argv": sys.argv,
+        "tasks": {},
+    }
+    for task in args.tasks:
+        print(f"[bench] {task}", flush=True)
+        results["tasks"][task] = bench_ppo(  # type: ignore[index]
+            task, args.num_envs, args.iterations, args.warmup, args.sim_steps, args.device
+        )
+        print(json.dumps(results["tasks"][task], indent=1), flush=True)  # type: ignore[index]
+        args.out.parent.mkdir(parents=True, exist_ok=True)
+        args.out.write_text(json.dumps(results, indent=1))
+    print(json.dumps(results, indent=1))
+
+
+if __name__ == "__main__":
+    main()
