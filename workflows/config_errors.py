@@ -1,0 +1,120 @@
+# SPDX-License-Identifier: Apache-2.0
+"""Turn Hydra / OmegaConf composition errors into one clear paragraph that names the key and the choices."""
+
+from __future__ import annotations
+
+import difflib
+import re
+from collections.abc import Sequence
+from pathlib import Path
+from typing import Any
+
+from hydra.errors import ConfigCompositionException, MissingConfigException, OverrideParseException
+from omegaconf import DictConfig, OmegaConf
+from omegaconf.errors import OmegaConfBaseException
+
+from schemas import REPO_ROOT, PipelineCfg
+
+__all__ = ["CONF_DIR", "ConfigInputError", "explain", "group_options", "groups", "unknown_key_error"]
+
+CONF_DIR = REPO_ROOT / "conf"
+"""Hydra config root."""
+
+
+class ConfigInputError(ValueError):
+    """Bad command-line or config input; ``str(self)`` is the paragraph shown to the user."""
+
+    def __init__(self, key: str, message: str) -> None:
+        """Store the offending key and the message."""
+        self.key = key
+        super().__init__(message)
+
+
+def groups(conf_dir: Path = CONF_DIR) -> list[str]:
+    """User-selectable config groups (folders of ``conf/``, except ``hydra``)."""
+    return sorted(p.name for p in conf_dir.iterdir() if p.is_dir() and p.name != "hydra")
+
+
+def group_options(group: str, conf_dir: Path = CONF_DIR) -> list[str]:
+    """YAML options of ``group``."""
+    return sorted(p.stem for p in (conf_dir / group).glob("*.yaml"))
+
+
+def _did_you_mean(word: str, choices: Sequence[str]) -> str:
+    """`` (did you mean 'x'?)`` for the closest choice, or ''."""
+    close = difflib.get_close_matches(word, list(choices), n=1, cutoff=0.6)
+    return f" (did you mean '{close[0]}'?)" if close else ""
+
+
+def _choices(items: Sequence[str]) -> str:
+    """Comma-separated list."""
+    return ", ".join(items) if items else "(none)"
+
+
+def unknown_key_error(key: str, override: str) -> ConfigInputError:
+    """Explain an unknown dotted ``key``: list the valid keys at the level where it goes wrong."""
+    node: Any = OmegaConf.structured(PipelineCfg)
+    parts = key.split(".")
+    for depth, part in enumerate(parts):
+        where = ".".join(parts[:depth]) or "the top level"
+        if not isinstance(node, DictConfig):
+            return ConfigInputError(key, f"'{where}' is a value, not a section, so '{key}' (in '{override}') is invalid.")
+        if part not in node:
+            keys = [str(k) for k in node]
+            extra = f" Config groups (select with +<group>=<option>): {_choices(groups())}." if depth == 0 else ""
+            msg = f"unknown config key '{key}' in '{override}'. Valid keys under {where}: {_choices(keys)}"
+            return ConfigInputError(key, f"{msg}{_did_you_mean(part, keys)}.{extra}")
+        node = node._get_node(part)  # keep nodes (not values) so nested configs stay DictConfig
+    return ConfigInputError(key, f"invalid override '{override}'.")
+
+
+def _missing_group(e: MissingConfigException) -> ConfigInputError:
+    """Unknown option of a config group, e.g. ``+exp=gm_lco``."""
+    missing = e.missing_cfg_file or ""
+    group, _, choice = missing.rpartition("/")
+    if group and group in groups():
+        options = list(e.options or group_options(group))
+        msg = f"unknown {group} '{choice}' (from '+{group}={choice}'). Valid choices for '{group}': {_choices(options)}"
+        return ConfigInputError(group, f"{msg}{_did_you_mean(choice, options)}.")
+    return ConfigInputError(missing, f"cannot find config '{missing}'. Config groups: {_choices(groups())}.")
+
+
+def _composition(e: ConfigCompositionException, overrides: Sequence[str]) -> ConfigInputError:
+    """Typos in overrides, wrong types, a group given without '+'."""
+    msg = str(e)
+    m = re.search(r"Could not override '([^']+)'", msg)
+    if m and "No match in the defaults list" in msg:
+        group = m.group(1)
+        options = group_options(group) if group in groups() else []
+        return ConfigInputError(group, f"'{group}' is not selected by default: append it with +{group}=<option>. Valid choices: {_choices(options)}.")
+    if m:
+        key = m.group(1)
+        return unknown_key_error(key, next((o for o in overrides if key in o), key))
+    m = re.search(r"An item is already at '([^']+)'", msg)
+    if m:
+        key = m.group(1)
+        return ConfigInputError(key, f"'{key}' already exists: override it without the '+', e.g. {key}=<value>.")
+    m = re.search(r"Error merging override (\S+)", msg)
+    cause = e.__cause__
+    if m and isinstance(cause, OmegaConfBaseException):
+        key = str(getattr(cause, "full_key", "") or m.group(1).split("=")[0])
+        first = str(cause).splitlines()[0]
+        return ConfigInputError(key, f"bad value for '{key}' in '{m.group(1)}': {first}.")
+    return ConfigInputError("", msg.splitlines()[0])
+
+
+def explain(e: Exception, overrides: Sequence[str]) -> ConfigInputError:
+    """Map a composition exception to a :class:`ConfigInputError` (others are re-raised by the caller)."""
+    if isinstance(e, ConfigInputError):
+        return e
+    if isinstance(e, MissingConfigException):
+        return _missing_group(e)
+    if isinstance(e, ConfigCompositionException):
+        return _composition(e, overrides)
+    if isinstance(e, OverrideParseException):
+        first = str(e).splitlines()[0]
+        return ConfigInputError("", f"{first}. Overrides look like key=value, +group=option or ~key.")
+    if isinstance(e, OmegaConfBaseException):
+        key = str(getattr(e, "full_key", "") or "")
+        return ConfigInputError(key, f"config error at '{key}': {str(e).splitlines()[0]}.")
+    raise e
