@@ -1,0 +1,144 @@
+# SPDX-License-Identifier: Apache-2.0
+"""Typed configuration of the G1 granular velocity task (pure data; built by ``tasks.g1_granular``)."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from typing import Literal
+
+__all__ = [
+    "ContactModelName",
+    "GranularTaskCfg",
+    "MaterialRangeCfg",
+    "RobotDrCfg",
+    "SandFloorCfg",
+    "SandTerrainCfg",
+    "TerrainName",
+    "deep_sand_terrain",
+    "flat_sand_terrain",
+    "rough_sand_terrain",
+]
+
+ContactModelName = Literal["rft3d", "heuristic_rft", "cone_multi", "cone_single", "rigid"]
+"""Foot-ground contact model: the four granular models of GM-Loco, or plain rigid contact."""
+
+TerrainName = Literal["flat", "rough", "deep"]
+"""Sand bed: flat soft sand, sinusoidal (rough) free surface, or a 30 cm deep loose bed."""
+
+
+@dataclass
+class MaterialRangeCfg:
+    """Per-env granular material, drawn on every reset (GM-Loco code DR, spec section 4)."""
+
+    bulk_density: tuple[float, float] = (1000.0, 3000.0)
+    """Uniform range of the grain bulk density [kg/m^3]; rho_c = packing * bulk_density."""
+    packing: tuple[float, float] = (0.5, 1.0)
+    """Uniform range of the packing fraction [-]."""
+    mu_int: tuple[float, float] = (0.2, 0.9)
+    """Uniform range of the internal friction coefficient [-]."""
+    mu_surf: tuple[float, float] = (0.1, 1.0)
+    """Uniform range of the intruder-grain surface friction coefficient [-]."""
+    preset: str | None = None
+    """Name in ``gmloco.contact.MATERIAL_PRESETS``; when set every env uses it and nothing is drawn."""
+
+
+@dataclass
+class SandFloorCfg:
+    """Hard floor (bedrock) under the sand; its depth is the terrain curriculum (spec 1.5 and 4)."""
+
+    enabled: bool = True
+    """Whether the feet collide with the floor. Other robot geoms always collide with it."""
+    depth_range: tuple[float, float] = (0.0, 0.12)
+    """Floor depth below the sand free surface [m] at curriculum level 0 and at the top level."""
+    num_levels: int = 10
+    """Number of curriculum levels between the two depths."""
+    max_init_level: int = 0
+    """Highest level an env may start at (uniform in [0, max_init_level])."""
+    curriculum: bool = True
+    """Move envs up a level when they walk far, down when they walk less than half the command."""
+
+
+@dataclass
+class SandTerrainCfg:
+    """Shape of the sand free surface and of the floor under it."""
+
+    kind: TerrainName = "flat"
+    """Terrain name, used in task ids and logs."""
+    amplitude: float = 0.0
+    """Amplitude of the sinusoidal free-surface height [m]; 0 is a flat surface at z = 0."""
+    wavelength: float = 2.0
+    """Wavelength of the sinusoidal free surface along x and y [m]."""
+    floor: SandFloorCfg = field(default_factory=SandFloorCfg)
+    """Hard floor under the sand."""
+
+
+def flat_sand_terrain() -> SandTerrainCfg:
+    """Flat soft sand over a floor lowered from 0 to 12 cm by the curriculum."""
+    return SandTerrainCfg(kind="flat")
+
+
+def rough_sand_terrain(amplitude: float = 0.04, wavelength: float = 1.5) -> SandTerrainCfg:
+    """Sand whose free surface is ``amplitude * sin(2 pi x / L) * sin(2 pi y / L)`` [m]."""
+    return SandTerrainCfg(kind="rough", amplitude=amplitude, wavelength=wavelength)
+
+
+def deep_sand_terrain(depth: float = 0.30) -> SandTerrainCfg:
+    """A deep bed: the floor sits ``depth`` [m] below the surface, no floor curriculum."""
+    floor = SandFloorCfg(depth_range=(depth, depth), num_levels=1, curriculum=False)
+    return SandTerrainCfg(kind="deep", floor=floor)
+
+
+@dataclass
+class RobotDrCfg:
+    """Robot domain randomization (GM-Loco code and project page, spec section 4)."""
+
+    enabled: bool = True
+    """Master switch; False disables every term below (evaluation)."""
+    added_mass: tuple[float, float] = (-1.0, 3.0)
+    """Mass added to the torso at startup [kg]."""
+    com_offset: float = 0.03
+    """Half-width of the uniform torso CoM offset along x, y, z at startup [m]."""
+    actuator_gain: tuple[float, float] = (0.9, 1.1)
+    """Scale of the PD gains kp and kd at startup [-]."""
+    foot_friction: tuple[float, float] = (0.6, 1.0)
+    """Friction of the foot geoms against the hard floor at startup [-]."""
+    push_velocity: float = 1.0
+    """Half-width of the uniform xy root-velocity kick [m/s]."""
+    push_interval_s: tuple[float, float] = (10.0, 15.0)
+    """Range of the time between pushes [s]."""
+    joint_pos_offset: float = 0.1
+    """Half-width of the uniform joint-position offset on reset [rad]."""
+
+
+@dataclass
+class GranularTaskCfg:
+    """Everything that selects one G1 velocity task on sand; ``make_g1_granular_env_cfg`` builds it."""
+
+    contact_model: ContactModelName = "rft3d"
+    """Foot-ground contact model."""
+    terrain: SandTerrainCfg = field(default_factory=flat_sand_terrain)
+    """Sand free surface and floor."""
+    material: MaterialRangeCfg = field(default_factory=MaterialRangeCfg)
+    """Per-env material randomization."""
+    robot_dr: RobotDrCfg = field(default_factory=RobotDrCfg)
+    """Robot domain randomization."""
+    num_envs: int = 4096
+    """Number of parallel environments."""
+    episode_length_s: float = 20.0
+    """Episode length [s]."""
+    action_scale: float = 0.25
+    """Joint-position offset per unit action [rad]."""
+    policy_history_length: int = 5
+    """Frames of history stacked in the actor observation (GM-Loco uses 10)."""
+    obs_noise_scale: float = 1.0
+    """Multiplier on the actor observation noise ranges; 0 disables noise."""
+    contact_force_threshold: float | None = None
+    """|F| above which a foot is in contact [N]; None: 40 N granular (GM-Loco), 5 N rigid."""
+    command_curriculum: bool = True
+    """Widen the commanded-velocity ranges in stages (GM-Loco schedule)."""
+    reward_ramp_steps: int = 15_000 * 24
+    """Env steps over which tracking weights ramp 4 -> 8 and std sqrt(1.0) -> sqrt(0.1); 0 disables."""
+    reward_weights: dict[str, float] = field(default_factory=dict)
+    """Overrides of reward term weights by name (see ``mdp.rewards``)."""
+    play: bool = False
+    """Evaluation mode: no noise, no pushes, no curricula, no robot DR."""

@@ -1,0 +1,75 @@
+# SPDX-License-Identifier: Apache-2.0
+"""Actor (policy) and critic (privileged) observation groups of the granular G1 task."""
+
+from __future__ import annotations
+
+from gmloco.train import mdp
+from gmloco.train.config import GranularTaskCfg
+from mjlab.managers.observation_manager import ObservationGroupCfg, ObservationTermCfg
+from mjlab.tasks.velocity import mdp as vel_mdp
+from mjlab.utils.noise import UniformNoiseCfg
+
+__all__ = ["ACTOR_TERMS", "CRITIC_EXTRA_TERMS", "make_observations_cfg"]
+
+ACTOR_TERMS = ("base_ang_vel", "projected_gravity", "command", "joint_pos", "joint_vel", "actions")
+"""Actor observation terms, in order (29-DoF G1: 3 + 3 + 3 + 29 + 29 + 29 = 96 per frame)."""
+CRITIC_EXTRA_TERMS = (
+    "base_lin_vel",
+    "foot_height",
+    "foot_contact",
+    "foot_contact_forces",
+    "foot_air_time",
+    "eta",
+)
+"""Privileged terms appended to the (noise-free) actor terms in the critic group."""
+
+
+def _noise(half_width: float, scale: float) -> UniformNoiseCfg | None:
+    """Uniform noise U[-w, w] scaled by ``scale`` (None when it vanishes)."""
+    w = half_width * scale
+    return UniformNoiseCfg(n_min=-w, n_max=w) if w > 0.0 else None
+
+
+def _actor_terms(noise_scale: float) -> dict[str, ObservationTermCfg]:
+    """Proprioceptive terms; noise ranges from Isaac Lab / mjlab velocity tasks."""
+    return {
+        "base_ang_vel": ObservationTermCfg(
+            func=vel_mdp.builtin_sensor,
+            params={"sensor_name": "robot/imu_ang_vel"},
+            noise=_noise(0.2, noise_scale),
+        ),
+        "projected_gravity": ObservationTermCfg(
+            func=vel_mdp.projected_gravity, noise=_noise(0.05, noise_scale)
+        ),
+        "command": ObservationTermCfg(func=vel_mdp.generated_commands, params={"command_name": "twist"}),
+        "joint_pos": ObservationTermCfg(func=vel_mdp.joint_pos_rel, noise=_noise(0.01, noise_scale)),
+        "joint_vel": ObservationTermCfg(func=vel_mdp.joint_vel_rel, noise=_noise(1.5, noise_scale)),
+        "actions": ObservationTermCfg(func=vel_mdp.last_action),
+    }
+
+
+def _critic_terms() -> dict[str, ObservationTermCfg]:
+    """Noise-free actor terms plus privileged contact and terrain terms."""
+    return {
+        **_actor_terms(0.0),
+        "base_lin_vel": ObservationTermCfg(
+            func=vel_mdp.builtin_sensor, params={"sensor_name": "robot/imu_lin_vel"}
+        ),
+        "foot_height": ObservationTermCfg(func=mdp.foot_height),
+        "foot_contact": ObservationTermCfg(func=mdp.foot_contact),
+        "foot_contact_forces": ObservationTermCfg(func=mdp.foot_contact_forces),
+        "foot_air_time": ObservationTermCfg(func=mdp.foot_air_time),
+        "eta": ObservationTermCfg(func=mdp.terrain_eta),
+    }
+
+
+def make_observations_cfg(task: GranularTaskCfg) -> dict[str, ObservationGroupCfg]:
+    """Return the ``actor`` and ``critic`` groups (rsl-rl / mjlab group names)."""
+    history = task.policy_history_length if task.policy_history_length > 1 else None
+    noise = 0.0 if task.play else task.obs_noise_scale
+    return {
+        "actor": ObservationGroupCfg(
+            terms=_actor_terms(noise), enable_corruption=noise > 0.0, history_length=history
+        ),
+        "critic": ObservationGroupCfg(terms=_critic_terms(), enable_corruption=False),
+    }
