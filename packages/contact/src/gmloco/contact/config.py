@@ -1,0 +1,131 @@
+# SPDX-License-Identifier: Apache-2.0
+"""Configurations of the contact models: typed dataclasses, every field with its SI unit."""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Literal
+
+from gmloco.contact.coefficients import Rft2dCoeffSet
+from gmloco.contact.colliders import ColliderBoxCfg, g1_foot_box_cfg
+from gmloco.contact.materials import GRAVITY
+
+__all__ = [
+    "AtRestMode",
+    "ContactConeMultiCfg",
+    "ContactConeSingleCfg",
+    "ContactHeuristicRFTCfg",
+    "ContactModelCfg",
+    "ContactRFT3DCfg",
+    "ContactRigidCfg",
+]
+
+AtRestMode = Literal["none", "unloading", "ema"]
+"""How a model behaves when a loaded foot comes to rest (README, "At rest"):
+
+* ``"none"``: the published model (RFT: trailing elements get zero force; cone: plastic unloading).
+* ``"unloading"``: elastic unloading branch below the remembered maximum depth (project default).
+* ``"ema"``: Choi 2023 S16 anti-drift EMA filter on the element force (GM-Loco's optional filter).
+"""
+
+
+@dataclass(frozen=True)
+class _AtRestCfg:
+    """Shared at-rest regularization fields."""
+
+    at_rest: AtRestMode = "unloading"
+    """At-rest treatment, see :data:`AtRestMode`."""
+    unloading_ratio: float = 20.0
+    """Elastic unloading stiffness over the loading (secant) stiffness [-]; the force vanishes after the
+    element rises by z_max / ratio."""
+    unloading_damping: float = 0.0
+    """Kelvin-Voigt time constant of the elastic branch [s]: d_eff += damping * ratio * d_depth/dt."""
+    slip_velocity: float = 0.01
+    """Tangential speed below which the elastic branch's Coulomb friction is viscous [m/s] (3D-RFT only)."""
+    ema_rate: float = 0.5
+    """EMA rigidity increment per velocity reversal c_r = 100 dt [-] (0.5 at 200 Hz, Choi 2023 S16)."""
+
+
+@dataclass(frozen=True)
+class ContactRFT3DCfg(_AtRestCfg):
+    """3D resistive force theory (Agarwal, Goldman & Kamrin, PNAS 2023) on a sampled foot collider."""
+
+    collider: ColliderBoxCfg = field(default_factory=g1_foot_box_cfg)
+    """Foot collider in the body frame (faces, resolution)."""
+    coeffs: str | Path = "pnas"
+    """3D-RFT coefficient set: ``"pnas"`` (majority transcription), ``"gmloco"``, or a .json/.npy/.npz file."""
+    sign_fix: bool = False
+    """Apply the reference MATLAB sign corrections to G_n and G_t (off = literal PNAS formula, as GM-Loco)."""
+    v_eps: float = 1e-4
+    """Speed below which the motion direction is taken as gravity's [m/s] (spec 1.5)."""
+    gravity: float = GRAVITY
+    """Gravitational acceleration in xi_n = rho_c g f(mu_int) [m/s^2]."""
+
+
+@dataclass(frozen=True)
+class ContactHeuristicRFTCfg(_AtRestCfg):
+    """Heuristic-RFT baseline: Li 2013 2D-RFT vertical force plus Coulomb tangential (GM-Loco "2D-warp")."""
+
+    collider: ColliderBoxCfg = field(default_factory=g1_foot_box_cfg)
+    """Foot collider in the body frame (faces, resolution)."""
+    coeffs: Rft2dCoeffSet = "generic"
+    """2D-RFT coefficient set; ``generic`` is scaled by xi_n, the poppy-seed sets are absolute (N/cm^3)."""
+    k_f: float = 100.0
+    """Tangential viscous cap per element, F_t = -min(mu F_z, k_f |v_t|) [N s/m]."""
+    v_eps: float = 1e-4
+    """Speed below which the motion direction is taken as gravity's [m/s]."""
+    gravity: float = GRAVITY
+    """Gravitational acceleration in xi_n [m/s^2]."""
+
+
+@dataclass(frozen=True)
+class ContactConeSingleCfg(_AtRestCfg):
+    """Jammed-cone RFT (Choi et al., Sci. Robotics 2023) at one point, the sole centre (GM-Loco defaults)."""
+
+    collider: ColliderBoxCfg = field(default_factory=g1_foot_box_cfg)
+    """Foot collider; only its sole (centre, hydraulic radius) is used."""
+    sigma_flat: float = 5.0e6
+    """Default stress per depth on the flat area [N/m^3] (per-world override via set_materials)."""
+    sigma_cone: float = 4.0e5
+    """Default stress per depth on the cone flank [N/m^3] (per-world override via set_materials)."""
+    nu: float = 1.0
+    """Recruitment rate [-]."""
+    theta: float = math.radians(30.0)
+    """Shear-band angle [rad]."""
+    c_g: float = 1.0
+    """Surrounding-mass factor [-]."""
+    c_d: float = 1.0
+    """Drag factor [-]."""
+    packing: float = 0.6
+    """Packing fraction in the added mass M = c_g phi rho nu [-]."""
+    grain_density: float = 638.0
+    """Grain density in the added mass [kg/m^3]."""
+    eps_f: float = 1e-4
+    """Plastic-unloading tolerance on the maximum depth [m]."""
+    k_f: float = 10.0
+    """Tangential viscous cap F_t = -min(mu_surf F_z, k_f |v_t|) [N s/m]."""
+    enable_added_mass: bool = False
+    """Add m_a z_ddot with m_a = M I_flat(z) and z_ddot by finite difference (GM-Loco: off)."""
+    dt: float = 0.005
+    """Physics step for the finite-difference z_ddot [s]."""
+
+
+@dataclass(frozen=True)
+class ContactConeMultiCfg(ContactConeSingleCfg):
+    """Cone-RFT at every sole grid point, each with its own state and hydraulic radius r_h / n (GM-Loco)."""
+
+
+@dataclass(frozen=True)
+class ContactRigidCfg:
+    """No granular force: the simulator's own rigid contact acts (the paper's rigid baseline)."""
+
+    collider: ColliderBoxCfg = field(default_factory=g1_foot_box_cfg)
+    """Foot collider, kept for logging depths."""
+
+
+ContactModelCfg = (
+    ContactRFT3DCfg | ContactHeuristicRFTCfg | ContactConeSingleCfg | ContactConeMultiCfg | ContactRigidCfg
+)
+"""Any contact-model configuration accepted by :func:`make_contact_model`."""

@@ -1,0 +1,154 @@
+# SPDX-License-Identifier: Apache-2.0
+"""Jammed-granular-cone RFT (Choi et al., Sci. Robotics 2023), GM-Loco closed form, single and multi point."""
+
+from __future__ import annotations
+
+from typing import Any
+
+import warp as wp
+
+from gmloco.contact.kernels_geometry import TerrainData, foot_point_kinematics, terrain_height
+from gmloco.contact.kernels_rft2d import coulomb_tangential
+from gmloco.contact.kernels_state import AT_REST_EMA, AT_REST_UNLOADING, ema_filter, ema_rigidity, unloading_depth
+
+__all__ = ["cone_flat_area", "cone_quasi_static", "eval_cone_point_forces"]
+
+
+@wp.func
+def cone_flat_area(z: float, r_h: float, k: float) -> float:
+    """Return A_flat(z) = pi (r_h - k z)^2, 0 beyond z_c = r_h / k [m^2]."""
+    r = wp.max(r_h - k * z, 0.0)
+    return wp.pi * r * r
+
+
+@wp.func
+def cone_flat_integral(z: float, r_h: float, k: float) -> float:
+    """Return I_flat(z) = int_0^z A_flat = (pi / 3k)(r_h^3 - (r_h - k z_clip)^3) [m^3]."""
+    r = r_h - k * wp.clamp(z, 0.0, r_h / k)
+    return wp.pi / (3.0 * k) * (r_h * r_h * r_h - r * r * r)
+
+
+@wp.func
+def cone_quasi_static(z: float, r_h: float, k: float, cos_theta: float, sigma_flat: float, sigma_cone: float) -> float:
+    """Return F_qs = sigma_flat I_flat + sigma_cone (pi r_h^2 z - I_flat) / cos(theta) [N]."""
+    i_flat = cone_flat_integral(z, r_h, k)
+    return sigma_flat * i_flat + sigma_cone * (wp.pi * r_h * r_h * wp.max(z, 0.0) - i_flat) / cos_theta
+
+
+@wp.kernel
+def cone_point_force_kernel(
+    # Model:
+    points_b: wp.array[wp.vec3],
+    radii: wp.array[float],
+    sigma_flat: wp.array[float],
+    sigma_cone: wp.array[float],
+    mu_surf: wp.array[float],
+    terrain: TerrainData,
+    k_cone: float,
+    cos_theta: float,
+    mass_rate: float,
+    c_d: float,
+    eps_f: float,
+    k_f: float,
+    added_mass: int,
+    dt: float,
+    at_rest: int,
+    unloading_ratio: float,
+    unloading_damping: float,
+    ema_rate: float,
+    # Data in:
+    foot_pos_in: wp.array2d[wp.vec3],
+    foot_mat_in: wp.array2d[wp.mat33],
+    foot_lin_vel_in: wp.array2d[wp.vec3],
+    foot_ang_vel_in: wp.array2d[wp.vec3],
+    depth_max_in: wp.array3d[float],
+    ema_tau_in: wp.array3d[float],
+    force_prev_in: wp.array3d[wp.vec3],
+    vel_prev_in: wp.array3d[wp.vec3],
+    # Data out:
+    point_force_out: wp.array3d[wp.vec3],
+    point_depth_out: wp.array3d[float],
+    point_vel_out: wp.array3d[wp.vec3],
+    nan_count_out: wp.array[int],
+) -> None:
+    """Compute one cone point's force: quasi-static + drag while penetrating, plastic/elastic unloading."""
+    w, f, p = wp.tid()
+    pos = foot_pos_in[w, f]
+    rot = foot_mat_in[w, f]
+    lin_vel = foot_lin_vel_in[w, f]
+    ang_vel = foot_ang_vel_in[w, f]
+    if not (wp.isfinite(pos) and wp.isfinite(rot) and wp.isfinite(lin_vel) and wp.isfinite(ang_vel)):
+        wp.atomic_add(nan_count_out, 0, 1)
+        point_force_out[w, f, p] = wp.vec3(0.0)
+        point_depth_out[w, f, p] = 0.0
+        point_vel_out[w, f, p] = wp.vec3(0.0)
+        return
+    kin = foot_point_kinematics(pos, rot, lin_vel, ang_vel, points_b[p], wp.vec3(0.0, 0.0, -1.0))
+    x = kin[0]
+    v = kin[2]
+    z = terrain_height(terrain, x[0], x[1]) - x[2]
+    z_dot = -v[2]
+    z_max = depth_max_in[w, f, p]
+    r_h = radii[p]
+    s_flat = sigma_flat[w % sigma_flat.shape[0]]
+    s_cone = sigma_cone[w % sigma_cone.shape[0]]
+    f_n = 0.0
+    if z > 0.0:
+        if z_dot > 0.0 or z >= z_max - eps_f:  # GM-Loco rule: penetrating or at the deepest point
+            f_n = cone_quasi_static(z, r_h, k_cone, cos_theta, s_flat, s_cone)
+            if z_dot > 0.0:  # drag c_d M A_flat z_dot^2 (GM-Loco form of c_d m_a_dot z_dot)
+                f_n += c_d * mass_rate * cone_flat_area(z, r_h, k_cone) * z_dot * z_dot
+            if added_mass != 0:
+                z_ddot = (z_dot + vel_prev_in[w, f, p][2]) / dt
+                f_n += mass_rate * cone_flat_integral(z, r_h, k_cone) * z_ddot
+            f_n = wp.max(f_n, 0.0)
+        elif at_rest == AT_REST_UNLOADING:
+            d_eff = unloading_depth(z, z_max, unloading_ratio, unloading_damping, z_dot)
+            f_n = cone_quasi_static(z_max, r_h, k_cone, cos_theta, s_flat, s_cone) * d_eff / z_max
+    force = coulomb_tangential(f_n, v, mu_surf[w % mu_surf.shape[0]], k_f) + wp.vec3(0.0, 0.0, f_n)
+    if at_rest == AT_REST_EMA:
+        tau = ema_rigidity(ema_tau_in[w, f, p], v, vel_prev_in[w, f, p], z, ema_rate, 1)
+        force = ema_filter(force, force_prev_in[w, f, p], tau)
+    point_force_out[w, f, p] = force
+    point_depth_out[w, f, p] = z
+    point_vel_out[w, f, p] = v
+
+
+def eval_cone_point_forces(model: Any, inputs: tuple, nan_count_out: wp.array) -> None:
+    """Launch :func:`cone_point_force_kernel` over [num_worlds, num_feet, num_points]."""
+    cfg = model.cfg
+    foot_pos, foot_mat, foot_lin_vel, foot_ang_vel, _ = inputs
+    wp.launch(
+        cone_point_force_kernel,
+        dim=model.point_depth.shape,
+        inputs=[
+            model.points_b,
+            model.radii,
+            model.sigma_flat,
+            model.sigma_cone,
+            model.mu_surf,
+            model.terrain,
+            model.k_cone,
+            model.cos_theta,
+            model.mass_rate,
+            cfg.c_d,
+            cfg.eps_f,
+            cfg.k_f,
+            int(cfg.enable_added_mass),
+            cfg.dt,
+            model.at_rest_code,
+            cfg.unloading_ratio,
+            cfg.unloading_damping,
+            cfg.ema_rate,
+            foot_pos,
+            foot_mat,
+            foot_lin_vel,
+            foot_ang_vel,
+            model.depth_max,
+            model.ema_tau,
+            model.force_prev,
+            model.vel_prev,
+        ],
+        outputs=[model.point_force, model.point_depth, model.point_vel, nan_count_out],
+        device=model.device,
+    )

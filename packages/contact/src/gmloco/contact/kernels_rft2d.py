@@ -1,0 +1,180 @@
+# SPDX-License-Identifier: Apache-2.0
+"""Heuristic-RFT element forces: Li, Zhang & Goldman (Science 2013) 2D-RFT normal force + Coulomb tangential."""
+
+from __future__ import annotations
+
+from typing import Any
+
+import warp as wp
+
+from gmloco.contact.kernels_geometry import (
+    TerrainData,
+    foot_point_kinematics,
+    media_scaling,
+    point_material,
+    terrain_height,
+)
+from gmloco.contact.kernels_rft3d import G_HAT, unit_velocity
+from gmloco.contact.kernels_state import AT_REST_EMA, AT_REST_UNLOADING, ema_filter, ema_rigidity, unloading_depth
+
+__all__ = ["eval_heuristic_point_forces", "rft2d_alpha_z", "rft2d_angles"]
+
+
+@wp.func
+def rft2d_angles(n: wp.vec3, v_hat: wp.vec3) -> wp.vec2:
+    """Return (beta, gamma) [rad]: e_r from horizontal v, else n, else +x; four-case beta (spec 1.2)."""
+    e_r = wp.vec3(1.0, 0.0, 0.0)
+    h_n = wp.vec3(n[0], n[1], 0.0)
+    h_v = wp.vec3(v_hat[0], v_hat[1], 0.0)
+    if wp.length(h_v) > 1.0e-12:
+        e_r = wp.normalize(h_v)
+    elif wp.length(h_n) > 1.0e-12:
+        e_r = wp.normalize(h_n)
+    gamma = wp.acos(wp.clamp(wp.dot(v_hat, e_r), -1.0, 1.0))
+    if v_hat[2] > 0.0:
+        gamma = -gamma
+    a = wp.acos(wp.clamp(n[2], -1.0, 1.0))
+    beta = 0.0
+    if wp.dot(n, e_r) >= 0.0:
+        beta = -a
+        if n[2] < 0.0:
+            beta = wp.pi - a
+    else:
+        beta = a
+        if n[2] < 0.0:
+            beta = -wp.pi + a
+    return wp.vec2(beta, gamma)
+
+
+@wp.func
+def rft2d_alpha_z(c: wp.array[float], beta: float, gamma: float) -> float:
+    """Return alpha_z = A00 + A10 cos 2b + B11 sin(2b+g) + B01 sin g + B-11 sin(-2b+g) (Li 2013, Table S2)."""
+    return (
+        c[0]
+        + c[1] * wp.cos(2.0 * beta)
+        + c[2] * wp.sin(2.0 * beta + gamma)
+        + c[3] * wp.sin(gamma)
+        + c[4] * wp.sin(-2.0 * beta + gamma)
+    )
+
+
+@wp.func
+def coulomb_tangential(f_z: float, v: wp.vec3, mu_surf: float, k_f: float) -> wp.vec3:
+    """Return -min(mu F_z, k_f |v_t|) v_t / |v_t| in the horizontal plane [N] (F_z clamped >= 0 first)."""
+    v_t = wp.vec3(v[0], v[1], 0.0)
+    speed = wp.length(v_t)
+    if speed <= 0.0:
+        return wp.vec3(0.0)
+    return -wp.min(mu_surf * f_z, k_f * speed) * v_t / speed
+
+
+@wp.kernel
+def heuristic_point_force_kernel(
+    # Model:
+    coeffs: wp.array[float],
+    dimensional: int,
+    points_b: wp.array[wp.vec3],
+    normals_b: wp.array[wp.vec3],
+    areas: wp.array[float],
+    rho_c: wp.array[float],
+    mu_int: wp.array[float],
+    mu_surf: wp.array[float],
+    terrain: TerrainData,
+    gravity: float,
+    v_eps: float,
+    k_f: float,
+    at_rest: int,
+    unloading_ratio: float,
+    unloading_damping: float,
+    ema_rate: float,
+    # Data in:
+    foot_pos_in: wp.array2d[wp.vec3],
+    foot_mat_in: wp.array2d[wp.mat33],
+    foot_lin_vel_in: wp.array2d[wp.vec3],
+    foot_ang_vel_in: wp.array2d[wp.vec3],
+    depth_max_in: wp.array3d[float],
+    ema_tau_in: wp.array3d[float],
+    force_prev_in: wp.array3d[wp.vec3],
+    vel_prev_in: wp.array3d[wp.vec3],
+    # Data out:
+    point_force_out: wp.array3d[wp.vec3],
+    point_depth_out: wp.array3d[float],
+    point_vel_out: wp.array3d[wp.vec3],
+    nan_count_out: wp.array[int],
+) -> None:
+    """Compute one element's Heuristic-RFT force (no leading-edge mask; F_z >= 0 before Coulomb)."""
+    w, f, p = wp.tid()
+    pos = foot_pos_in[w, f]
+    rot = foot_mat_in[w, f]
+    lin_vel = foot_lin_vel_in[w, f]
+    ang_vel = foot_ang_vel_in[w, f]
+    if not (wp.isfinite(pos) and wp.isfinite(rot) and wp.isfinite(lin_vel) and wp.isfinite(ang_vel)):
+        wp.atomic_add(nan_count_out, 0, 1)
+        point_force_out[w, f, p] = wp.vec3(0.0)
+        point_depth_out[w, f, p] = 0.0
+        point_vel_out[w, f, p] = wp.vec3(0.0)
+        return
+    kin = foot_point_kinematics(pos, rot, lin_vel, ang_vel, points_b[p], normals_b[p])
+    x = kin[0]
+    n = kin[1]
+    v = kin[2]
+    depth = terrain_height(terrain, x[0], x[1]) - x[2]
+    mat = point_material(terrain, rho_c, mu_int, mu_surf, w, x[0])
+    scale = 1.0e6  # N/cm^3 -> N/m^3 for the dimensional poppy-seed sets
+    if dimensional == 0:
+        scale = media_scaling(mat[0], mat[1], gravity)
+    v_hat = unit_velocity(v, v_eps)
+    depth_eff = depth
+    depth_max = depth_max_in[w, f, p]
+    if at_rest == AT_REST_UNLOADING and depth > 0.0 and depth < depth_max:
+        v_hat = G_HAT  # elastic branch: static resistance on the unloading line
+        depth_eff = unloading_depth(depth, depth_max, unloading_ratio, unloading_damping, -v[2])
+    force = wp.vec3(0.0)
+    if depth > 0.0:
+        angles = rft2d_angles(n, v_hat)
+        f_z = wp.max(0.0, scale * rft2d_alpha_z(coeffs, angles[0], angles[1]) * depth_eff * areas[p])
+        force = coulomb_tangential(f_z, v, mat[2], k_f) + wp.vec3(0.0, 0.0, f_z)
+    if at_rest == AT_REST_EMA:
+        tau = ema_rigidity(ema_tau_in[w, f, p], v, vel_prev_in[w, f, p], depth, ema_rate, 1)
+        force = ema_filter(force, force_prev_in[w, f, p], tau)
+    point_force_out[w, f, p] = force
+    point_depth_out[w, f, p] = depth
+    point_vel_out[w, f, p] = v
+
+
+def eval_heuristic_point_forces(model: Any, inputs: tuple, nan_count_out: wp.array) -> None:
+    """Launch :func:`heuristic_point_force_kernel` over [num_worlds, num_feet, num_points]."""
+    cfg = model.cfg
+    foot_pos, foot_mat, foot_lin_vel, foot_ang_vel, _ = inputs
+    wp.launch(
+        heuristic_point_force_kernel,
+        dim=model.point_depth.shape,
+        inputs=[
+            model.coeffs,
+            model.dimensional,
+            model.points_b,
+            model.normals_b,
+            model.areas,
+            model.rho_c,
+            model.mu_int,
+            model.mu_surf,
+            model.terrain,
+            cfg.gravity,
+            cfg.v_eps,
+            cfg.k_f,
+            model.at_rest_code,
+            cfg.unloading_ratio,
+            cfg.unloading_damping,
+            cfg.ema_rate,
+            foot_pos,
+            foot_mat,
+            foot_lin_vel,
+            foot_ang_vel,
+            model.depth_max,
+            model.ema_tau,
+            model.force_prev,
+            model.vel_prev,
+        ],
+        outputs=[model.point_force, model.point_depth, model.point_vel, nan_count_out],
+        device=model.device,
+    )

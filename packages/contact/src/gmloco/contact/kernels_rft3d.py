@@ -1,0 +1,225 @@
+# SPDX-License-Identifier: Apache-2.0
+"""3D-RFT element forces (Agarwal, Goldman & Kamrin, PNAS 120 e2214017120, 2023), frame-free form."""
+
+from __future__ import annotations
+
+from typing import Any
+
+import warp as wp
+
+from gmloco.contact.kernels_geometry import (
+    TerrainData,
+    foot_point_kinematics,
+    media_scaling,
+    point_material,
+    terrain_height,
+)
+from gmloco.contact.kernels_state import (
+    AT_REST_EMA,
+    AT_REST_UNLOADING,
+    ema_filter,
+    ema_rigidity,
+    unloading_depth,
+)
+
+__all__ = ["eval_rft3d_point_forces", "rft3d_alpha", "rft3d_generic", "unit_velocity"]
+
+G_HAT = wp.constant(wp.vec3(0.0, 0.0, -1.0))
+
+
+@wp.func
+def unit_velocity(v: wp.vec3, v_eps: float) -> wp.vec3:
+    """Return v / |v|, or g_hat when |v| < v_eps (spec 1.5: a foot at rest resists as if pressed down)."""
+    speed = wp.length(v)
+    if speed < v_eps:
+        return G_HAT
+    return v / speed
+
+
+@wp.func
+def cubic_fit(c: wp.array2d[float], j: int, x1: float, x2: float, x3: float) -> float:
+    """Return f_j = sum_k c[k, j] T_k(x1, x2, x3) over the 20 PNAS SI monomials, in SI order."""
+    f = c[0, j] + c[1, j] * x1 + c[2, j] * x2 + c[3, j] * x3
+    f += c[4, j] * x1 * x1 + c[5, j] * x2 * x2 + c[6, j] * x3 * x3
+    f += c[7, j] * x1 * x2 + c[8, j] * x2 * x3 + c[9, j] * x3 * x1
+    f += c[10, j] * x1 * x1 * x1 + c[11, j] * x2 * x2 * x2 + c[12, j] * x3 * x3 * x3
+    f += c[13, j] * x1 * x2 * x2 + c[14, j] * x2 * x1 * x1 + c[15, j] * x2 * x3 * x3
+    f += c[16, j] * x3 * x2 * x2 + c[17, j] * x3 * x1 * x1 + c[18, j] * x1 * x3 * x3
+    f += c[19, j] * x1 * x2 * x3
+    return f
+
+
+@wp.func
+def rft3d_generic(n: wp.vec3, v_hat: wp.vec3, coeffs: wp.array2d[float]) -> wp.vec3:
+    """Return G = f1 n_e + f2 v_hat + f3 g_hat with n_e = n if n_z < 0 else -n (PNAS 2023, spec 1.1)."""
+    n_e = n
+    if n[2] >= 0.0:
+        n_e = -n
+    x1 = wp.dot(G_HAT, v_hat)
+    x2 = wp.dot(G_HAT, n_e)
+    x3 = wp.dot(n_e, v_hat)
+    f1 = cubic_fit(coeffs, 0, x1, x2, x3)
+    f2 = cubic_fit(coeffs, 1, x1, x2, x3)
+    f3 = cubic_fit(coeffs, 2, x1, x2, x3)
+    return f1 * n_e + f2 * v_hat + f3 * G_HAT
+
+
+@wp.func
+def rft3d_alpha(g: wp.vec3, n: wp.vec3, xi: float, mu_surf: float, v_hat: wp.vec3, sign_fix: int) -> wp.vec3:
+    """Return alpha = xi [G_n + min(1, mu |G_n| / (|G_t| + 1e-6)) G_t] [N/m^3] (PNAS surface-friction cone)."""
+    g_dot_n = wp.dot(g, n)
+    g_n = g_dot_n * n
+    g_t = g - g_n
+    if sign_fix != 0:  # reference MATLAB findAlpha.m corrections (spec 1.1.7)
+        g_n = -wp.abs(g_dot_n) * n
+        if wp.dot(g_t, v_hat) > 0.0:
+            g_t = -g_t
+    scale = wp.min(1.0, mu_surf * wp.length(g_n) / (wp.length(g_t) + 1.0e-6))
+    return xi * (g_n + scale * g_t)
+
+
+@wp.func
+def rft3d_plastic_force(
+    n: wp.vec3,
+    v: wp.vec3,
+    depth: float,
+    area: float,
+    xi: float,
+    mu_surf: float,
+    coeffs: wp.array2d[float],
+    v_eps: float,
+    sign_fix: int,
+) -> wp.vec3:
+    """Return F = alpha depth dS for a submerged leading element (n.v_hat >= 0), else 0 [N]."""
+    v_hat = unit_velocity(v, v_eps)
+    if depth <= 0.0 or wp.dot(n, v_hat) < 0.0:
+        return wp.vec3(0.0)
+    return rft3d_alpha(rft3d_generic(n, v_hat, coeffs), n, xi, mu_surf, v_hat, sign_fix) * (depth * area)
+
+
+@wp.func
+def rft3d_elastic_force(
+    n: wp.vec3,
+    v: wp.vec3,
+    depth: float,
+    depth_max: float,
+    area: float,
+    xi: float,
+    mu_surf: float,
+    coeffs: wp.array2d[float],
+    ratio: float,
+    damping: float,
+    slip_velocity: float,
+) -> wp.vec3:
+    """Return the elastic-branch force inside the crater: static alpha on d_eff plus regularized Coulomb [N]."""
+    alpha_s = rft3d_alpha(rft3d_generic(n, G_HAT, coeffs), n, xi, mu_surf, G_HAT, 0)
+    f = alpha_s * (unloading_depth(depth, depth_max, ratio, damping, -v[2]) * area)
+    v_t = v - wp.dot(v, n) * n
+    return f - (mu_surf * wp.abs(wp.dot(f, n)) / wp.max(wp.length(v_t), slip_velocity)) * v_t
+
+
+@wp.kernel
+def rft3d_point_force_kernel(
+    # Model:
+    coeffs: wp.array2d[float],
+    points_b: wp.array[wp.vec3],
+    normals_b: wp.array[wp.vec3],
+    areas: wp.array[float],
+    rho_c: wp.array[float],
+    mu_int: wp.array[float],
+    mu_surf: wp.array[float],
+    terrain: TerrainData,
+    gravity: float,
+    v_eps: float,
+    sign_fix: int,
+    at_rest: int,
+    unloading_ratio: float,
+    unloading_damping: float,
+    slip_velocity: float,
+    ema_rate: float,
+    # Data in:
+    foot_pos_in: wp.array2d[wp.vec3],
+    foot_mat_in: wp.array2d[wp.mat33],
+    foot_lin_vel_in: wp.array2d[wp.vec3],
+    foot_ang_vel_in: wp.array2d[wp.vec3],
+    depth_max_in: wp.array3d[float],
+    ema_tau_in: wp.array3d[float],
+    force_prev_in: wp.array3d[wp.vec3],
+    vel_prev_in: wp.array3d[wp.vec3],
+    # Data out:
+    point_force_out: wp.array3d[wp.vec3],
+    point_depth_out: wp.array3d[float],
+    point_vel_out: wp.array3d[wp.vec3],
+    nan_count_out: wp.array[int],
+) -> None:
+    """Compute one element's 3D-RFT force, depth and velocity for [world, foot, point]."""
+    w, f, p = wp.tid()
+    pos = foot_pos_in[w, f]
+    rot = foot_mat_in[w, f]
+    lin_vel = foot_lin_vel_in[w, f]
+    ang_vel = foot_ang_vel_in[w, f]
+    if not (wp.isfinite(pos) and wp.isfinite(rot) and wp.isfinite(lin_vel) and wp.isfinite(ang_vel)):
+        wp.atomic_add(nan_count_out, 0, 1)
+        point_force_out[w, f, p] = wp.vec3(0.0)
+        point_depth_out[w, f, p] = 0.0
+        point_vel_out[w, f, p] = wp.vec3(0.0)
+        return
+    kin = foot_point_kinematics(pos, rot, lin_vel, ang_vel, points_b[p], normals_b[p])
+    x = kin[0]
+    n = kin[1]
+    v = kin[2]
+    depth = terrain_height(terrain, x[0], x[1]) - x[2]
+    mat = point_material(terrain, rho_c, mu_int, mu_surf, w, x[0])
+    xi = media_scaling(mat[0], mat[1], gravity)
+    depth_max = depth_max_in[w, f, p]
+    force = wp.vec3(0.0)
+    if at_rest == AT_REST_UNLOADING and depth > 0.0 and depth < depth_max:
+        force = rft3d_elastic_force(
+            n, v, depth, depth_max, areas[p], xi, mat[2], coeffs, unloading_ratio, unloading_damping, slip_velocity
+        )
+    else:
+        force = rft3d_plastic_force(n, v, depth, areas[p], xi, mat[2], coeffs, v_eps, sign_fix)
+    if at_rest == AT_REST_EMA:
+        tau = ema_rigidity(ema_tau_in[w, f, p], v, vel_prev_in[w, f, p], depth, ema_rate, 0)
+        force = ema_filter(force, force_prev_in[w, f, p], tau)
+    point_force_out[w, f, p] = force
+    point_depth_out[w, f, p] = depth
+    point_vel_out[w, f, p] = v
+
+
+def eval_rft3d_point_forces(model: Any, inputs: tuple, nan_count_out: wp.array) -> None:
+    """Launch :func:`rft3d_point_force_kernel` over [num_worlds, num_feet, num_points]."""
+    cfg = model.cfg
+    foot_pos, foot_mat, foot_lin_vel, foot_ang_vel, _ = inputs
+    wp.launch(
+        rft3d_point_force_kernel,
+        dim=model.point_depth.shape,
+        inputs=[
+            model.coeffs,
+            model.points_b,
+            model.normals_b,
+            model.areas,
+            model.rho_c,
+            model.mu_int,
+            model.mu_surf,
+            model.terrain,
+            cfg.gravity,
+            cfg.v_eps,
+            int(cfg.sign_fix),
+            model.at_rest_code,
+            cfg.unloading_ratio,
+            cfg.unloading_damping,
+            cfg.slip_velocity,
+            cfg.ema_rate,
+            foot_pos,
+            foot_mat,
+            foot_lin_vel,
+            foot_ang_vel,
+            model.depth_max,
+            model.ema_tau,
+            model.force_prev,
+            model.vel_prev,
+        ],
+        outputs=[model.point_force, model.point_depth, model.point_vel, nan_count_out],
+        device=model.device,
+    )

@@ -1,0 +1,146 @@
+# SPDX-License-Identifier: Apache-2.0
+"""At-rest regularization: elastic unloading depth, EMA filter, and the once-per-substep state update."""
+
+from __future__ import annotations
+
+from typing import Any
+
+import warp as wp
+
+__all__ = [
+    "AT_REST_CODES",
+    "ema_filter",
+    "ema_rigidity",
+    "eval_reset_state",
+    "eval_state_update",
+    "eval_zero_wrench",
+    "unloading_depth",
+]
+
+AT_REST_NONE = wp.constant(0)
+AT_REST_UNLOADING = wp.constant(1)
+AT_REST_EMA = wp.constant(2)
+AT_REST_CODES: dict[str, int] = {"none": 0, "unloading": 1, "ema": 2}
+"""Integer codes of the at-rest modes used by the kernels."""
+
+
+@wp.func
+def unloading_depth(depth: float, depth_max: float, ratio: float, damping: float, depth_rate: float) -> float:
+    """Return the elastic-branch effective depth max(0, z_max - r (z_max - d) + tau r d_dot) [m].
+
+    A linear elastic unloading line of stiffness r times the secant loading stiffness: it equals z_max at
+    d = z_max and vanishes once the element has risen by z_max / r (project choice, README "At rest").
+    """
+    return wp.max(0.0, depth_max - ratio * (depth_max - depth) + damping * ratio * depth_rate)
+
+
+@wp.func
+def ema_rigidity(
+    tau_prev: float, vel: wp.vec3, vel_prev: wp.vec3, depth: float, rate: float, vertical_only: int
+) -> float:
+    """Return the EMA rigidity tau_r after this step (Choi 2023 S16 as used by GM-Loco).
+
+    tau_r += c_r on a velocity reversal (v.v_prev < 0, or v_z v_z,prev < 0 for 2D/cone) while tau_r < 1;
+    tau_r = 0 out of contact.
+    """
+    if depth <= 0.0:
+        return 0.0
+    reversal = wp.dot(vel, vel_prev) < 0.0
+    if vertical_only != 0:
+        reversal = vel[2] * vel_prev[2] < 0.0
+    tau = tau_prev
+    if reversal and tau < 1.0:
+        tau = wp.min(1.0, tau + rate)
+    return tau
+
+
+@wp.func
+def ema_filter(force: wp.vec3, force_prev: wp.vec3, tau: float) -> wp.vec3:
+    """Return (1 - 0.8 tau) F + 0.8 tau F_prev."""
+    return (1.0 - 0.8 * tau) * force + 0.8 * tau * force_prev
+
+
+@wp.kernel
+def state_update_kernel(
+    # Model:
+    ema_rate: float,
+    vertical_only: int,
+    # Data in:
+    point_depth_in: wp.array3d[float],
+    point_vel_in: wp.array3d[wp.vec3],
+    point_force_in: wp.array3d[wp.vec3],
+    # Data out:
+    depth_max_out: wp.array3d[float],
+    ema_tau_out: wp.array3d[float],
+    force_prev_out: wp.array3d[wp.vec3],
+    vel_prev_out: wp.array3d[wp.vec3],
+) -> None:
+    """Advance per-element memory: z_max (reset out of contact), EMA rigidity, previous force and velocity."""
+    w, f, p = wp.tid()
+    depth = point_depth_in[w, f, p]
+    vel = point_vel_in[w, f, p]
+    if depth > 0.0:
+        depth_max_out[w, f, p] = wp.max(depth_max_out[w, f, p], depth)
+    else:
+        depth_max_out[w, f, p] = 0.0
+    ema_tau_out[w, f, p] = ema_rigidity(
+        ema_tau_out[w, f, p], vel, vel_prev_out[w, f, p], depth, ema_rate, vertical_only
+    )
+    force_prev_out[w, f, p] = point_force_in[w, f, p]
+    vel_prev_out[w, f, p] = vel
+
+
+def eval_state_update(model: Any, ema_rate: float, vertical_only: int) -> None:
+    """Launch :func:`state_update_kernel` over [num_worlds, num_feet, num_points] from the last compute()."""
+    wp.launch(
+        state_update_kernel,
+        dim=model.point_depth.shape,
+        inputs=[ema_rate, vertical_only, model.point_depth, model.point_vel, model.point_force],
+        outputs=[model.depth_max, model.ema_tau, model.force_prev, model.vel_prev],
+        device=model.device,
+    )
+
+
+@wp.kernel
+def reset_state_kernel(
+    # Data in:
+    world_ids_in: wp.array[int],
+    # Data out:
+    depth_max_out: wp.array3d[float],
+    ema_tau_out: wp.array3d[float],
+    force_prev_out: wp.array3d[wp.vec3],
+    vel_prev_out: wp.array3d[wp.vec3],
+) -> None:
+    """Clear the per-element memory of the listed worlds."""
+    i, f, p = wp.tid()
+    w = world_ids_in[i]
+    depth_max_out[w, f, p] = 0.0
+    ema_tau_out[w, f, p] = 0.0
+    force_prev_out[w, f, p] = wp.vec3(0.0)
+    vel_prev_out[w, f, p] = wp.vec3(0.0)
+
+
+def eval_reset_state(model: Any, world_ids: wp.array) -> None:
+    """Launch :func:`reset_state_kernel` over [len(world_ids), num_feet, num_points]."""
+    wp.launch(
+        reset_state_kernel,
+        dim=(world_ids.shape[0], model.num_feet, model.num_points),
+        inputs=[world_ids],
+        outputs=[model.depth_max, model.ema_tau, model.force_prev, model.vel_prev],
+        device=model.device,
+    )
+
+
+@wp.kernel
+def zero_wrench_kernel(
+    # Data out:
+    wrench_out: wp.array2d[wp.spatial_vector],
+) -> None:
+    """Write a zero wrench (rigid baseline: the simulator's own contact acts)."""
+    w, f = wp.tid()
+    wrench_out[w, f] = wp.spatial_vector(0.0, 0.0, 0.0, 0.0, 0.0, 0.0)
+
+
+def eval_zero_wrench(model: Any, wrench_out: wp.array2d) -> None:
+    """Launch :func:`zero_wrench_kernel` over [num_worlds, num_feet]."""
+    wp.launch(zero_wrench_kernel, dim=(model.num_worlds, model.num_feet), outputs=[wrench_out], device=model.device)

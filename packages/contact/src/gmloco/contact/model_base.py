@@ -1,0 +1,205 @@
+# SPDX-License-Identifier: Apache-2.0
+"""ContactModel: allocation, per-world materials, and the compute / update_state / reset sequence."""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from typing import Any
+
+import numpy as np
+import warp as wp
+
+from gmloco.contact.colliders import ColliderPoints
+from gmloco.contact.kernels_geometry import TerrainData, eval_foot_wrench, eval_scatter_values
+from gmloco.contact.kernels_state import AT_REST_CODES, eval_reset_state, eval_state_update
+from gmloco.contact.materials import MATERIAL_PRESETS, eta, validate_material_arrays
+from gmloco.contact.terrain import HEIGHT_KINDS, TerrainCfg
+
+__all__ = ["ContactModel", "make_terrain_data"]
+
+DEFAULT_MATERIAL = MATERIAL_PRESETS["dry_sand"]
+"""Material every world starts with until :meth:`ContactModel.set_materials` is called."""
+
+
+def make_terrain_data(cfg: TerrainCfg, device: str) -> TerrainData:
+    """Upload a :class:`TerrainCfg` into the kernels' :class:`TerrainData` struct."""
+    t = TerrainData()
+    t.kind = HEIGHT_KINDS[cfg.height]
+    t.z0 = cfg.surface_z
+    t.amplitude = wp.vec2(*cfg.amplitude)
+    t.wavelength = wp.vec2(*cfg.wavelength)
+    t.grid = wp.array(cfg.grid_array, dtype=float, device=device)
+    t.grid_origin = wp.vec2(*cfg.grid_origin)
+    t.grid_spacing = cfg.grid_spacing
+    t.num_materials = len(cfg.materials)
+    t.material_table = wp.array(cfg.material_table if cfg.materials else np.zeros((1, 3)), dtype=float, device=device)
+    edges = np.asarray(cfg.material_x_edges, dtype=np.float64)
+    t.material_edges = wp.array(edges if edges.size else np.zeros(1), dtype=float, device=device)
+    t.material_blend = cfg.material_blend
+    return t
+
+
+def _to_numpy(values: Any) -> np.ndarray:
+    """Convert numpy, torch (any device), warp or scalars to a float64 numpy array."""
+    if isinstance(values, wp.array):
+        return values.numpy().astype(np.float64)
+    if hasattr(values, "detach"):
+        return values.detach().cpu().numpy().astype(np.float64)
+    return np.asarray(values, dtype=np.float64)
+
+
+class ContactModel:
+    """Granular foot-contact model batched over [num_worlds, num_feet, num_points] (base class).
+
+    Attributes:
+        point_depth: Element depth below the local free surface [m], wp.array3d[float] [W, F, P].
+        point_force: Element force of the medium on the foot [N], wp.array3d[wp.vec3] [W, F, P].
+        nan_count: Count of non-finite element inputs seen by compute() (one per element per call), [1].
+        eta: Normalized stiffness xi / xi_max of each world's material (paper definition) [-], [W].
+        eta_log: Log-scaled normalized stiffness (materials.eta scale="log") [-], [W].
+    """
+
+    is_rigid: bool = False
+    _vertical_only: int = 0
+    _eval_points: Callable[[Any, tuple, wp.array], None]
+
+    def __init__(
+        self,
+        cfg: Any,
+        num_worlds: int,
+        num_feet: int,
+        device: str,
+        terrain: TerrainCfg | None,
+        collider: ColliderPoints,
+    ) -> None:
+        """Allocate every array once (graph capture freezes pointers: never reallocate)."""
+        self.cfg = cfg
+        self.num_worlds, self.num_feet, self.num_points = num_worlds, num_feet, collider.num_points
+        self.device = device
+        self.collider = collider
+        self.at_rest_code = AT_REST_CODES[getattr(cfg, "at_rest", "none")]
+        self.terrain_cfg = terrain or TerrainCfg()
+        self.terrain = make_terrain_data(self.terrain_cfg, device)
+        self.points_b = wp.array(collider.points, dtype=wp.vec3, device=device)
+        self.normals_b = wp.array(collider.normals, dtype=wp.vec3, device=device)
+        self.areas = wp.array(collider.areas, dtype=float, device=device)
+        m = DEFAULT_MATERIAL
+        self.rho_c = wp.full(num_worlds, m.rho_c, dtype=float, device=device)
+        self.mu_int = wp.full(num_worlds, m.mu_int, dtype=float, device=device)
+        self.mu_surf = wp.full(num_worlds, m.mu_surf, dtype=float, device=device)
+        self.eta = wp.full(num_worlds, float(eta(m.rho_c, m.mu_int)), dtype=float, device=device)
+        self.eta_log = wp.full(num_worlds, float(eta(m.rho_c, m.mu_int, "log")), dtype=float, device=device)
+        shape = (num_worlds, num_feet, collider.num_points)
+        self.point_depth = wp.zeros(shape, dtype=float, device=device)
+        self.point_force = wp.zeros(shape, dtype=wp.vec3, device=device)
+        self.point_vel = wp.zeros(shape, dtype=wp.vec3, device=device)
+        self.depth_max = wp.zeros(shape, dtype=float, device=device)
+        self.ema_tau = wp.zeros(shape, dtype=float, device=device)
+        self.force_prev = wp.zeros(shape, dtype=wp.vec3, device=device)
+        self.vel_prev = wp.zeros(shape, dtype=wp.vec3, device=device)
+        self.nan_count = wp.zeros(1, dtype=int, device=device)
+        self._scratch_count = wp.zeros(1, dtype=int, device=device)
+
+    # -- materials -------------------------------------------------------------------------------------------
+
+    def _world_ids(self, env_ids: Any, count: int) -> wp.array:
+        """Return env_ids as a wp int array (all worlds when None), checking the value count."""
+        ids = np.arange(self.num_worlds) if env_ids is None else _to_numpy(env_ids).astype(np.int64).ravel()
+        if count != len(ids):
+            raise ValueError(f"set_materials: got {count} values for {len(ids)} worlds")
+        if len(ids) and (ids.min() < 0 or ids.max() >= self.num_worlds):
+            raise ValueError(f"env_ids must lie in [0, {self.num_worlds - 1}]")
+        return wp.array(ids.astype(np.int32), dtype=int, device=self.device)
+
+    def _scatter(self, values: np.ndarray, ids: wp.array, out: wp.array) -> None:
+        """Copy ``values`` into ``out[ids]`` in place."""
+        eval_scatter_values(ids, wp.array(values, dtype=float, device=self.device), out)
+
+    def set_materials(
+        self, rho_c: Any = None, mu_int: Any = None, mu_surf: Any = None, env_ids: Any = None, **extra: Any
+    ) -> None:
+        """Set per-world materials in place; None leaves a parameter unchanged.
+
+        Args:
+            rho_c: Critical density [kg/m^3], [num_worlds] or [len(env_ids)] (numpy, torch, warp or scalar).
+            mu_int: Internal friction [-], same shape.
+            mu_surf: Surface friction [-], same shape.
+            env_ids: Worlds to update; None = all.
+            **extra: Model-specific per-world parameters (cone: sigma_flat, sigma_cone [N/m^3]).
+        """
+        given = {
+            k: v for k, v in {"rho_c": rho_c, "mu_int": mu_int, "mu_surf": mu_surf, **extra}.items() if v is not None
+        }
+        if not given:
+            return
+        count = len(np.atleast_1d(_to_numpy(next(iter(given.values())))))
+        ids = self._world_ids(env_ids, count)
+        arrays = {k: np.broadcast_to(np.atleast_1d(_to_numpy(v)), (count,)).copy() for k, v in given.items()}
+        validate_material_arrays(arrays.get("rho_c"), arrays.get("mu_int"), arrays.get("mu_surf"))
+        self._validate_extra(arrays)
+        for name, values in arrays.items():
+            self._scatter(values, ids, getattr(self, name))
+        if "rho_c" in arrays or "mu_int" in arrays:
+            ids_np = ids.numpy()
+            rho = arrays.get("rho_c", self.rho_c.numpy()[ids_np])
+            mu = arrays.get("mu_int", self.mu_int.numpy()[ids_np])
+            self._scatter(eta(rho, mu), ids, self.eta)
+            self._scatter(eta(rho, mu, "log"), ids, self.eta_log)
+
+    def _validate_extra(self, arrays: dict[str, np.ndarray]) -> None:
+        """Reject parameters this model does not have (subclasses add theirs)."""
+        unknown = set(arrays) - {"rho_c", "mu_int", "mu_surf"}
+        if unknown:
+            raise ValueError(f"{type(self).__name__}.set_materials: unknown parameters {sorted(unknown)}")
+
+    # -- simulation ------------------------------------------------------------------------------------------
+
+    def compute(
+        self,
+        foot_pos_w: wp.array2d,
+        foot_mat_w: wp.array2d,
+        foot_lin_vel_w: wp.array2d,
+        foot_ang_vel_w: wp.array2d,
+        foot_com_w: wp.array2d,
+        wrench_out: wp.array2d,
+    ) -> None:
+        """Write each foot's wrench (force, torque about its CoM; world frame) without touching model state.
+
+        Args:
+            foot_pos_w: Body-frame origin positions [m], wp.array2d[wp.vec3] [W, F].
+            foot_mat_w: Rotation matrices body -> world, wp.array2d[wp.mat33] [W, F].
+            foot_lin_vel_w: Linear velocity of the body-frame origin [m/s], [W, F].
+            foot_ang_vel_w: Angular velocity [rad/s], [W, F].
+            foot_com_w: Body centre of mass [m], [W, F].
+            wrench_out: Output, wp.array2d[wp.spatial_vector] [W, F], MuJoCo ``xfrc_applied`` layout.
+        """
+        inputs = (foot_pos_w, foot_mat_w, foot_lin_vel_w, foot_ang_vel_w, foot_com_w)
+        # 1. element forces, depths and velocities from the kinematics and the (read-only) state
+        self._eval_points(self, inputs, self.nan_count)
+        # 2. per-foot sum of forces and of moments about the CoM, fixed order
+        eval_foot_wrench(self, inputs, wrench_out)
+
+    def update_state(
+        self,
+        foot_pos_w: wp.array2d,
+        foot_mat_w: wp.array2d,
+        foot_lin_vel_w: wp.array2d,
+        foot_ang_vel_w: wp.array2d,
+        foot_com_w: wp.array2d,
+    ) -> None:
+        """Advance the memory once per physics substep, with the kinematics compute() used in that substep.
+
+        After ``mj_step`` MuJoCo's ``xpos``/``xmat``/``cvel`` still hold the pre-integration kinematics that the
+        passive callback saw, so reading them after the step gives exactly those inputs.
+        """
+        inputs = (foot_pos_w, foot_mat_w, foot_lin_vel_w, foot_ang_vel_w, foot_com_w)
+        # 1. recompute the element forces of this substep (not counted twice in nan_count)
+        self._eval_points(self, inputs, self._scratch_count)
+        # 2. z_max, EMA rigidity, previous force and velocity
+        eval_state_update(self, getattr(self.cfg, "ema_rate", 0.0), self._vertical_only)
+
+    def reset(self, env_ids: Any = None) -> None:
+        """Clear the state of the given worlds (all when None)."""
+        ids = np.arange(self.num_worlds) if env_ids is None else _to_numpy(env_ids).astype(np.int64).ravel()
+        if len(ids):
+            eval_reset_state(self, wp.array(ids.astype(np.int32), dtype=int, device=self.device))
