@@ -42,8 +42,8 @@ def group_options(group: str, conf_dir: Path = CONF_DIR) -> list[str]:
 
 def _did_you_mean(word: str, choices: Sequence[str]) -> str:
     """`` (did you mean 'x'?)`` for the closest choice, or ''."""
-    close = difflib.get_close_matches(word, list(choices), n=1, cutoff=0.6)
-    return f" (did you mean '{close[0]}'?)" if close else ""
+    close = difflib.get_close_matches(word, list(choices), n=2, cutoff=0.6)
+    return f" (did you mean {' or '.join(repr(c) for c in close)}?)" if close else ""
 
 
 def _choices(items: Sequence[str]) -> str:
@@ -58,7 +58,9 @@ def unknown_key_error(key: str, override: str) -> ConfigInputError:
     for depth, part in enumerate(parts):
         where = ".".join(parts[:depth]) or "the top level"
         if not isinstance(node, DictConfig):
-            return ConfigInputError(key, f"'{where}' is a value, not a section, so '{key}' (in '{override}') is invalid.")
+            return ConfigInputError(
+                key, f"'{where}' is a value, not a section, so '{key}' (in '{override}') is invalid."
+            )
         if part not in node:
             keys = [str(k) for k in node]
             extra = f" Config groups (select with +<group>=<option>): {_choices(groups())}." if depth == 0 else ""
@@ -86,7 +88,10 @@ def _composition(e: ConfigCompositionException, overrides: Sequence[str]) -> Con
     if m and "No match in the defaults list" in msg:
         group = m.group(1)
         options = group_options(group) if group in groups() else []
-        return ConfigInputError(group, f"'{group}' is not selected by default: append it with +{group}=<option>. Valid choices: {_choices(options)}.")
+        return ConfigInputError(
+            group,
+            f"'{group}' is not selected by default: append it with +{group}=<option>. Valid choices: {_choices(options)}.",
+        )
     if m:
         key = m.group(1)
         return unknown_key_error(key, next((o for o in overrides if key in o), key))

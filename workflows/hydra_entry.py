@@ -19,6 +19,7 @@ from hydra import compose, initialize_config_dir
 from hydra._internal.utils import get_args_parser
 from omegaconf import DictConfig, OmegaConf
 from omegaconf.errors import OmegaConfBaseException
+from rich.markup import escape
 
 import schemas  # noqa: F401  (registers the schemas and resolvers)
 import stage_registry
@@ -43,28 +44,30 @@ def _full_error() -> bool:
 def _missing_values(cfg: DictConfig, prefix: str = "") -> list[str]:
     """Dotted keys whose value is ``???`` (checked without resolving interpolations)."""
     out: list[str] = []
-    for key in cfg:
-        path = f"{prefix}{key}"
+    for key in map(str, cfg):
         if OmegaConf.is_missing(cfg, key):
-            out.append(path)
-        elif isinstance(cfg._get_node(key), DictConfig) and not OmegaConf.is_interpolation(cfg, key):
-            node = cfg._get_node(key)
-            assert isinstance(node, DictConfig)
-            if not node._is_none():
-                out.extend(_missing_values(node, f"{path}."))
+            out.append(f"{prefix}{key}")
+            continue
+        node = cfg._get_node(key)
+        if isinstance(node, DictConfig) and not node._is_none() and not node._is_interpolation():
+            out.extend(_missing_values(node, f"{prefix}{key}."))
     return out
 
 
 def _check_missing(cfg: DictConfig, stage_names: Sequence[str]) -> None:
     """Raise for ``???`` values outside the unselected stages' sections."""
-    ignored = tuple(f"{s}." for s in stage_names if s not in cfg.stages) + ("hydra.",)
+    ignored = (*(f"{s}." for s in stage_names if s not in cfg.stages), "hydra.")
     missing = [k for k in _missing_values(cfg) if not k.startswith(ignored)]
     if "exp_name" in missing:
         exps = ", ".join(group_options("exp"))
-        raise ConfigInputError("exp_name", f"no experiment chosen: add +exp=<name> to the command. Valid choices for 'exp': {exps}.")
+        raise ConfigInputError(
+            "exp_name", f"no experiment chosen: add +exp=<name> to the command. Valid choices for 'exp': {exps}."
+        )
     if missing:
         key = missing[0]
-        raise ConfigInputError(key, f"missing config value '{key}' (marked ??? in the config): set it, e.g. {key}=<value>.")
+        raise ConfigInputError(
+            key, f"missing config value '{key}' (marked ??? in the config): set it, e.g. {key}=<value>."
+        )
 
 
 def _check_appended(overrides: Sequence[str]) -> None:
@@ -131,7 +134,9 @@ def _announce_smoke() -> None:
 
 def _fail(e: ConfigInputError) -> None:
     """Print the paragraph and exit with :data:`EXIT_BAD_INPUT`."""
-    console.print(f"[bold red]error:[/] {e} Nothing was run. (Set HYDRA_FULL_ERROR=1 for the full traceback.)")
+    console.print(
+        f"[bold red]error:[/] {escape(str(e))} Nothing was run. (Set HYDRA_FULL_ERROR=1 for the full traceback.)"
+    )
     sys.exit(EXIT_BAD_INPUT)
 
 

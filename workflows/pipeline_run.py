@@ -11,7 +11,7 @@ import copy
 import sys
 import time
 from collections.abc import Sequence
-from datetime import datetime, timezone
+from datetime import UTC, datetime
 from pathlib import Path
 from typing import Any
 
@@ -59,7 +59,7 @@ def _prepare(cfg: DictConfig, run_dir: str | None) -> DictConfig:
 def _invocation(cfg: DictConfig, git: dict[str, Any], full_hash: str) -> dict[str, Any]:
     """One entry of ``manifest.invocations``."""
     return {
-        "started_at": datetime.now(timezone.utc).isoformat(timespec="seconds"),
+        "started_at": datetime.now(UTC).isoformat(timespec="seconds"),
         "argv": sys.argv,
         "stages": list(cfg.stages),
         "seed": int(cfg.seed),
@@ -95,8 +95,9 @@ def run_pipeline(
     cfg = _prepare(cfg, run_dir)
     seed_everything(int(cfg.seed))
     layout = RunDir(Path(cfg.run_dir))
-    resolved = OmegaConf.to_container(cfg, resolve=True, enum_to_str=True)
-    assert isinstance(resolved, dict)
+    container = OmegaConf.to_container(cfg, resolve=True, enum_to_str=True)
+    assert isinstance(container, dict)
+    resolved = {str(k): v for k, v in container.items()}
     atomic_write_yaml(layout.config_yaml, resolved)
     git = write_git_state(REPO_ROOT, layout.root)
     manifest = Manifest.load(layout.manifest_json)
@@ -146,7 +147,6 @@ def _run_stages(
     finally:
         tracker.close()
     return outcomes
-
 
 
 def run_from_hydra(cfg: DictConfig) -> int:

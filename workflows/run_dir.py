@@ -99,7 +99,7 @@ def seed_everything(seed: int) -> None:
     try:
         import numpy as np
 
-        np.random.seed(seed)
+        np.random.seed(seed)  # noqa: NPY002  (seeds libraries that still use the legacy global RNG)
     except ImportError:  # numpy is optional for the workflow layer
         pass
     try:

@@ -1,6 +1,8 @@
 # SPDX-License-Identifier: Apache-2.0
-"""Per-stage config hashes: a stage is reused only when its own section, the common keys and all of its
-upstream stages' hashes are unchanged.
+"""Per-stage config hashes, chained through upstream stages.
+
+A stage is reused only when its own section, the common keys and all of its upstream stages' hashes are
+unchanged.
 
 Paths inside the run directory and the checkout are written relative (``${run_dir}``, ``${paths.root_dir}``)
 before hashing, so a run directory copied to another machine (e.g. from the GPU machine) still resumes.

@@ -13,7 +13,7 @@ import time
 import traceback
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
-from datetime import datetime, timezone
+from datetime import UTC, datetime
 from pathlib import Path
 from typing import Any
 
@@ -56,7 +56,7 @@ def forced_stages(force: Any, registry: Sequence[StageSpec]) -> set[str]:
     unknown = [str(i) for i in items if i not in _names(registry)]
     if unknown:
         valid = ", ".join(_names(registry))
-        raise PipelineConfigError("force", f"unknown stage(s) {unknown} in 'force'; valid: true, false, {valid}")
+        raise PipelineConfigError("force", f"unknown stage(s) {unknown} in 'force'; valid: true, false, {valid}.")
     return {str(i) for i in items}
 
 
@@ -65,7 +65,7 @@ def validate_selection(cfg: DictConfig, registry: Sequence[StageSpec]) -> None:
     unknown = [s for s in cfg.stages if s not in _names(registry)]
     if unknown:
         valid = ", ".join(_names(registry))
-        raise PipelineConfigError("stages", f"unknown stage(s) {unknown} in 'stages'; valid: {valid}")
+        raise PipelineConfigError("stages", f"unknown stage(s) {unknown} in 'stages'; valid: {valid}.")
     forced_stages(OmegaConf.to_object(cfg.force) if OmegaConf.is_config(cfg.force) else cfg.force, registry)
 
 
@@ -114,7 +114,7 @@ class StageOutcome:
 
 def _now() -> str:
     """Current UTC time, ISO-8601."""
-    return datetime.now(timezone.utc).isoformat(timespec="seconds")
+    return datetime.now(UTC).isoformat(timespec="seconds")
 
 
 class StageRunner:
