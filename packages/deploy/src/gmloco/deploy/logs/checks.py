@@ -61,9 +61,7 @@ def _check_imu(log: G1Log) -> None:
     _, acc = log.signal("imu.accelerometer")
     g = float(np.nanmedian(np.linalg.norm(acc, axis=1)))
     if not 0.5 * _G < g < 1.5 * _G:
-        _warn(
-            log, f"median accelerometer norm {g:.2f}, expected ~{_G} m/s^2 (logged in g, or gravity removed?)"
-        )
+        _warn(log, f"median accelerometer norm {g:.2f}, expected ~{_G} m/s^2 (logged in g, or gravity removed?)")
 
 
 def _check_rate(log: G1Log) -> None:

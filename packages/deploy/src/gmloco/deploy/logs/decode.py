@@ -13,7 +13,7 @@ from gmloco.deploy.logs.errors import JointOrderError, LogFormatError
 from gmloco.deploy.logs.g1 import G1_JOINT_NAMES, G1_NUM_JOINTS
 from gmloco.deploy.logs.schema import JOINT_DIM, TopicSpec
 
-__all__ = ["joint_permutation", "protobuf_decoder", "decode_topic"]
+__all__ = ["decode_topic", "joint_permutation", "protobuf_decoder"]
 
 
 def joint_permutation(names: list[str] | tuple[str, ...], where: str) -> np.ndarray:
@@ -101,9 +101,7 @@ def _decode_json(spec: TopicSpec, payloads: list[bytes], perm: np.ndarray | None
                             f"{spec.topic}: field {f.name!r} of message {i} has {a.shape[0]} joints, expected "
                             f"{G1_NUM_JOINTS} (G1 29-DoF). Log all 29 joints in G1_JOINT_NAMES order."
                         )
-                    raise LogFormatError(
-                        f"{spec.topic}: field {f.name!r} shape {a.shape} != {shapes[f.name]}"
-                    )
+                    raise LogFormatError(f"{spec.topic}: field {f.name!r} shape {a.shape} != {shapes[f.name]}")
                 row[f.name] = a
         except JointOrderError:
             raise
@@ -118,11 +116,7 @@ def _decode_json(spec: TopicSpec, payloads: list[bytes], perm: np.ndarray | None
         if all(v is None for v in vals):
             continue  # optional field absent
         shape = shapes[f.name] or ()
-        arr = (
-            np.stack([np.full(shape, np.nan) if v is None else v for v in vals])
-            if vals
-            else np.zeros((0, *shape))
-        )
+        arr = np.stack([np.full(shape, np.nan) if v is None else v for v in vals]) if vals else np.zeros((0, *shape))
         if perm is not None and JOINT_DIM in f.shape and arr.size:
             arr = _to_canonical(arr, perm)
         out[f.name] = arr.astype(bool) if f.unit == "bool" else arr
@@ -136,9 +130,7 @@ def _to_canonical(arr: np.ndarray, perm: np.ndarray) -> np.ndarray:
     return out
 
 
-def _decode_joint_states(
-    decode: Callable[[bytes], Any], payloads: list[bytes], topic: str
-) -> tuple[dict, list[int]]:
+def _decode_joint_states(decode: Callable[[bytes], Any], payloads: list[bytes], topic: str) -> tuple[dict, list[int]]:
     """Decode ``foxglove.JointStates`` messages, mapping joint names to canonical order."""
     n = len(payloads)
     out = {k: np.full((n, G1_NUM_JOINTS), np.nan) for k in ("q", "dq", "ddq", "tau_est")}

@@ -244,9 +244,7 @@ def scan_mcap(path: str | Path) -> ScanResult:
             out.damage.append(DamageReport("no_footer", pos, f"file ends at byte {pos} without a footer"))
             break
         if pos + 9 > len(data):
-            out.damage.append(
-                DamageReport("truncated", pos, f"file ends inside a record header at byte {pos}")
-            )
+            out.damage.append(DamageReport("truncated", pos, f"file ends inside a record header at byte {pos}"))
             break
         op, length = data[pos], _u64(data, pos + 1)
         end = pos + 9 + length
@@ -296,8 +294,6 @@ def scan_mcap(path: str | Path) -> ScanResult:
         except Exception as exc:
             rng = _time_range(payload) if op == 0x06 else None
             kind = "corrupted_chunk" if op == 0x06 else "corrupted_record"
-            out.damage.append(
-                DamageReport(kind, pos, f"{name} at byte {pos} unreadable ({exc}); skipped", rng, end)
-            )
+            out.damage.append(DamageReport(kind, pos, f"{name} at byte {pos} unreadable ({exc}); skipped", rng, end))
         pos = end
     return out

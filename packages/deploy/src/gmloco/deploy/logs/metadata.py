@@ -78,9 +78,7 @@ class RunMetadata:
             LogFormatError: If a key is malformed or ``controller`` is missing.
         """
         if "controller" not in record:
-            raise LogFormatError(
-                "run metadata has no 'controller' key; every run must say what controlled the robot"
-            )
+            raise LogFormatError("run metadata has no 'controller' key; every run must say what controlled the robot")
         known = {f.name: f for f in fields(cls)}
         kwargs: dict = {}
         extra = {}

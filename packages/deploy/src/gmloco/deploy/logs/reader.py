@@ -112,9 +112,7 @@ class G1Log:
         """
         spec, f = signal_spec(signal)
         if not self.has(signal):
-            raise KeyError(
-                f"{self.path.name} has no {signal!r} (topic {spec.topic}); it holds {self.signals()}"
-            )
+            raise KeyError(f"{self.path.name} has no {signal!r} (topic {spec.topic}); it holds {self.signals()}")
         ch = self.channels[spec.topic]
         values = ch.fields[f.name]
         if joint is not None:
@@ -176,9 +174,7 @@ def _check_units(path: Path, meta: RunMetadata) -> None:
     bad = {s: (u, UNITS[s]) for s, u in meta.units.items() if s in UNITS and u != UNITS[s]}
     if bad:
         lines = ", ".join(f"{s}: file says {u!r}, schema says {e!r}" for s, (u, e) in sorted(bad.items()))
-        raise UnitsError(
-            f"{path}: units differ from the schema ({lines}). Convert to SI units before logging."
-        )
+        raise UnitsError(f"{path}: units differ from the schema ({lines}). Convert to SI units before logging.")
 
 
 def _group(scan: Any, meta_record: dict[str, str]) -> tuple[dict[str, list], dict[int, Any]]:
@@ -239,9 +235,7 @@ def _decode_channel(
             stacklevel=3,
         )
     idx = order[keep]
-    return ChannelData(
-        topic, t[idx], t_log[idx], t_pub[idx], seq[idx], fields_, dict(ch.metadata) if ch else {}
-    )
+    return ChannelData(topic, t[idx], t_log[idx], t_pub[idx], seq[idx], fields_, dict(ch.metadata) if ch else {})
 
 
 def read_log(path: str | Path, cfg: ReadCfg | None = None) -> G1Log:
@@ -274,15 +268,11 @@ def read_log(path: str | Path, cfg: ReadCfg | None = None) -> G1Log:
     channels: dict[str, ChannelData] = {}
     for topic, msgs in by_topic.items():
         if topic in TOPICS and msgs:
-            channels[topic] = _decode_channel(
-                path, topic, msgs, channel_by_topic.get(topic), scan.schemas, meta, cfg
-            )
+            channels[topic] = _decode_channel(path, topic, msgs, channel_by_topic.get(topic), scan.schemas, meta, cfg)
     t0 = int(channels[TOPIC_JOINT_STATES].time_ns[0]) if TOPIC_JOINT_STATES in channels else None
     t_last = max((int(c.time_ns[-1]) for c in channels.values() if len(c.time_ns)), default=None)
     _warn_damage(path, scan.damage, t_last, t0)
-    missing = [
-        t for t, s in TOPICS.items() if s.required and (t not in channels or len(channels[t].time_ns) == 0)
-    ]
+    missing = [t for t, s in TOPICS.items() if s.required and (t not in channels or len(channels[t].time_ns) == 0)]
     if missing:
         present = sorted(by_topic)
         dmg = f" The file is damaged ({scan.damage[0].detail})." if scan.damage else ""

@@ -6,12 +6,12 @@ from __future__ import annotations
 import numpy as np
 
 __all__ = [
+    "axis_angle_matrix",
     "quat_normalize",
     "quat_rotate",
     "quat_rotate_inv",
     "quat_to_matrix",
     "quat_to_rpy",
-    "axis_angle_matrix",
 ]
 
 

@@ -133,9 +133,7 @@ TOPICS: dict[str, TopicSpec] = {
             (
                 FieldSpec("quaternion", "1", (4,), "imu_state.quaternion, (w, x, y, z), IMU frame in world"),
                 FieldSpec("gyroscope", "rad/s", (3,), "imu_state.gyroscope, angular velocity in IMU frame"),
-                FieldSpec(
-                    "accelerometer", "m/s^2", (3,), "imu_state.accelerometer, specific force (+g up at rest)"
-                ),
+                FieldSpec("accelerometer", "m/s^2", (3,), "imu_state.accelerometer, specific force (+g up at rest)"),
                 FieldSpec("rpy", "rad", (3,), "imu_state.rpy, roll/pitch/yaw (optional)"),
             ),
             "Pelvis IMU (LowState imu_state) at the LowState rate; quaternion interpolated by normalized lerp.",
@@ -148,9 +146,7 @@ TOPICS: dict[str, TopicSpec] = {
             False,
             "linear",
             (
-                FieldSpec(
-                    "temperature", "degC", (JOINT_DIM, 2), "motor_state.temperature[2] (winding, casing)"
-                ),
+                FieldSpec("temperature", "degC", (JOINT_DIM, 2), "motor_state.temperature[2] (winding, casing)"),
                 FieldSpec("vol", "V", _J, "motor_state.vol"),
             ),
             "Slow motor diagnostics (thermal derating, battery sag); a few Hz is enough.",
@@ -179,9 +175,7 @@ TOPICS: dict[str, TopicSpec] = {
             False,
             "linear",
             (
-                FieldSpec(
-                    "position", "m", (3,), "pose.position of body_frame_id (pelvis) in frame_id (odom)"
-                ),
+                FieldSpec("position", "m", (3,), "pose.position of body_frame_id (pelvis) in frame_id (odom)"),
                 FieldSpec("orientation", "1", (4,), "pose.orientation (w, x, y, z)"),
                 FieldSpec("linear_velocity", "m/s", (3,), "linear velocity in the body frame"),
                 FieldSpec("angular_velocity", "rad/s", (3,), "angular velocity in the body frame"),

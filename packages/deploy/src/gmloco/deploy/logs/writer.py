@@ -69,9 +69,7 @@ def _jsonable(a: Any) -> Any:
     lst = arr.astype(np.float64).tolist()
     if np.all(np.isfinite(arr)):
         return lst
-    return json.loads(
-        json.dumps(lst).replace("NaN", "null").replace("-Infinity", "null").replace("Infinity", "null")
-    )
+    return json.loads(json.dumps(lst).replace("NaN", "null").replace("-Infinity", "null").replace("Infinity", "null"))
 
 
 def _check_shape(name: str, a: Any, shape: tuple[int, ...]) -> np.ndarray:
@@ -95,29 +93,21 @@ class G1LogWriter:
         ...     w.write_lowstate(0.0, q, dq, tau, quat, gyro, acc)
     """
 
-    def __init__(
-        self, path: str | os.PathLike, metadata: RunMetadata, cfg: LogWriterCfg | None = None
-    ) -> None:
+    def __init__(self, path: str | os.PathLike, metadata: RunMetadata, cfg: LogWriterCfg | None = None) -> None:
         """Open the file, write the header, the schemas of ``cfg.topics`` and the run metadata."""
         from mcap.writer import CompressionType, Writer
 
         self.cfg = cfg or LogWriterCfg()
         self.path = Path(path)
         if self.path.exists() and not self.cfg.overwrite:
-            raise FileExistsError(
-                f"{self.path} exists; refusing to overwrite it (set LogWriterCfg.overwrite=True)"
-            )
+            raise FileExistsError(f"{self.path} exists; refusing to overwrite it (set LogWriterCfg.overwrite=True)")
         if len(metadata.joint_names) != G1_NUM_JOINTS:
-            raise ValueError(
-                f"metadata.joint_names has {len(metadata.joint_names)} names, the G1 has {G1_NUM_JOINTS}"
-            )
+            raise ValueError(f"metadata.joint_names has {len(metadata.joint_names)} names, the G1 has {G1_NUM_JOINTS}")
         self.metadata = metadata
         self._part = self.path.with_name(self.path.name + ".part")
         self._file = open(self._part, "wb")  # noqa: SIM115 (closed in close())
         compression = {"zstd": CompressionType.ZSTD, "lz4": CompressionType.LZ4, "none": CompressionType.NONE}
-        self._mcap = Writer(
-            self._file, chunk_size=self.cfg.chunk_size, compression=compression[self.cfg.compression]
-        )
+        self._mcap = Writer(self._file, chunk_size=self.cfg.chunk_size, compression=compression[self.cfg.compression])
         self._mcap.start(profile="", library="gmloco-deploy")
         self._channels: dict[str, int] = {}
         self._counts: dict[str, int] = {}
@@ -163,9 +153,7 @@ class G1LogWriter:
         meta = {k: v if isinstance(v, str) else json.dumps(v) for k, v in channel_metadata.items()}
         self._channel(topic, meta)
 
-    def _write(
-        self, topic: str, t: float, data: bytes, publish_time: float | None, sequence: int | None
-    ) -> None:
+    def _write(self, topic: str, t: float, data: bytes, publish_time: float | None, sequence: int | None) -> None:
         """Add one serialized message."""
         if self._closed:
             raise RuntimeError(f"{self.path} is closed")
@@ -175,14 +163,10 @@ class G1LogWriter:
         log_ns = self.cfg.start_time_ns + _ns(t)
         pub_ns = log_ns if publish_time is None else self.cfg.start_time_ns + _ns(publish_time)
         seq = n if sequence is None else int(sequence) & 0xFFFFFFFF
-        self._mcap.add_message(
-            self._channel(topic), log_time=log_ns, data=data, publish_time=pub_ns, sequence=seq
-        )
+        self._mcap.add_message(self._channel(topic), log_time=log_ns, data=data, publish_time=pub_ns, sequence=seq)
         self._counts[topic] = n + 1
 
-    def _write_json(
-        self, topic: str, t: float, msg: dict, publish_time: float | None, seq: int | None
-    ) -> None:
+    def _write_json(self, topic: str, t: float, msg: dict, publish_time: float | None, seq: int | None) -> None:
         """Serialize and add a JSON message."""
         self._write(topic, t, json.dumps(msg, separators=(",", ":")).encode(), publish_time, seq)
 
@@ -257,8 +241,7 @@ class G1LogWriter:
         """Write one LowCmd sample (targets [rad], [rad/s], gains [N*m/rad], [N*m*s/rad], feed-forward [N*m]), each [29]."""
         j = (G1_NUM_JOINTS,)
         msg = {
-            n: _jsonable(_check_shape(n, a, j))
-            for n, a in (("q", q), ("dq", dq), ("kp", kp), ("kd", kd), ("tau", tau))
+            n: _jsonable(_check_shape(n, a, j)) for n, a in (("q", q), ("dq", dq), ("kp", kp), ("kd", kd), ("tau", tau))
         }
         self._write_json(TOPIC_LOWCMD, t, msg, publish_time, sequence)
 
@@ -281,7 +264,8 @@ class G1LogWriter:
         tf: bool = True,
     ) -> None:
         """Write the base state: position [m] and orientation (w, x, y, z) of the pelvis in ``odom``,
-        linear [m/s] and angular [rad/s] velocity in the pelvis frame; also ``/tf`` when ``tf``."""
+        linear [m/s] and angular [rad/s] velocity in the pelvis frame; also ``/tf`` when ``tf``.
+        """
         from foxglove_schemas_protobuf.FrameTransform_pb2 import FrameTransform
         from foxglove_schemas_protobuf.FrameTransforms_pb2 import FrameTransforms
         from foxglove_schemas_protobuf.Odometry_pb2 import Odometry
@@ -303,21 +287,15 @@ class G1LogWriter:
             tr.rotation.w, tr.rotation.x, tr.rotation.y, tr.rotation.z = (float(x) for x in o)
             self._write(TOPIC_TF, t, FrameTransforms(transforms=[tr]).SerializeToString(), None, None)
 
-    def write_command(
-        self, t: float, lin_vel_x: float, lin_vel_y: float = 0.0, ang_vel_z: float = 0.0
-    ) -> None:
+    def write_command(self, t: float, lin_vel_x: float, lin_vel_y: float = 0.0, ang_vel_z: float = 0.0) -> None:
         """Write the velocity command: forward and lateral [m/s] in the heading frame, yaw rate [rad/s]."""
         msg = {"lin_vel_x": float(lin_vel_x), "lin_vel_y": float(lin_vel_y), "ang_vel_z": float(ang_vel_z)}
         self._write_json(TOPIC_COMMAND, t, msg, None, None)
 
-    def write_policy(
-        self, t: float, observation: np.ndarray | None = None, action: np.ndarray | None = None
-    ) -> None:
+    def write_policy(self, t: float, observation: np.ndarray | None = None, action: np.ndarray | None = None) -> None:
         """Write the policy observation [n_obs] and/or raw action [n_act] of one control step."""
         if observation is not None:
-            self._write_json(
-                TOPIC_POLICY_OBS, t, {"observation": _jsonable(np.ravel(observation))}, None, None
-            )
+            self._write_json(TOPIC_POLICY_OBS, t, {"observation": _jsonable(np.ravel(observation))}, None, None)
         if action is not None:
             self._write_json(TOPIC_POLICY_ACTION, t, {"action": _jsonable(np.ravel(action))}, None, None)
 
@@ -325,9 +303,7 @@ class G1LogWriter:
         """Write the student's decoded eta [K] (declare ``names``/``units`` first with :meth:`declare`)."""
         self._write_json(TOPIC_ETA, t, {"eta": _jsonable(np.ravel(eta))}, None, None)
 
-    def write_sim_contact(
-        self, t: float, in_contact: np.ndarray, force: np.ndarray, sinkage: np.ndarray
-    ) -> None:
+    def write_sim_contact(self, t: float, in_contact: np.ndarray, force: np.ndarray, sinkage: np.ndarray) -> None:
         """Write privileged foot contact truth: flags [2], world forces [N] [2, 3], sinkage [m] [2]."""
         nf = len(G1_FEET)
         msg = {
@@ -337,9 +313,7 @@ class G1LogWriter:
         }
         self._write_json(TOPIC_SIM_CONTACT, t, msg, None, None)
 
-    def write_log(
-        self, t: float, message: str, level: Literal["DEBUG", "INFO", "WARNING", "ERROR"] = "INFO"
-    ) -> None:
+    def write_log(self, t: float, message: str, level: Literal["DEBUG", "INFO", "WARNING", "ERROR"] = "INFO") -> None:
         """Write a text event to ``/log`` (Foxglove's Log panel)."""
         from foxglove_schemas_protobuf.Log_pb2 import Log
 

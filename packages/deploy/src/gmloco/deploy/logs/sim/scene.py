@@ -1,0 +1,94 @@
+# SPDX-License-Identifier: Apache-2.0
+"""The G1 scene in MuJoCo C: the mjlab MJCF plus a floor, rotor armature and feet-only collisions."""
+
+from __future__ import annotations
+
+import importlib.util
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from gmloco.deploy.logs.g1 import G1_JOINT_NAMES
+
+__all__ = ["G1SceneCfg", "build_g1_model", "g1_effort_limits", "g1_xml_path"]
+
+# Reflected rotor inertia [kg*m^2] and effort limit [N*m] per actuator type, from
+# mjlab 1.6.0 asset_zoo/robots/unitree_g1/g1_constants.py (ARMATURE_*, ACTUATOR_*.effort_limit).
+_ACTUATORS: dict[str, tuple[float, float]] = {
+    "7520_14": (0.01017752004132231, 88.0),
+    "7520_22": (0.025101924999999997, 139.0),
+    "5020": (0.003609725, 25.0),
+    "5020x2": (2 * 0.003609725, 50.0),  # ankles, waist roll/pitch: 4-bar linkage driven by two 5020
+    "4010": (0.00425, 5.0),
+}
+
+
+def _actuator(name: str) -> str:
+    """Actuator type of a G1 joint (mjlab's grouping)."""
+    if any(k in name for k in ("hip_pitch", "hip_yaw", "waist_yaw")):
+        return "7520_14"
+    if any(k in name for k in ("hip_roll", "knee")):
+        return "7520_22"
+    if any(k in name for k in ("ankle", "waist_roll", "waist_pitch")):
+        return "5020x2"
+    if any(k in name for k in ("wrist_pitch", "wrist_yaw")):
+        return "4010"
+    return "5020"
+
+
+def g1_effort_limits() -> np.ndarray:
+    """Joint torque limits [N*m], canonical order, shape [29]."""
+    return np.array([_ACTUATORS[_actuator(n)][1] for n in G1_JOINT_NAMES])
+
+
+def g1_xml_path() -> Path:
+    """Return the G1 MJCF shipped with mjlab, located without importing mjlab (which pulls torch and warp)."""
+    spec = importlib.util.find_spec("mjlab")
+    if spec is None or spec.origin is None:
+        raise ImportError("mjlab is not installed; the G1 MJCF ships with mjlab 1.6.0 (uv sync the workspace)")
+    return Path(spec.origin).parent / "asset_zoo/robots/unitree_g1/xmls/g1.xml"
+
+
+@dataclass
+class G1SceneCfg:
+    """Settings of the MuJoCo C G1 scene."""
+
+    timestep: float = 0.002
+    """Physics step [s]."""
+    foot_friction: float = 0.6
+    """Sliding friction of the foot capsules (mjlab's value)."""
+    floor: bool = True
+    """Add a rigid floor plane at z = 0 (disable for a granular ground model that supplies all foot forces)."""
+
+
+def build_g1_model(cfg: G1SceneCfg | None = None) -> Any:
+    """Compile the G1 scene and return a ``mujoco.MjModel``.
+
+    Feet keep their capsules (condim 3); other collision geoms are disabled, as in mjlab's feet-only
+    collision preset. Joint armature follows mjlab's actuator constants.
+    """
+    import mujoco
+
+    cfg = cfg or G1SceneCfg()
+    spec = mujoco.MjSpec.from_file(str(g1_xml_path()))
+    spec.option.timestep = cfg.timestep
+    spec.option.integrator = mujoco.mjtIntegrator.mjINT_IMPLICITFAST
+    if cfg.floor:
+        spec.worldbody.add_geom(name="floor", type=mujoco.mjtGeom.mjGEOM_PLANE, size=[0, 0, 0.05])
+    for g in spec.geoms:
+        if g.name.endswith("_collision"):
+            foot = "_foot" in g.name
+            g.contype = g.conaffinity = 1 if foot else 0
+            if foot:
+                g.condim = 3
+                g.friction[0] = cfg.foot_friction
+    for j in spec.joints:
+        if j.name in G1_JOINT_NAMES:
+            j.armature = _ACTUATORS[_actuator(j.name)][0]
+    model = spec.compile()
+    names = tuple(model.joint(i).name for i in range(1, model.njnt))
+    if names != G1_JOINT_NAMES:
+        raise RuntimeError(f"MJCF joint order {names} differs from G1_JOINT_NAMES")
+    return model

@@ -1,0 +1,126 @@
+# SPDX-License-Identifier: Apache-2.0
+"""The nominal G1 simulator of the mismatch tool: mjlab's MJCF, rotor armature, a soft ground plane.
+
+Everything here imports ``mujoco`` lazily so that ``gmloco.deploy.mismatch`` stays importable without it.
+The nominal model is deliberately plain: joint torques come from the logged PD commands (no MuJoCo
+actuator dynamics), feet touch a compliant plane (MuJoCo soft contact, sand-like sinkage of a few mm),
+all other collisions are off. Every candidate effect (:mod:`gmloco.deploy.mismatch.effects`) is a
+parametric change of *this* model.
+"""
+
+from __future__ import annotations
+
+import importlib.util
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from gmloco.deploy.logs.g1 import G1_JOINT_NAMES
+
+__all__ = [
+    "G1_ARMATURE",
+    "G1_EFFORT_LIMIT",
+    "SOLE_POINTS",
+    "G1SimCfg",
+    "build_model",
+    "g1_mjcf_path",
+]
+
+# Reflected rotor inertia [kg*m^2] and effort limit [N*m] per motor type, from mjlab 1.6.0
+# asset_zoo/robots/unitree_g1/g1_constants.py (ARMATURE_*, ACTUATOR_*.effort_limit); ankles and waist
+# roll/pitch are 4-bar linkages driven by two 5020 motors (mjlab sums their armature).
+_MOTORS: dict[str, tuple[float, float]] = {
+    "7520_14": (0.01017752004132231, 88.0),
+    "7520_22": (0.025101924999999997, 139.0),
+    "5020": (0.003609725, 25.0),
+    "5020x2": (2 * 0.003609725, 50.0),
+    "4010": (0.00425, 5.0),
+}
+
+
+def _motor(name: str) -> str:
+    """Motor type of a G1 joint (mjlab's grouping)."""
+    if any(k in name for k in ("hip_pitch", "hip_yaw", "waist_yaw")):
+        return "7520_14"
+    if any(k in name for k in ("hip_roll", "knee")):
+        return "7520_22"
+    if any(k in name for k in ("ankle", "waist_roll", "waist_pitch")):
+        return "5020x2"
+    if any(k in name for k in ("wrist_pitch", "wrist_yaw")):
+        return "4010"
+    return "5020"
+
+
+G1_ARMATURE: np.ndarray = np.array([_MOTORS[_motor(n)][0] for n in G1_JOINT_NAMES])
+"""Nominal reflected rotor inertia per joint [kg*m^2], canonical order, shape [29]."""
+G1_EFFORT_LIMIT: np.ndarray = np.array([_MOTORS[_motor(n)][1] for n in G1_JOINT_NAMES])
+"""Nominal torque limit per joint [N*m], canonical order, shape [29]."""
+
+# Sole sample points in the ankle-roll link frame [m]: a 4 x 2 grid under the seven foot capsules of the
+# MJCF (capsules span x in [-0.054, 0.132], y in [-0.027, 0.027], centre z = -0.025, radius 0.01).
+_SX = (-0.05, 0.01, 0.07, 0.125)
+_SY = (-0.025, 0.025)
+SOLE_POINTS: np.ndarray = np.array([[x, y, -0.035] for x in _SX for y in _SY])
+"""Foot sole points used by terrain effects, ankle-roll frame [m], shape [8, 3]."""
+
+
+def g1_mjcf_path() -> Path:
+    """Return mjlab's G1 MJCF path without importing mjlab (which pulls torch and warp)."""
+    spec = importlib.util.find_spec("mjlab")
+    if spec is None or spec.origin is None:
+        raise ImportError("mjlab is not installed; the G1 MJCF ships with mjlab 1.6.0")
+    return Path(spec.origin).parent / "asset_zoo/robots/unitree_g1/xmls/g1.xml"
+
+
+@dataclass
+class G1SimCfg:
+    """Nominal simulator settings of the mismatch tool."""
+
+    timestep: float = 0.002
+    """Physics step [s]; one step per 500 Hz log sample by default."""
+    ground_timeconst: float = 0.02
+    """MuJoCo ``solref`` time constant of the foot-ground contact [s] (soft: a few mm of sinkage)."""
+    ground_dampratio: float = 1.0
+    """MuJoCo ``solref`` damping ratio of the foot-ground contact [-]."""
+    foot_friction: float = 0.8
+    """Sliding friction coefficient of the foot capsules on the ground [-]."""
+
+
+def build_model(cfg: G1SimCfg | None = None, spec_edit: Any = None) -> Any:
+    """Compile the nominal G1 model and return a ``mujoco.MjModel``.
+
+    Args:
+        cfg: Simulator settings.
+        spec_edit: Optional callable ``f(spec)`` applied to the ``mujoco.MjSpec`` before compiling; the
+            benchmark generator uses it to inject model edits without touching this module.
+    """
+    import mujoco
+
+    cfg = cfg or G1SimCfg()
+    spec = mujoco.MjSpec.from_file(str(g1_mjcf_path()))
+    spec.option.timestep = cfg.timestep
+    spec.option.integrator = mujoco.mjtIntegrator.mjINT_EULER
+    floor = spec.worldbody.add_geom(name="floor", type=mujoco.mjtGeom.mjGEOM_PLANE, size=[0, 0, 0.05])
+    floor.solref = [cfg.ground_timeconst, cfg.ground_dampratio]
+    for g in spec.geoms:
+        if g.name.endswith("_collision"):
+            foot = "_foot" in g.name
+            g.contype = 1 if foot else 0
+            g.conaffinity = 0  # feet collide with the floor only, never with each other
+            if foot:
+                g.condim = 3
+                g.friction[0] = cfg.foot_friction
+                g.solref = [cfg.ground_timeconst, cfg.ground_dampratio]
+    floor.contype, floor.conaffinity = 0, 1
+    for j in spec.joints:
+        if j.name in G1_JOINT_NAMES:
+            j.armature = _MOTORS[_motor(j.name)][0]
+    if spec_edit is not None:
+        spec_edit(spec)
+    model = spec.compile()
+    names = tuple(model.joint(i).name for i in range(1, model.njnt))
+    if names != G1_JOINT_NAMES:
+        raise RuntimeError(f"MJCF joint order {names} differs from G1_JOINT_NAMES")
+    return model
