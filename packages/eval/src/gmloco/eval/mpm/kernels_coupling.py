@@ -1,0 +1,106 @@
+# SPDX-License-Identifier: Apache-2.0
+"""Warp kernels of the rigid-body <-> implicit-MPM two-way coupling (impulse harvest, lagged-force rewind)."""
+
+from __future__ import annotations
+
+import warp as wp
+
+__all__ = ["eval_body_sand_wrench", "eval_rewind_body_velocity"]
+
+
+@wp.kernel
+def _body_sand_wrench(
+    # Model:
+    collider_body: wp.array[int],
+    body_com: wp.array[wp.vec3],
+    # Data in:
+    inv_dt: float,
+    node_collider_in: wp.array[int],
+    node_impulse_in: wp.array[wp.vec3],
+    node_pos_in: wp.array[wp.vec3],
+    body_q_in: wp.array[wp.transform],
+    # Data out:
+    body_wrench_out: wp.array[wp.spatial_vector],
+) -> None:
+    """Sum collider-node impulses of the sand on each body into (force, torque about the CoM)."""
+    i = wp.tid()
+    cid = node_collider_in[i]
+    if cid < 0 or cid >= collider_body.shape[0]:
+        return
+    b = collider_body[cid]
+    if b < 0:
+        return
+    # F = J / dt: the impulse the sand gave the collider over the MPM step
+    f = node_impulse_in[i] * inv_dt
+    com = wp.transform_point(body_q_in[b], body_com[b])
+    wp.atomic_add(body_wrench_out, b, wp.spatial_vector(f, wp.cross(node_pos_in[i] - com, f)))
+
+
+def eval_body_sand_wrench(
+    collider_body: wp.array,
+    body_com: wp.array,
+    dt: float,
+    impulses: tuple[wp.array, wp.array, wp.array],
+    body_q: wp.array,
+    body_wrench_out: wp.array,
+) -> None:
+    """Write each body's sand wrench [N, N m] from ``SolverImplicitMPM.collect_collider_impulses`` output.
+
+    Args:
+        collider_body: Collider -> body index (``solver.collider_body_index``), [C].
+        body_com: Body CoM in the body frame [m], [B].
+        dt: MPM step the impulses were accumulated over [s].
+        impulses: (impulse [N s], position [m], collider id) per collider node.
+        body_q: Body poses, [B].
+        body_wrench_out: Output (force, torque about CoM) in world frame, [B]; zeroed first.
+    """
+    node_impulse, node_pos, node_collider = impulses
+    body_wrench_out.zero_()
+    wp.launch(
+        _body_sand_wrench,
+        dim=node_collider.shape[0],
+        inputs=[collider_body, body_com, 1.0 / dt, node_collider, node_impulse, node_pos, body_q],
+        outputs=[body_wrench_out],
+        device=body_wrench_out.device,
+    )
+
+
+@wp.kernel
+def _rewind_body_velocity(
+    # Model:
+    body_inv_mass: wp.array[float],
+    body_inv_inertia: wp.array[wp.mat33],
+    # Data in:
+    dt: float,
+    body_q_in: wp.array[wp.transform],
+    body_qd_in: wp.array[wp.spatial_vector],
+    body_wrench_in: wp.array[wp.spatial_vector],
+    # Data out:
+    body_qd_out: wp.array[wp.spatial_vector],
+) -> None:
+    """Remove the lagged sand wrench's velocity change, so MPM re-solves the contact with the body's mass."""
+    b = wp.tid()
+    w = body_wrench_in[b]
+    rot = wp.transform_get_rotation(body_q_in[b])
+    dv = dt * body_inv_mass[b] * wp.spatial_top(w)
+    dw = dt * wp.quat_rotate(rot, body_inv_inertia[b] * wp.quat_rotate_inv(rot, wp.spatial_bottom(w)))
+    body_qd_out[b] = body_qd_in[b] - wp.spatial_vector(dv, dw)
+
+
+def eval_rewind_body_velocity(
+    body_inv_mass: wp.array,
+    body_inv_inertia: wp.array,
+    dt: float,
+    body_q: wp.array,
+    body_qd: wp.array,
+    body_wrench: wp.array,
+    body_qd_out: wp.array,
+) -> None:
+    """Write body velocities without the last frame's sand wrench: qd - dt M^-1 wrench (semi-implicit coupling)."""
+    wp.launch(
+        _rewind_body_velocity,
+        dim=body_qd.shape[0],
+        inputs=[body_inv_mass, body_inv_inertia, dt, body_q, body_qd, body_wrench],
+        outputs=[body_qd_out],
+        device=body_qd.device,
+    )

@@ -1,0 +1,120 @@
+# SPDX-License-Identifier: Apache-2.0
+"""Material mapping: one granular medium (rho_c, mu_int, mu_surf, packing) expressed in Newton's implicit MPM.
+
+Every MPM evaluation in gmloco builds its sand through :func:`mpm_material` and :func:`apply_mpm_material`, so a
+``MaterialCfg`` means the same medium in the RFT models and in MPM. The reasoning is in
+``packages/eval/README.md`` ("Material mapping"); in short:
+
+* ``rho_c`` -> particle density ``particle_mass / (8 r^3)``. Newton's unilateral incompressibility makes a cell
+  stress-bearing only once it is fully packed by particle volume, which is the critical-state density of the
+  Kamrin continuum that 3D-RFT was fitted on (Agarwal, Goldman & Kamrin, PNAS 2023; Dunatunga & Kamrin, JFM 2015).
+  The bed is emitted at fill fraction 1, so its bulk density is rho_c and its lithostatic pressure rho_c g z.
+* ``mu_int`` -> ``mpm:friction``. Newton's yield surface is sqrt(J2) <= mu p + s (checked in
+  ``rheology_solver_kernels.shear_yield_stress`` with warp.fem's symmetric-tensor mapping: |r_T| = sqrt(J2),
+  r_N = sqrt(3/2) p), the same Drucker-Prager form as the continuum of Dunatunga & Kamrin 2015 whose mu
+  the PNAS f(mu) was fitted against.
+* ``mu_surf`` -> the collider (intruder) Coulomb friction, ``ShapeConfig.mu`` of the intruder's shapes.
+* ``packing`` -> only through rho_c = packing * bulk_density, exactly as in the RFT models; Newton has no
+  separate packing input once ``critical_fraction = 0`` (no free compaction below rho_c).
+* Cohesionless, rigid-plastic sand: ``yield_stress = 0``, ``tensile_yield_ratio = 0``, ``young_modulus = 1e15``
+  (Newton's default, the fully inelastic limit its solver targets), no dilatancy, hardening or viscosity.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Any, Protocol
+
+import numpy as np
+
+__all__ = ["GranularMaterial", "MpmMaterialCfg", "apply_mpm_material", "mpm_material"]
+
+
+class GranularMaterial(Protocol):
+    """What the mapping reads from a material (``gmloco.contact.MaterialCfg`` satisfies it)."""
+
+    @property
+    def rho_c(self) -> float:
+        """Critical density [kg/m^3]."""
+        ...
+
+    mu_int: float
+    mu_surf: float
+
+
+@dataclass(frozen=True)
+class MpmMaterialCfg:
+    """Newton implicit-MPM parameters of one medium (``mpm:*`` particle attributes plus collider friction)."""
+
+    density: float
+    """Particle (fully packed) density = rho_c [kg/m^3]."""
+    friction: float
+    """Drucker-Prager coefficient mu in sqrt(J2) <= mu p (``mpm:friction``) = mu_int [-]."""
+    collider_friction: float
+    """Coulomb friction between intruder and sand (``ShapeConfig.mu`` of the intruder) = mu_surf [-]."""
+    young_modulus: float = 1.0e15
+    """Young's modulus [Pa]; 1e15 is Newton's rigid-plastic default."""
+    poisson_ratio: float = 0.3
+    """Poisson ratio [-] (inactive in the rigid limit)."""
+    yield_pressure: float = 1.0e12
+    """Compressive yield pressure cap [Pa]; effectively infinite (no crushing)."""
+    tensile_yield_ratio: float = 0.0
+    """Tensile over compressive yield pressure [-]; 0 = no tension (cohesionless)."""
+    yield_stress: float = 0.0
+    """Deviatoric yield stress at zero pressure (cohesion) [Pa]; 0 for dry sand."""
+    dilatancy: float = 0.0
+    """Dilatancy factor [-]; 0 = non-associated, volume-preserving flow."""
+    hardening: float = 0.0
+    """Plastic hardening factor [-]."""
+    critical_fraction: float = 0.0
+    """``SolverImplicitMPM.Config.critical_fraction`` [-]: 0 = the bed is at rho_c and never compacts freely."""
+
+    def mpm_attributes(self) -> dict[str, float]:
+        """Return the per-particle ``model.mpm.<name>`` values of this medium."""
+        return {
+            "young_modulus": self.young_modulus,
+            "poisson_ratio": self.poisson_ratio,
+            "friction": self.friction,
+            "yield_pressure": self.yield_pressure,
+            "tensile_yield_ratio": self.tensile_yield_ratio,
+            "yield_stress": self.yield_stress,
+            "dilatancy": self.dilatancy,
+            "hardening": self.hardening,
+            "viscosity": 0.0,
+            "damping": 0.0,
+        }
+
+
+def mpm_material(material: GranularMaterial, **overrides: Any) -> MpmMaterialCfg:
+    """Map a granular medium to Newton implicit-MPM parameters (see the module docstring).
+
+    Args:
+        material: The medium, e.g. ``gmloco.contact.MaterialCfg``; reads ``rho_c``, ``mu_int``, ``mu_surf``.
+        **overrides: Fields of :class:`MpmMaterialCfg` to change (e.g. ``young_modulus`` for a compliant bed).
+    """
+    rho_c = float(material.rho_c)
+    if not np.isfinite(rho_c) or rho_c <= 0.0:
+        raise ValueError(f"rho_c={rho_c} [kg/m^3] must be positive")
+    return MpmMaterialCfg(
+        density=rho_c, friction=float(material.mu_int), collider_friction=float(material.mu_surf), **overrides
+    )
+
+
+def apply_mpm_material(model: Any, mat: MpmMaterialCfg, particle_ids: np.ndarray | None = None) -> None:
+    """Write the medium's ``mpm:*`` attributes into a finalized Newton model (all or some particles).
+
+    Particle masses are set at emission (:func:`gmloco.eval.mpm.bed.emit_sand_bed`); this sets the rheology.
+
+    Args:
+        model: A ``newton.Model`` built with ``SolverImplicitMPM.register_custom_attributes``.
+        mat: The mapped medium.
+        particle_ids: Particles to set, [n] ints; None = all.
+    """
+    for name, value in mat.mpm_attributes().items():
+        arr = getattr(model.mpm, name)
+        if particle_ids is None:
+            arr.fill_(value)
+        else:
+            host = arr.numpy()
+            host[np.asarray(particle_ids, dtype=np.int64)] = value
+            arr.assign(host)
