@@ -1,0 +1,25 @@
+# SPDX-License-Identifier: Apache-2.0
+"""Fixtures for the cross-package pipeline tests (``workflows/`` is on ``sys.path`` via pytest's pythonpath)."""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+
+import pytest
+from omegaconf import DictConfig
+
+@pytest.fixture(autouse=True)
+def _no_wandb(monkeypatch: pytest.MonkeyPatch) -> None:
+    """Keep tests off wandb (the tracking config reads ``WANDB_MODE``)."""
+    monkeypatch.setenv("WANDB_MODE", "disabled")
+
+
+@pytest.fixture
+def compose() -> Callable[..., DictConfig]:
+    """Return ``compose(*overrides)``: the checked pipeline config, as ``@hydra.main`` tasks see it."""
+    from hydra_entry import compose_checked
+
+    def _compose(*overrides: str) -> DictConfig:
+        return compose_checked("full_pipeline", list(overrides))
+
+    return _compose

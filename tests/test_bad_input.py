@@ -1,0 +1,63 @@
+# SPDX-License-Identifier: Apache-2.0
+"""Bad input gives one paragraph naming the key and the valid choices, exit code 2, and no traceback."""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+
+import pytest
+from omegaconf import DictConfig
+
+from config_errors import ConfigInputError
+from tests.pipeline_helpers import plain_python_env, run_cli
+
+CASES = [
+    # (overrides, key named in the error, words the message must contain)
+    (["+exp=gm_lco"], "exp", ["gm_loco", "ppo_rigid", "did you mean 'gm_loco'"]),
+    ([], "exp_name", ["+exp=<name>", "gm_loco"]),
+    (["exp=gm_loco"], "exp", ["+exp=<option>"]),
+    (["+exp=gm_loco", "train_teacher.num_envz=8"], "train_teacher.num_envz", ["num_envs", "max_iterations"]),
+    (["+exp=gm_loco", "trainn.num_envs=8"], "trainn.num_envs", ["train_teacher", "seed"]),
+    (["+expp=gm_loco"], "expp", ["exp", "Config groups"]),
+    (["+exp=gm_loco", "+train_teacher.foo=1"], "train_teacher.foo", ["num_envs"]),
+    (["+exp=gm_loco", "seed=abc"], "seed", ["abc"]),
+    (["+exp=gm_loco", "train_teacher.contact_model=rft"], "train_teacher.contact_model", ["rft3d", "rigid"]),
+    (["+exp=gm_loco", "stages=[train]"], "stages", ["train_teacher", "mismatch"]),
+    (["+exp=gm_loco", "force=[exprt]"], "force", ["export"]),
+    (["+exp=gm_loco", "+scale=huge"], "scale", ["full", "smoke"]),
+]
+
+
+@pytest.mark.parametrize(("overrides", "key", "words"), CASES)
+def test_bad_input_names_key_and_choices(
+    compose: Callable[..., DictConfig], overrides: list[str], key: str, words: list[str]
+) -> None:
+    """Each bad command line raises ConfigInputError naming ``key`` and listing the valid choices."""
+    with pytest.raises(ConfigInputError) as info:
+        compose(*overrides)
+    assert info.value.key == key
+    message = str(info.value)
+    assert "\n" not in message
+    for word in words:
+        assert word in message
+
+
+@pytest.mark.parametrize(
+    ("args", "key"),
+    [(["+exp=gm_lco"], "gm_lco"), (["+exp=gm_loco", "train_teacher.num_envz=8"], "train_teacher.num_envz"), ([], "+exp")],
+)
+def test_cli_bad_input_exits_2_without_traceback(args: list[str], key: str) -> None:
+    """The command line exits with 2, names the key, prints no traceback and creates no run directory."""
+    res = run_cli(["workflows/full_pipeline.py", *args, "paths.runs_dir=/nonexistent/should-not-be-created"])
+    assert res.returncode == 2, res.stderr
+    assert key in res.stderr.replace("\n", " ")
+    assert "Traceback" not in res.stderr
+    assert "Nothing was run" in res.stderr.replace("\n", " ")
+
+
+def test_hydra_full_error_shows_the_traceback() -> None:
+    """``HYDRA_FULL_ERROR=1`` lets the original exception through with its traceback."""
+    env = plain_python_env() | {"HYDRA_FULL_ERROR": "1"}
+    res = run_cli(["workflows/full_pipeline.py", "+exp=gm_lco"], env=env)
+    assert res.returncode != 0
+    assert "Traceback" in res.stderr

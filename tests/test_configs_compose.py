@@ -1,0 +1,87 @@
+# SPDX-License-Identifier: Apache-2.0
+"""Every config under ``conf/`` composes, passes the entry checks and instantiates its schema dataclasses."""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from pathlib import Path
+
+import pytest
+from omegaconf import DictConfig, OmegaConf
+
+from config_errors import CONF_DIR, group_options, groups
+from schemas import ContactModelName, PipelineCfg, StageCfg, SweepCfg
+from stage_registry import stage_names
+
+EXPS = group_options("exp")
+"""Every experiment config."""
+DEFAULT_GROUPS = ("paths", "tracking")
+"""Groups selected in ``full_pipeline.yaml``'s defaults list (overridden without ``+``)."""
+GROUP_OPTIONS = [(g, o) for g in groups() if g != "exp" for o in group_options(g)]
+"""Every (group, option) pair except experiments."""
+
+
+def _instantiate(cfg: DictConfig) -> PipelineCfg:
+    """Convert to the schema dataclasses (fails on any type mismatch or unresolvable interpolation)."""
+    obj = OmegaConf.to_object(cfg)
+    assert isinstance(obj, PipelineCfg)
+    return obj
+
+
+def test_conf_has_the_house_groups() -> None:
+    """The config tree has exp/, sweep/, debug/, paths/, hydra/ and the scales."""
+    assert {"exp", "sweep", "debug", "paths", "scale"} <= set(groups())
+    assert (CONF_DIR / "hydra" / "default.yaml").is_file()
+    assert {"full", "smoke"} <= set(group_options("scale"))
+    assert {"gm_loco", "ppo_rft3d", "ppo_heuristic_rft", "ppo_cone_multi", "ppo_rigid"} <= set(EXPS)
+
+
+def test_every_yaml_is_composed_by_this_module() -> None:
+    """Every YAML file under conf/ is the primary config, Hydra's, or covered by EXPS / GROUP_OPTIONS."""
+    covered = {CONF_DIR / "full_pipeline.yaml", *(CONF_DIR / "hydra").glob("*.yaml")}
+    covered |= {CONF_DIR / "exp" / f"{e}.yaml" for e in EXPS}
+    covered |= {CONF_DIR / g / f"{o}.yaml" for g, o in GROUP_OPTIONS}
+    found = {p for p in CONF_DIR.rglob("*.yaml") if "local" not in p.relative_to(CONF_DIR).parts}
+    assert found == covered
+
+
+@pytest.mark.parametrize("scale", ["full", "smoke"])
+@pytest.mark.parametrize("exp", EXPS)
+def test_exp_composes_and_instantiates(compose: Callable[..., DictConfig], exp: str, scale: str) -> None:
+    """``+exp=<exp> +scale=<scale>`` composes, resolves and becomes typed dataclasses."""
+    obj = _instantiate(compose(f"+exp={exp}", f"+scale={scale}"))
+    assert obj.exp_name == exp
+    assert obj.scale.value == scale
+    assert set(obj.stages) <= set(stage_names())
+    assert isinstance(obj.train_teacher.contact_model, ContactModelName)
+    for name in stage_names():
+        stage = getattr(obj, name)
+        assert isinstance(stage, StageCfg)
+        assert Path(stage.out_dir).is_absolute() and Path(stage.out_dir).name == name
+        assert Path(stage.out_dir).parent == Path(obj.run_dir)
+
+
+@pytest.mark.parametrize(("group", "option"), GROUP_OPTIONS)
+def test_group_option_composes(compose: Callable[..., DictConfig], group: str, option: str) -> None:
+    """Each option of every other group composes on top of ``+exp=gm_loco``."""
+    prefix = "" if group in DEFAULT_GROUPS else "+"
+    obj = _instantiate(compose("+exp=gm_loco", f"{prefix}{group}={option}"))
+    if group == "sweep":
+        assert isinstance(obj.sweep, SweepCfg)
+
+
+def test_smoke_scale_shrinks_the_experiment(compose: Callable[..., DictConfig]) -> None:
+    """Smoke scale overrides the experiment's sizes even though ``+exp`` comes first on the command line."""
+    full = _instantiate(compose("+exp=gm_loco", "+scale=full"))
+    smoke = _instantiate(compose("+exp=gm_loco", "+scale=smoke"))
+    assert smoke.train_teacher.num_envs < full.train_teacher.num_envs
+    assert smoke.train_teacher.max_iterations < full.train_teacher.max_iterations
+    assert smoke.eval_mpm.num_episodes < full.eval_mpm.num_episodes
+
+
+def test_ablation_exps_select_their_contact_model(compose: Callable[..., DictConfig]) -> None:
+    """``+exp=ppo_<model>`` runs only the train stage with that contact model."""
+    for model in ("rft3d", "heuristic_rft", "cone_multi", "rigid"):
+        cfg = compose(f"+exp=ppo_{model}")
+        assert list(cfg.stages) == ["train_teacher"]
+        assert cfg.train_teacher.contact_model.value == model

@@ -1,0 +1,13 @@
+# SPDX-License-Identifier: Apache-2.0
+"""``full_pipeline.py`` with the toy stages registered: the kill/resume test runs this as a subprocess."""
+
+from __future__ import annotations
+
+import stage_registry
+from tests.pipeline_helpers import toy_registry
+
+if __name__ == "__main__":
+    stage_registry.STAGES = toy_registry()
+    import full_pipeline
+
+    full_pipeline.main()
