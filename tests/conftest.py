@@ -8,6 +8,7 @@ from collections.abc import Callable
 import pytest
 from omegaconf import DictConfig
 
+
 @pytest.fixture(autouse=True)
 def _no_wandb(monkeypatch: pytest.MonkeyPatch) -> None:
     """Keep tests off wandb (the tracking config reads ``WANDB_MODE``)."""

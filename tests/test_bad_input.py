@@ -44,7 +44,11 @@ def test_bad_input_names_key_and_choices(
 
 @pytest.mark.parametrize(
     ("args", "key"),
-    [(["+exp=gm_lco"], "gm_lco"), (["+exp=gm_loco", "train_teacher.num_envz=8"], "train_teacher.num_envz"), ([], "+exp")],
+    [
+        (["+exp=gm_lco"], "gm_lco"),
+        (["+exp=gm_loco", "train_teacher.num_envz=8"], "train_teacher.num_envz"),
+        ([], "+exp"),
+    ],
 )
 def test_cli_bad_input_exits_2_without_traceback(args: list[str], key: str) -> None:
     """The command line exits with 2, names the key, prints no traceback and creates no run directory."""

@@ -45,7 +45,13 @@ def test_first_run_records_everything(run: Callable[..., dict[str, Any]], tmp_pa
     for name in ("export", "eval_mpm", "analyze_logs", "mismatch"):
         assert statuses[name] == "not_implemented"
     root = tmp_path / "run"
-    for rel in ("config.yaml", "manifest.json", "summary.json", "train_teacher/checkpoint.json", "distill/student.json"):
+    for rel in (
+        "config.yaml",
+        "manifest.json",
+        "summary.json",
+        "train_teacher/checkpoint.json",
+        "distill/student.json",
+    ):
         assert (root / rel).is_file(), rel
     assert list((root / "git").glob("gmloco-*.diff")) and list((root / "tb").iterdir())
     metrics = read_json(root / "distill" / "metrics.json")
