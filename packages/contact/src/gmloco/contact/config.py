@@ -37,13 +37,15 @@ class _AtRestCfg:
 
     at_rest: AtRestMode = "unloading"
     """At-rest treatment, see :data:`AtRestMode`."""
-    unloading_ratio: float = 20.0
+    unloading_ratio: float = 1.0
     """Elastic unloading stiffness over the loading (secant) stiffness [-]; the force vanishes after the
-    element rises by z_max / ratio."""
-    unloading_damping: float = 0.0
+    element rises by z_max / ratio. Ratios above ~1.5 make the light, weakly held G1 foot rock at the step
+    rate under 200 Hz explicit coupling (README, "At rest")."""
+    unloading_damping: float = 0.001
     """Kelvin-Voigt time constant of the elastic branch [s]: d_eff += damping * ratio * d_depth/dt."""
-    slip_velocity: float = 0.01
-    """Tangential speed below which the elastic branch's Coulomb friction is viscous [m/s] (3D-RFT only)."""
+    tangential_damping: float = 1.0e4
+    """Viscous cap of the elastic branch's Coulomb friction per element area, F_t = -min(mu F_n, c_t dS |v_t|)
+    [N s/m^3] (3D-RFT only; 150 N s/m for the G1 sole)."""
     ema_rate: float = 0.5
     """EMA rigidity increment per velocity reversal c_r = 100 dt [-] (0.5 at 200 Hz, Choi 2023 S16)."""
 

@@ -109,13 +109,20 @@ def rft3d_elastic_force(
     coeffs: wp.array2d[float],
     ratio: float,
     damping: float,
-    slip_velocity: float,
+    tangential_damping: float,
 ) -> wp.vec3:
-    """Return the elastic-branch force inside the crater: static alpha on d_eff plus regularized Coulomb [N]."""
+    """Return the elastic-branch force inside the crater: static alpha on d_eff plus capped viscous friction [N].
+
+    F_t = -min(mu |F.n|, c_t dS |v_t|) v_t / |v_t| in the element plane (the viscous cap keeps the explicit
+    coupling stable, like GM-Loco's k_f for its baselines).
+    """
     alpha_s = rft3d_alpha(rft3d_generic(n, G_HAT, coeffs), n, xi, mu_surf, G_HAT, 0)
     f = alpha_s * (unloading_depth(depth, depth_max, ratio, damping, -v[2]) * area)
     v_t = v - wp.dot(v, n) * n
-    return f - (mu_surf * wp.abs(wp.dot(f, n)) / wp.max(wp.length(v_t), slip_velocity)) * v_t
+    speed = wp.length(v_t)
+    if speed <= 0.0:
+        return f
+    return f - (wp.min(mu_surf * wp.abs(wp.dot(f, n)), tangential_damping * area * speed) / speed) * v_t
 
 
 @wp.kernel
@@ -135,7 +142,7 @@ def rft3d_point_force_kernel(
     at_rest: int,
     unloading_ratio: float,
     unloading_damping: float,
-    slip_velocity: float,
+    tangential_damping: float,
     ema_rate: float,
     # Data in:
     foot_pos_in: wp.array2d[wp.vec3],
@@ -175,7 +182,7 @@ def rft3d_point_force_kernel(
     force = wp.vec3(0.0)
     if at_rest == AT_REST_UNLOADING and depth > 0.0 and depth < depth_max:
         force = rft3d_elastic_force(
-            n, v, depth, depth_max, areas[p], xi, mat[2], coeffs, unloading_ratio, unloading_damping, slip_velocity
+            n, v, depth, depth_max, areas[p], xi, mat[2], coeffs, unloading_ratio, unloading_damping, tangential_damping
         )
     else:
         force = rft3d_plastic_force(n, v, depth, areas[p], xi, mat[2], coeffs, v_eps, sign_fix)
@@ -209,7 +216,7 @@ def eval_rft3d_point_forces(model: Any, inputs: tuple, nan_count_out: wp.array) 
             model.at_rest_code,
             cfg.unloading_ratio,
             cfg.unloading_damping,
-            cfg.slip_velocity,
+            cfg.tangential_damping,
             cfg.ema_rate,
             foot_pos,
             foot_mat,

@@ -199,7 +199,7 @@ def rft3d_unloading_forces(
     mu_int: float,
     mu_surf: float,
     ratio: float,
-    slip_velocity: float,
+    tangential_damping: float,
     damping: float = 0.0,
     surface_z: float | np.ndarray = 0.0,
     coeffs: Coeffs = "pnas",
@@ -210,7 +210,7 @@ def rft3d_unloading_forces(
     Elements deeper than their remembered maximum depth z_max (virgin loading) get plain RFT. Inside
     the crater (0 < depth < z_max) the element is on an elastic branch: the static resistance
     alpha_s = alpha(n, v_hat = g_hat) acts on an effective depth d_eff = max(0, z_max - r (z_max - d) + damping r
-    d_dot) with d_dot = -v_z, plus a regularized Coulomb friction -mu |F.n| v_t / max(|v_t|, v_slip).
+    d_dot) with d_dot = -v_z, plus a capped viscous friction -min(mu |F.n|, c_t dS |v_t|) v_t / |v_t|.
     """
     n = np.asarray(normals, dtype=np.float64)
     v = np.asarray(velocities, dtype=np.float64)
@@ -233,7 +233,10 @@ def rft3d_unloading_forces(
     f_el = alpha_s * (d_eff * areas)[:, None]
     v_t = v - np.sum(v * n, -1, keepdims=True) * n
     speed_t = np.linalg.norm(v_t, axis=-1, keepdims=True)
-    f_el = f_el - mu_surf * np.abs(np.sum(f_el * n, -1, keepdims=True)) * v_t / np.maximum(speed_t, slip_velocity)
+    cap = np.minimum(
+        mu_surf * np.abs(np.sum(f_el * n, -1, keepdims=True)), tangential_damping * areas[:, None] * speed_t
+    )
+    f_el = f_el - cap * v_t / np.maximum(speed_t, 1e-300)
     elastic = (depth > 0.0) & (depth < depth_max)
     return np.where(elastic[:, None], f_el, plastic)
 
