@@ -1,0 +1,140 @@
+# SPDX-License-Identifier: Apache-2.0
+"""Make "real" recordings from the truth simulator: scripted motion, one hidden effect, noise and nuisances.
+
+Only channels a real G1 logs are produced (LowState joints and IMU, LowCmd); base odometry only when asked
+(as an estimator or mocap would provide). The truth key is returned separately so that callers write it where
+the tool cannot read it.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from gmloco.deploy.mismatch.benchmark.controller import MotionCfg, ScriptedMotion, default_gains
+from gmloco.deploy.mismatch.benchmark.truth import (
+    NoiseCfg,
+    TruthActuator,
+    TruthEffect,
+    TruthSensor,
+    truth_spec_edit,
+    truth_terrain_wrench,
+)
+from gmloco.deploy.mismatch.g1model import G1_EFFORT_LIMIT, G1SimCfg, build_model
+from gmloco.deploy.mismatch.recording import Recording
+
+__all__ = ["EpisodeCfg", "generate"]
+
+
+@dataclass
+class EpisodeCfg:
+    """One benchmark episode."""
+
+    effect: TruthEffect = field(default_factory=TruthEffect)
+    """Hidden effect (the truth key)."""
+    motion: MotionCfg = field(default_factory=MotionCfg)
+    """Scripted motion."""
+    duration: float = 8.0
+    """Recording length [s]."""
+    rate_hz: float = 500.0
+    """LowState / LowCmd rate [Hz]."""
+    substeps: int = 4
+    """Truth physics steps per log sample (explicit friction needs a short step)."""
+    seed: int = 0
+    """Noise and nuisance seed."""
+    nuisance: bool = True
+    """Draw small mass, friction and per-joint gain errors (never exactly nominal)."""
+    noise: NoiseCfg | None = field(default_factory=NoiseCfg)
+    """Sensor noise; ``None`` for noise-free recordings."""
+    odometry: bool = False
+    """Also log ground-truth base odometry."""
+    drop_fraction: float = 0.0
+    """Fraction of LowState samples dropped (marked invalid after resampling)."""
+
+
+def _initial_state(model: object, data: object, q0: np.ndarray) -> None:
+    """Place the robot standing on the ground in the default pose."""
+    import mujoco
+
+    data.qpos[3:7] = [1, 0, 0, 0]
+    data.qpos[7:] = q0
+    data.qpos[2] = 0.8
+    mujoco.mj_kinematics(model, data)
+    feet = [model.body(f"{s}_ankle_roll_link").id for s in ("left", "right")]
+    low = min(float((data.xpos[b] + np.array([0, 0, -0.035]) @ data.xmat[b].reshape(3, 3).T)[2]) for b in feet)
+    data.qpos[2] -= low + 0.002
+
+
+def generate(cfg: EpisodeCfg) -> tuple[Recording, dict]:
+    """Simulate one episode; return the recording and its truth key."""
+    import mujoco
+
+    rng = np.random.default_rng(cfg.seed)
+    dt_log = 1.0 / cfg.rate_hz
+    dt = dt_log / cfg.substeps
+    model = build_model(G1SimCfg(timestep=dt), spec_edit=truth_spec_edit(cfg.effect, rng, cfg.nuisance))
+    model.opt.integrator = mujoco.mjtIntegrator.mjINT_IMPLICITFAST
+    data = mujoco.MjData(model)
+    act = TruthActuator(cfg.effect, G1_EFFORT_LIMIT, dt, rng, cfg.nuisance)
+    sen = TruthSensor(cfg.effect, rng, cfg.noise)
+    ctrl = ScriptedMotion(cfg.motion)
+    kp, kd = default_gains()
+    _initial_state(model, data, ctrl.q0)
+    feet = [model.body(f"{s}_ankle_roll_link").id for s in ("left", "right")]
+    n = int(round(cfg.duration * cfg.rate_hz))
+    out = {k: np.zeros((n, w)) for k, w in (("q", 29), ("dq", 29), ("tau", 29), ("qc", 29), ("quat", 4), ("gyro", 3), ("acc", 3), ("pos", 3), ("bq", 4), ("v", 3), ("w", 3))}
+    tau = np.zeros(29)
+    for k in range(n):
+        mujoco.mj_forward(model, data)
+        q_enc, dq_enc = sen.encoders(data.qpos[7:].copy(), data.qvel[6:].copy())
+        quat, gyro, acc = sen.imu(data.qpos[3:7].copy(), data.sensordata[0:3].copy(), data.sensordata[6:9].copy())
+        qc = ctrl.targets(k * dt_log, quat, gyro)
+        cmd = (qc, np.zeros(29), kp, kd, np.zeros(29))
+        for sub in range(cfg.substeps):
+            if sub:
+                mujoco.mj_forward(model, data)
+            qe = data.qpos[7:] + sen.offset
+            tau = act.motor_torque(cmd, qe, data.qvel[6:])
+            if sub == 0:
+                tau_log = tau.copy()
+            data.qfrc_applied[6:] = tau + act.joint_friction(data.qvel[6:])
+            data.xfrc_applied[:] = 0.0
+            truth_terrain_wrench(cfg.effect, model, data, feet)
+            mujoco.mj_step(model, data)
+        rot = data.xmat[1].reshape(3, 3)
+        out["q"][k], out["dq"][k], out["tau"][k], out["qc"][k] = q_enc, dq_enc, sen.tau(tau_log), qc
+        out["quat"][k], out["gyro"][k], out["acc"][k] = quat, gyro, acc
+        out["pos"][k], out["bq"][k] = data.qpos[:3], data.qpos[3:7]
+        out["v"][k], out["w"][k] = rot.T @ data.qvel[:3], data.qvel[3:6]
+        if data.qpos[2] < 0.45:
+            raise RuntimeError(f"truth robot fell at t = {k * dt_log:.2f} s (effect {cfg.effect.id})")
+    return _to_recording(cfg, out, n, dt_log, kp, kd, rng), {"effect": cfg.effect.id, "params": cfg.effect.params, "seed": cfg.seed}
+
+
+def _to_recording(cfg: EpisodeCfg, o: dict, n: int, dt: float, kp: np.ndarray, kd: np.ndarray, rng: np.random.Generator) -> Recording:
+    """Pack arrays as a :class:`Recording` (with dropped samples marked invalid)."""
+    valid = np.ones(n, bool)
+    if cfg.drop_fraction > 0:
+        valid[rng.random(n) < cfg.drop_fraction] = False
+    odo = cfg.odometry
+    return Recording(
+        t=np.arange(n) * dt,
+        q=o["q"],
+        dq=o["dq"],
+        tau_est=o["tau"],
+        q_cmd=o["qc"],
+        dq_cmd=np.zeros((n, 29)),
+        kp=np.tile(kp, (n, 1)),
+        kd=np.tile(kd, (n, 1)),
+        tau_ff=np.zeros((n, 29)),
+        imu_quat=o["quat"],
+        imu_gyro=o["gyro"],
+        imu_acc=o["acc"],
+        base_pos=o["pos"] if odo else None,
+        base_quat=o["bq"] if odo else None,
+        base_linvel=o["v"] if odo else None,
+        base_angvel=o["w"] if odo else None,
+        valid=valid,
+        meta={"controller": f"scripted_{cfg.motion.kind}", "source": "benchmark"},
+    )

@@ -1,0 +1,288 @@
+# SPDX-License-Identifier: Apache-2.0
+"""The candidate-effect vocabulary: stable ids, parameters with units and bounds, signatures, confusables.
+
+Each effect is a parametric change of the nominal simulator (:mod:`gmloco.deploy.mismatch.g1model`) that is
+*exactly* nominal at zero parameters. The ids are part of the report schema and never change meaning;
+new effects get new ids. Physics and signatures follow ``shared/reference/mismatch-discovery.md`` section 2.
+The code that realises each effect lives in :mod:`gmloco.deploy.mismatch.replay` (actuator, sensor, model
+edits) and :mod:`gmloco.deploy.mismatch.terrain` (ground); the ranking code never special-cases an id.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from gmloco.deploy.logs.g1 import G1_JOINT_NAMES
+
+__all__ = ["EFFECTS", "EFFECT_IDS", "LEG_JOINTS", "OUTCOME_IDS", "EffectSpec", "ParamSpec", "effect", "zero_params"]
+
+LEG_JOINTS: tuple[str, ...] = G1_JOINT_NAMES[:12]
+"""Joints carrying per-joint effect parameters (encoder offsets): the two legs, hip to ankle."""
+
+OUTCOME_IDS: tuple[str, ...] = ("none", "unexplained")
+"""Report outcomes that are not effects: nothing missing, or something outside the library."""
+
+
+@dataclass(frozen=True)
+class ParamSpec:
+    """One (possibly vector) parameter of an effect; zero is the nominal simulator."""
+
+    name: str
+    """Parameter name, unique within the effect."""
+    unit: str
+    """SI unit, ``"1"`` when dimensionless."""
+    size: int
+    """Number of components (e.g. 12 encoder offsets, 3 gyro biases)."""
+    lower: float
+    """Lower bound of every component."""
+    upper: float
+    """Upper bound of every component."""
+    fd_step: float
+    """Finite-difference step used for sensitivities, same unit."""
+    tolerance: float
+    """Smallest magnitude that counts as a mismatch (a practical, not statistical, threshold), same unit."""
+    doc: str
+    """What the parameter means."""
+    labels: tuple[str, ...] = ()
+    """Component labels (joint or axis names) when ``size > 1``."""
+
+
+@dataclass(frozen=True)
+class EffectSpec:
+    """A candidate missing physics."""
+
+    id: str
+    """Stable effect id (``<group>.<name>``)."""
+    title: str
+    """Human-readable name."""
+    params: tuple[ParamSpec, ...]
+    """Parameters; all zero is the nominal simulator."""
+    model: str
+    """Parametric model, in words and equations."""
+    signature: str
+    """Where it shows in proprioceptive data (signal, phase)."""
+    phases: tuple[str, ...]
+    """Gait phases where it can act (``swing``, ``touchdown``, ``stance``, ``liftoff``, ``any``)."""
+    signals: tuple[str, ...]
+    """Signals it changes (``q``, ``dq``, ``tau_est``, ``gyro``, ``acc``)."""
+    confusables: tuple[str, ...]
+    """Effect ids with similar signatures."""
+    excitation: str
+    """What a recording needs for the effect to be testable."""
+
+    @property
+    def size(self) -> int:
+        """Total number of parameter components."""
+        return sum(p.size for p in self.params)
+
+    def split(self, theta: np.ndarray) -> dict[str, np.ndarray]:
+        """Split a flat parameter vector into named parameters."""
+        out, i = {}, 0
+        for p in self.params:
+            out[p.name] = np.asarray(theta[i : i + p.size], dtype=float)
+            i += p.size
+        return out
+
+    def bounds(self) -> tuple[np.ndarray, np.ndarray]:
+        """Return flat lower and upper bounds, shape [size] each."""
+        lo = np.concatenate([np.full(p.size, p.lower) for p in self.params])
+        hi = np.concatenate([np.full(p.size, p.upper) for p in self.params])
+        return lo, hi
+
+    def flat(self, attr: str) -> np.ndarray:
+        """Return a per-component vector of a :class:`ParamSpec` attribute (``fd_step``, ``tolerance``)."""
+        return np.concatenate([np.full(p.size, getattr(p, attr)) for p in self.params])
+
+    def labels(self) -> list[str]:
+        """Return flat component labels ``name`` or ``name[label]``."""
+        out = []
+        for p in self.params:
+            out += [p.name] if p.size == 1 else [f"{p.name}[{lab}]" for lab in (p.labels or map(str, range(p.size)))]
+        return out
+
+
+_A = ("q", "dq", "tau_est", "gyro", "acc")
+EFFECTS: tuple[EffectSpec, ...] = (
+    EffectSpec(
+        "actuator.delay",
+        "Action / command delay",
+        (ParamSpec("delay", "s", 1, 0.0, 0.04, 0.002, 0.002, "Transport delay of every LowCmd field."),),
+        "u(t) = u_cmd(t - d), linear interpolation of the logged commands (Isaac Lab DelayedPDActuator).",
+        "Residual ~ -d du/dt; phase lag of q behind q_cmd growing with frequency; same on all joints.",
+        ("any",),
+        ("q", "dq", "tau_est"),
+        ("actuator.gain_scale", "joint.armature"),
+        "Commands that change faster than the delay (swing, stepping, chirps).",
+    ),
+    EffectSpec(
+        "actuator.gain_scale",
+        "PD gain mismatch",
+        (ParamSpec("kp_scale", "1", 1, -0.6, 0.6, 0.03, 0.06, "Realised gains (1 + s) kp, (1 + s) kd."),),
+        "tau = (1 + s) (kp (q* - q) + kd (dq* - dq)) + tau_ff; tau_est reports the realised torque.",
+        "tau_est differs from the PD law evaluated on logged q; stance sag; altered swing overshoot.",
+        ("any",),
+        _A,
+        ("joint.viscous_damping", "actuator.torque_speed"),
+        "Non-zero tracking error (any load).",
+    ),
+    EffectSpec(
+        "actuator.torque_speed",
+        "Torque-speed saturation (DC-motor envelope)",
+        (ParamSpec("droop", "s/rad", 1, 0.0, 0.2, 0.01, 0.01, "Torque limit lost per rad/s of joint speed."),),
+        "|tau| <= tau_max (1 - droop |dq|) (Isaac Lab DCMotor envelope); tau_max from mjlab's G1 constants.",
+        "tau_est plateaus while the PD torque grows: push-off, fast swing, deep stance.",
+        ("stance", "liftoff", "swing"),
+        _A,
+        ("actuator.gain_scale", "terrain.depth_hardening"),
+        "Torques near the limit at high joint speed (push-off, fast swings).",
+    ),
+    EffectSpec(
+        "joint.coulomb_friction",
+        "Coulomb joint friction",
+        (ParamSpec("tau_c", "N*m", 1, 0.0, 8.0, 0.3, 0.3, "Friction of an 88 N*m joint; others scale by effort limit."),),
+        "Dry friction of magnitude tau_c * tau_max_j / 88 N*m (MuJoCo frictionloss constraint).",
+        "Steps in the motion residual at dq sign changes; position error ~ tau_c / kp at low speed.",
+        ("swing", "any"),
+        ("q", "dq", "gyro", "acc"),
+        ("joint.viscous_damping", "sensor.encoder_offset"),
+        "Joint velocity reversals (swing, stepping, chirps).",
+    ),
+    EffectSpec(
+        "joint.viscous_damping",
+        "Viscous joint damping",
+        (ParamSpec("b", "N*m*s/rad", 1, -0.5, 6.0, 0.15, 0.15, "Damping of an 88 N*m joint; others scale by effort limit."),),
+        "tau_f = -b_j dq with b_j = b tau_max_j / 88 N*m. With dq* = 0 it is collinear with kd in motion, "
+        "but not in tau_est, which only sees the PD torque.",
+        "Motion residual ~ dq, phase lag at high swing speed; tau_est unchanged.",
+        ("swing", "any"),
+        ("q", "dq", "gyro", "acc"),
+        ("actuator.gain_scale", "joint.coulomb_friction", "joint.armature"),
+        "Joint speeds well above the encoder noise.",
+    ),
+    EffectSpec(
+        "joint.armature",
+        "Armature (reflected rotor inertia)",
+        (ParamSpec("scale", "1", 1, -0.8, 6.0, 0.3, 0.25, "Armature (1 + s) times mjlab's nominal."),),
+        "(M(q) + diag((1 + s) I_a)) ddq.",
+        "Residual ~ ddq: swing reversals, touchdown; shifts the PD natural frequency.",
+        ("swing", "touchdown", "any"),
+        ("q", "dq", "tau_est", "gyro", "acc"),
+        ("actuator.delay", "terrain.rate_drag"),
+        "Joint accelerations (swing, reversals).",
+    ),
+    EffectSpec(
+        "sensor.encoder_offset",
+        "Encoder offset / calibration bias",
+        (
+            ParamSpec(
+                "offset", "rad", 12, -0.1, 0.1, 0.005, 0.006, "q_meas = q + offset, leg joints.", LEG_JOINTS
+            ),
+        ),
+        "q_meas = q_true + c_j on the leg joints; the motor PD acts on q_meas.",
+        "Constant posture and gravity-torque bias per joint, phase independent.",
+        ("any",),
+        ("q", "dq", "tau_est", "gyro", "acc"),
+        ("imu.misalignment",),
+        "Any loaded posture (standing is enough).",
+    ),
+    EffectSpec(
+        "imu.gyro_bias",
+        "Gyroscope bias",
+        (ParamSpec("bias", "rad/s", 3, -0.2, 0.2, 0.01, 0.006, "Additive gyro bias.", ("x", "y", "z")),),
+        "gyro_meas = omega + b (IMU frame).",
+        "Constant gyro offset in every phase.",
+        ("any",),
+        ("gyro",),
+        ("imu.misalignment",),
+        "Any recording.",
+    ),
+    EffectSpec(
+        "imu.misalignment",
+        "IMU mounting misalignment",
+        (ParamSpec("angle", "rad", 2, -0.15, 0.15, 0.01, 0.01, "IMU roll and pitch relative to the pelvis.", ("roll", "pitch")),),
+        "R_imu = R_pelvis R_x(roll) R_y(pitch): quaternion, gyro and accelerometer rotated.",
+        "Base tilt inconsistent with flat feet: stance torques, tilting motion after reset.",
+        ("stance", "any"),
+        ("q", "dq", "tau_est", "gyro", "acc"),
+        ("sensor.encoder_offset", "imu.gyro_bias"),
+        "Standing or stepping with the feet on level ground.",
+    ),
+    EffectSpec(
+        "body.mass_error",
+        "Body mass error (torso payload)",
+        (ParamSpec("delta_mass", "kg", 1, -5.0, 12.0, 0.5, 0.6, "Mass added at the torso-link centre of mass."),),
+        "m_torso += dm, inertia scaled with mass.",
+        "Stance torque bias (hips, knees), sag ~ dm g / kp.",
+        ("stance",),
+        ("q", "dq", "tau_est", "gyro", "acc"),
+        ("actuator.gain_scale", "terrain.stiffness_scale"),
+        "Standing or stance phases.",
+    ),
+    EffectSpec(
+        "terrain.stiffness_scale",
+        "Ground stiffness / packing scale (zeta)",
+        (ParamSpec("zeta", "1", 1, -0.9, 8.0, 0.3, 0.3, "Added depth-linear stress zeta * alpha_ref * z."),),
+        "sigma_z += zeta alpha_ref z at each sole point (RFT depth-linear law, Li, Zhang & Goldman 2013).",
+        "Uniform change of stance sinkage and stance ankle/knee motion.",
+        ("stance", "touchdown"),
+        ("q", "dq", "tau_est", "acc"),
+        ("body.mass_error", "terrain.depth_hardening"),
+        "Stance phases; sinkage itself needs external sensing.",
+    ),
+    EffectSpec(
+        "terrain.depth_hardening",
+        "Non-linear depth hardening",
+        (ParamSpec("kappa", "1/m", 1, 0.0, 3000.0, 100.0, 100.0, "Added stress alpha_ref kappa z^2."),),
+        "sigma_z += alpha_ref kappa z^2 (Bekker-type convexity).",
+        "Deep-sinkage steps stiffer than shallow ones; confusable with zeta when the depth range is narrow.",
+        ("stance", "touchdown"),
+        ("q", "dq", "tau_est", "acc"),
+        ("terrain.stiffness_scale",),
+        "A range of sinkage depths (varying load).",
+    ),
+    EffectSpec(
+        "terrain.rate_drag",
+        "Rate-dependent (inertial) drag",
+        (ParamSpec("rho_drag", "kg/m^3", 1, 0.0, 2.0e5, 4000.0, 4000.0, "Drag rho A v_z^2 on intruding points."),),
+        "F_z += rho_drag A_i v_z^2 while the point intrudes (Roth, Han & Jaeger, arXiv 1910.10358).",
+        "Early-stance / touchdown deceleration, rises with impact speed.",
+        ("touchdown",),
+        ("q", "dq", "tau_est", "acc"),
+        ("joint.armature",),
+        "Touchdowns at varied speeds.",
+    ),
+    EffectSpec(
+        "terrain.cohesion",
+        "Cohesion / suction",
+        (ParamSpec("cohesion", "Pa", 1, 0.0, 4.0e4, 500.0, 500.0, "Adhesion stress on sole points in contact."),),
+        "F_z -= c A_i at sole points below the surface (Mohr-Coulomb cohesion, wet-sand RFT).",
+        "Delayed lift-off, extra flexion torque at LO, lower stance sinkage.",
+        ("liftoff", "stance"),
+        ("q", "dq", "tau_est", "acc"),
+        ("terrain.stiffness_scale", "body.mass_error"),
+        "Lift-offs (stepping).",
+    ),
+)
+"""The library, in report order."""
+
+EFFECT_IDS: tuple[str, ...] = tuple(e.id for e in EFFECTS)
+"""Stable effect ids."""
+
+
+def effect(effect_id: str) -> EffectSpec:
+    """Return the spec of an effect id.
+
+    Raises:
+        KeyError: Unknown id; the message lists the vocabulary.
+    """
+    for e in EFFECTS:
+        if e.id == effect_id:
+            return e
+    raise KeyError(f"unknown effect id {effect_id!r}; vocabulary: {EFFECT_IDS}")
+
+
+def zero_params() -> dict[str, np.ndarray]:
+    """Return all-zero (nominal) flat parameter vectors for every effect."""
+    return {e.id: np.zeros(e.size) for e in EFFECTS}

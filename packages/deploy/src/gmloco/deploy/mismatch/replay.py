@@ -1,0 +1,256 @@
+# SPDX-License-Identifier: Apache-2.0
+"""Multiple-shooting replay of a recording in the nominal (or hypothesis-modified) MuJoCo G1 simulator.
+
+For every segment start ``k0`` the simulator is reset to the *real* state at ``k0`` (joints from the log, base
+from odometry or leg odometry, :mod:`gmloco.deploy.mismatch.baseest`), the *logged* LowCmd is applied through
+the motor PD law for ``horizon`` samples, and the simulated measurements are compared with the logged ones
+(R1 short-horizon output error, ``shared/reference/mismatch-discovery.md`` section 3.2). Short horizons keep a
+closed-loop policy or a fall from hiding the local signature. Every candidate effect is applied here (actuator,
+sensor, model edits) or in :mod:`gmloco.deploy.mismatch.terrain`, and all are exactly nominal at zero.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+
+from gmloco.deploy.mismatch.baseest import BaseEstCfg, BaseTrajectory, estimate_base, odometry_base
+from gmloco.deploy.mismatch.effects import EFFECTS, effect
+from gmloco.deploy.mismatch.frames import quat_conj, quat_from_roll_pitch, quat_mul, quat_to_mat
+from gmloco.deploy.mismatch.g1model import G1_ARMATURE, G1_EFFORT_LIMIT, SOLE_POINTS, G1SimCfg, build_model
+from gmloco.deploy.mismatch.recording import Recording
+from gmloco.deploy.mismatch.terrain import TerrainCfg, TerrainParams, sole_forces
+
+__all__ = ["CHANNEL_GROUPS", "ReplayCfg", "Replayer", "channel_names"]
+
+CHANNEL_GROUPS: tuple[tuple[str, int], ...] = (("q", 29), ("dq", 29), ("tau_est", 29), ("gyro", 3), ("acc", 3))
+"""Compared signals and their widths, in output-column order."""
+
+_REF_EFFORT = 88.0  # N*m: friction/damping parameters are quoted for an 88 N*m joint (7520-14 motor)
+
+
+def channel_names(joint_names: tuple[str, ...]) -> list[str]:
+    """Return ``signal:joint`` (or ``signal:axis``) names of the output columns."""
+    out = []
+    for sig, width in CHANNEL_GROUPS:
+        out += [f"{sig}:{j}" for j in joint_names] if width == 29 else [f"{sig}:{a}" for a in "xyz"]
+    return out
+
+
+@dataclass
+class ReplayCfg:
+    """Settings of the multiple-shooting replay."""
+
+    horizon: int = 30
+    """Samples simulated after each reset (60 ms at 500 Hz)."""
+    stride: int = 3
+    """Compare every ``stride``-th sample of the horizon."""
+    substeps: int = 1
+    """Physics steps per log sample."""
+    sim: G1SimCfg = field(default_factory=G1SimCfg)
+    """Nominal simulator."""
+    base: BaseEstCfg = field(default_factory=BaseEstCfg)
+    """Leg-odometry settings (used when the log has no odometry)."""
+    terrain: TerrainCfg = field(default_factory=TerrainCfg)
+    """Terrain effect constants."""
+
+
+@dataclass
+class _Hyp:
+    """All effect parameters, unpacked for the inner loop."""
+
+    delay: float
+    gain: float
+    droop: float
+    tau_c: float
+    b: float
+    arm_scale: float
+    offset: np.ndarray
+    gyro_bias: np.ndarray
+    mis: np.ndarray
+    dmass: float
+    terrain: TerrainParams
+
+
+def _unpack(params: dict[str, np.ndarray]) -> _Hyp:
+    """Turn ``{effect_id: flat theta}`` into :class:`_Hyp` (missing ids are nominal)."""
+    p = {e.id: e.split(np.asarray(params.get(e.id, np.zeros(e.size)), float)) for e in EFFECTS}
+    off = np.zeros(29)
+    off[:12] = p["sensor.encoder_offset"]["offset"]
+    return _Hyp(
+        delay=float(p["actuator.delay"]["delay"][0]),
+        gain=1.0 + float(p["actuator.gain_scale"]["kp_scale"][0]),
+        droop=float(p["actuator.torque_speed"]["droop"][0]),
+        tau_c=float(p["joint.coulomb_friction"]["tau_c"][0]),
+        b=float(p["joint.viscous_damping"]["b"][0]),
+        arm_scale=float(p["joint.armature"]["scale"][0]),
+        offset=off,
+        gyro_bias=p["imu.gyro_bias"]["bias"],
+        mis=p["imu.misalignment"]["angle"],
+        dmass=float(p["body.mass_error"]["delta_mass"][0]),
+        terrain=TerrainParams(
+            zeta=float(p["terrain.stiffness_scale"]["zeta"][0]),
+            kappa=float(p["terrain.depth_hardening"]["kappa"][0]),
+            rho_drag=float(p["terrain.rate_drag"]["rho_drag"][0]),
+            cohesion=float(p["terrain.cohesion"]["cohesion"][0]),
+        ),
+    )
+
+
+class Replayer:
+    """Replay a :class:`Recording` over shooting segments with given effect parameters."""
+
+    def __init__(self, rec: Recording, cfg: ReplayCfg | None = None) -> None:
+        """Build the nominal model and cache what every replay needs."""
+        import mujoco
+
+        self.cfg = cfg or ReplayCfg()
+        self.rec = rec
+        self.model = build_model(self.cfg.sim)
+        self.data = mujoco.MjData(self.model)
+        m = self.model
+        self._torso = m.body("torso_link").id
+        self._mass0 = float(m.body_mass[self._torso])
+        self._inertia0 = m.body_inertia[self._torso].copy()
+        self._feet = [m.body(f"{s}_ankle_roll_link").id for s in ("left", "right")]
+        self._w = G1_EFFORT_LIMIT / _REF_EFFORT
+        self.offsets = np.arange(self.cfg.stride, self.cfg.horizon + 1, self.cfg.stride)
+        self._base_cache: dict[tuple, BaseTrajectory] = {}
+
+    # ----------------------------------------------------------------------------------------------- data
+    def segment_starts(self, spacing: int | None = None) -> np.ndarray:
+        """Return valid segment starts (no gap inside a segment), every ``spacing`` samples (default: horizon)."""
+        h = self.cfg.horizon
+        spacing = spacing or h
+        ok = self.rec.valid_mask()
+        bad = np.concatenate([[0], np.cumsum(~ok)])
+        starts = np.arange(0, self.rec.n - h - 1, spacing)
+        return starts[bad[starts + h + 1] - bad[starts] == 0]
+
+    def measured(self, starts: np.ndarray) -> np.ndarray:
+        """Logged measurements at the compare points, shape [S, P, 93]."""
+        r = self.rec
+        idx = starts[:, None] + self.offsets[None, :]
+        return np.concatenate([r.q[idx], r.dq[idx], r.tau_est[idx], r.imu_gyro[idx], r.imu_acc[idx]], axis=-1)
+
+    def base(self, params: dict[str, np.ndarray], starts: np.ndarray) -> BaseTrajectory:
+        """Base state at the segment starts under the sensor hypotheses of ``params`` (cached)."""
+        h = _unpack(params)
+        key = (tuple(np.round(h.offset[:12], 9)), tuple(np.round(h.mis, 9)), tuple(np.round(h.gyro_bias, 9)), starts.tobytes())
+        if key not in self._base_cache:
+            self._base_cache[key] = self._estimate(h, starts)
+            if len(self._base_cache) > 64:
+                self._base_cache.pop(next(iter(self._base_cache)))
+        return self._base_cache[key]
+
+    def _estimate(self, h: _Hyp, starts: np.ndarray) -> BaseTrajectory:
+        """Run the base estimator (or wrap odometry) at ``starts``."""
+        r = self.rec
+        q_true = r.q[starts] - h.offset
+        if r.has_odometry:
+            return odometry_base(self.model, q_true, r.base_pos[starts], r.base_quat[starts], r.base_linvel[starts], r.base_angvel[starts])
+        qm = quat_from_roll_pitch(float(h.mis[0]), float(h.mis[1]))
+        quat = quat_mul(r.imu_quat[starts], quat_conj(qm))
+        omega = (r.imu_gyro[starts] - h.gyro_bias) @ quat_to_mat(qm).T
+        return estimate_base(self.model, q_true, r.dq[starts], quat, omega, self.cfg.base)
+
+    # ----------------------------------------------------------------------------------------- simulate
+    def _set_model(self, h: _Hyp) -> None:
+        """Apply the model-edit effects (armature, friction, mass) to the shared model."""
+        import mujoco
+
+        m = self.model
+        m.dof_armature[6:] = G1_ARMATURE * (1.0 + h.arm_scale)
+        m.dof_frictionloss[6:] = h.tau_c * self._w
+        m.body_mass[self._torso] = self._mass0 + h.dmass
+        m.body_inertia[self._torso] = self._inertia0 * (self._mass0 + h.dmass) / self._mass0
+        mujoco.mj_setConst(m, self.data)
+
+    def _commands(self, k0: int, delay: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """Commands applied at samples ``k0..k0+H``, delayed by linear interpolation, shapes [H+1, 29]."""
+        r = self.rec
+        s = np.arange(k0, k0 + self.cfg.horizon + 1) - delay / r.dt
+        i0 = np.clip(np.floor(s).astype(int), 0, r.n - 1)
+        i1 = np.clip(i0 + 1, 0, r.n - 1)
+        w = np.clip(s - np.floor(s), 0.0, 1.0)[:, None]
+        lerp = lambda a: (1 - w) * a[i0] + w * a[i1]  # noqa: E731
+        return lerp(r.q_cmd), lerp(r.dq_cmd), lerp(r.tau_ff)
+
+    def simulate(self, params: dict[str, np.ndarray], starts: np.ndarray) -> np.ndarray:
+        """Simulated measurements at the compare points, shape [S, P, 93].
+
+        Args:
+            params: ``{effect_id: flat parameter vector}``; missing ids are nominal.
+            starts: Segment start samples, shape [S].
+        """
+        h = _unpack(params)
+        self._set_model(h)
+        base = self.base(params, starts)
+        out = np.zeros((len(starts), len(self.offsets), 93))
+        for s, k0 in enumerate(starts):
+            self._segment(h, base, s, int(k0), out[s])
+        return out
+
+    def _segment(self, h: _Hyp, base: BaseTrajectory, s: int, k0: int, out: np.ndarray) -> None:
+        """Reset to the real state at ``k0`` and simulate one shooting segment into ``out`` [P, 93]."""
+        import mujoco
+
+        m, d, r, cfg = self.model, self.data, self.rec, self.cfg
+        mujoco.mj_resetData(m, d)
+        d.qpos[2] = base.pos[s, 2]
+        d.qpos[3:7] = base.quat[s]
+        d.qpos[7:] = r.q[k0] - h.offset
+        d.qvel[:3] = base.linvel[s]
+        d.qvel[3:6] = base.angvel[s]
+        d.qvel[6:] = r.dq[k0]
+        qc, dqc, tff = self._commands(k0, h.delay)
+        rmis_t = quat_to_mat(quat_from_roll_pitch(float(h.mis[0]), float(h.mis[1]))).T
+        tmax = G1_EFFORT_LIMIT
+        bj = h.b * self._w
+        terrain = h.terrain.active()
+        p = 0
+        for j in range(cfg.horizon + 1):
+            k = k0 + j
+            kp, kd = r.kp[k], r.kd[k]
+            for sub in range(cfg.substeps):
+                mujoco.mj_step1(m, d)
+                qm = d.qpos[7:] + h.offset
+                v = d.qvel[6:]
+                tau = h.gain * (kp * (qc[j] - qm) + kd * (dqc[j] - v)) + tff[j]
+                lim = tmax if h.droop == 0.0 else tmax * np.clip(1.0 - h.droop * np.abs(v), 0.0, None)
+                tau = np.clip(tau, -lim, lim)
+                # The -kd*dq part is integrated implicitly through dof_damping (Euler integrator), so add it back.
+                d.qfrc_applied[6:] = tau + h.gain * kd * v
+                m.dof_damping[6:] = h.gain * kd + bj
+                if terrain:
+                    self._terrain(h.terrain)
+                mujoco.mj_step2(m, d)
+                if sub == 0 and p < len(self.offsets) and j == self.offsets[p]:
+                    out[p, :29] = qm
+                    out[p, 29:58] = v
+                    out[p, 58:87] = tau
+                    out[p, 87:90] = rmis_t @ d.sensordata[0:3] + h.gyro_bias
+                    out[p, 90:93] = rmis_t @ d.sensordata[6:9]
+                    p += 1
+
+    def _terrain(self, tp: TerrainParams) -> None:
+        """Write the terrain-effect wrench of both feet into ``xfrc_applied``."""
+        import mujoco
+
+        m, d = self.model, self.data
+        vel6 = np.zeros(6)
+        for b in self._feet:
+            rot = d.xmat[b].reshape(3, 3)
+            rel = SOLE_POINTS @ rot.T
+            pts = d.xpos[b] + rel
+            mujoco.mj_objectVelocity(m, d, mujoco.mjtObj.mjOBJ_BODY, b, vel6, 0)
+            vz = vel6[5] + vel6[0] * rel[:, 1] - vel6[1] * rel[:, 0]
+            fz = sole_forces(pts[:, 2], vz, tp, self.cfg.terrain)
+            arm = pts - d.xipos[b]
+            d.xfrc_applied[b, :] = [0.0, 0.0, fz.sum(), (arm[:, 1] * fz).sum(), -(arm[:, 0] * fz).sum(), 0.0]
+
+    def effect_ids(self) -> tuple[str, ...]:
+        """Effect ids this replayer realises."""
+        return tuple(e.id for e in EFFECTS if effect(e.id))
