@@ -38,6 +38,10 @@ class MaterialRangeCfg:
     """Uniform range of the internal friction coefficient [-]."""
     mu_surf: tuple[float, float] = (0.1, 1.0)
     """Uniform range of the intruder-grain surface friction coefficient [-]."""
+    sigma_flat: tuple[float, float] = (1.0e6, 1.0e7)
+    """Uniform range of the cone models' flat-area stress per depth [N/m^3] (cone models only)."""
+    sigma_cone: tuple[float, float] = (1.5e5, 6.0e5)
+    """Uniform range of the cone models' flank stress per depth [N/m^3] (cone models only)."""
     preset: str | None = None
     """Name in ``gmloco.contact.MATERIAL_PRESETS``; when set every env uses it and nothing is drawn."""
 
@@ -65,9 +69,9 @@ class SandTerrainCfg:
     kind: TerrainName = "flat"
     """Terrain name, used in task ids and logs."""
     amplitude: float = 0.0
-    """Amplitude of the sinusoidal free-surface height [m]; 0 is a flat surface at z = 0."""
+    """Amplitude a of the free surface z_s = a sin(2 pi x / L) + a sin(2 pi y / L) [m]; 0 is flat at z = 0."""
     wavelength: float = 2.0
-    """Wavelength of the sinusoidal free surface along x and y [m]."""
+    """Wavelength L of the sinusoidal free surface along x and y [m]."""
     floor: SandFloorCfg = field(default_factory=SandFloorCfg)
     """Hard floor under the sand."""
 
@@ -78,7 +82,7 @@ def flat_sand_terrain() -> SandTerrainCfg:
 
 
 def rough_sand_terrain(amplitude: float = 0.04, wavelength: float = 1.5) -> SandTerrainCfg:
-    """Sand whose free surface is ``amplitude * sin(2 pi x / L) * sin(2 pi y / L)`` [m]."""
+    """Sand whose free surface is ``a sin(2 pi x / L) + a sin(2 pi y / L)`` [m] (gmloco.contact sinusoid)."""
     return SandTerrainCfg(kind="rough", amplitude=amplitude, wavelength=wavelength)
 
 
@@ -122,8 +126,6 @@ class GranularTaskCfg:
     """Per-env material randomization."""
     robot_dr: RobotDrCfg = field(default_factory=RobotDrCfg)
     """Robot domain randomization."""
-    num_envs: int = 4096
-    """Number of parallel environments."""
     episode_length_s: float = 20.0
     """Episode length [s]."""
     action_scale: float = 0.25

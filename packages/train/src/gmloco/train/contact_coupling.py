@@ -20,6 +20,7 @@ from typing import TYPE_CHECKING, Protocol
 
 import torch
 import warp as wp
+
 from gmloco.train.kernels_coupling import launch_gather_foot_state, launch_scatter_foot_wrench
 
 if TYPE_CHECKING:

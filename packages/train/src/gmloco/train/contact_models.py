@@ -1,15 +1,24 @@
 # SPDX-License-Identifier: Apache-2.0
-"""Adapter from :class:`GranularTaskCfg` to ``gmloco.contact`` (the only module that imports it)."""
+"""Adapter from :class:`GranularTaskCfg` to ``gmloco.contact`` (the only train module that imports it).
+
+Per-env materials are written straight into the model's per-world Warp arrays through zero-copy
+torch views (no host round trip on reset, which happens almost every step at 4,096 envs); eta uses
+the contact package's own ``xi_n`` / ``xi_max`` (plain arithmetic, so it runs on torch tensors).
+"""
 
 from __future__ import annotations
 
 from typing import Any
 
+import numpy as np
 import torch
 import warp as wp
-from gmloco.train.config import ContactModelName, GranularTaskCfg
 
-__all__ = ["build_contact_model", "contact_model_cfg", "material_eta", "set_model_materials"]
+import gmloco.contact as gc
+from gmloco.contact.materials import validate_material_arrays, xi_max, xi_n
+from gmloco.train.config import ContactModelName, GranularTaskCfg, MaterialRangeCfg, SandTerrainCfg
+
+__all__ = ["MaterialWriter", "build_contact_model", "contact_model_cfg", "contact_terrain_cfg"]
 
 NUM_FEET = 2
 """Feet per robot that carry a granular wrench."""
@@ -17,8 +26,6 @@ NUM_FEET = 2
 
 def contact_model_cfg(name: ContactModelName) -> Any:
     """Return the default ``gmloco.contact`` config of a named contact model."""
-    import gmloco.contact as gc
-
     table = {
         "rft3d": gc.ContactRFT3DCfg,
         "heuristic_rft": gc.ContactHeuristicRFTCfg,
@@ -29,36 +36,81 @@ def contact_model_cfg(name: ContactModelName) -> Any:
     return table[name]()
 
 
-def _contact_terrain(task: GranularTaskCfg) -> Any:
-    """Map the sand terrain to ``gmloco.contact.TerrainCfg`` (None: flat surface at z = 0)."""
-    terrain = task.terrain
+def contact_terrain_cfg(terrain: SandTerrainCfg) -> Any:
+    """Map the sand terrain to ``gmloco.contact.TerrainCfg`` (flat at z = 0 or a sinusoid)."""
     if terrain.amplitude == 0.0:
-        return None
-    import gmloco.contact as gc
-
-    return gc.TerrainCfg(amplitude=terrain.amplitude, wavelength=terrain.wavelength)
+        return gc.terrain_flat(0.0)
+    a, lam = terrain.amplitude, terrain.wavelength
+    return gc.terrain_sinusoid((a, a), (lam, lam))
 
 
 def build_contact_model(task: GranularTaskCfg, num_envs: int, device: wp.context.Device) -> tuple[Any, bool]:
     """Build the task's contact model for ``num_envs`` worlds; returns ``(model, stateful)``."""
-    import gmloco.contact as gc
-
     cfg = contact_model_cfg(task.contact_model)
-    model = gc.make_contact_model(cfg, num_envs, NUM_FEET, str(device), terrain=_contact_terrain(task))
-    stateful = bool(getattr(model, "is_stateful", True))
-    return model, stateful
+    terrain = contact_terrain_cfg(task.terrain)
+    model = gc.make_contact_model(cfg, num_envs, NUM_FEET, str(device), terrain=terrain)
+    return model, bool(getattr(model, "is_stateful", True))
 
 
-def set_model_materials(
-    model: Any, rho_c: torch.Tensor, mu_int: torch.Tensor, mu_surf: torch.Tensor, env_ids: torch.Tensor
-) -> None:
-    """Copy the materials of ``env_ids`` (from full ``[W]`` tensors) into the contact model."""
-    model.set_materials(rho_c[env_ids], mu_int[env_ids], mu_surf[env_ids], env_ids=env_ids)
+class MaterialWriter:
+    """Draws per-env materials and writes them into a contact model's per-world arrays in place.
 
+    Args:
+        model: A ``gmloco.contact.ContactModel``.
+        ranges: DR ranges (or a preset) of the material.
+        device: Torch device of the env.
+    """
 
-def material_eta(
-    model: Any, rho_c: torch.Tensor, mu_int: torch.Tensor, env_ids: torch.Tensor
-) -> torch.Tensor:
-    """Return the model's normalized stiffness eta [-] of ``env_ids``, shape ``[len(env_ids)]``."""
-    del rho_c, mu_int
-    return wp.to_torch(model.eta)[env_ids]
+    def __init__(self, model: Any, ranges: MaterialRangeCfg, device: str) -> None:
+        self.ranges = ranges
+        self.device = device
+        self._xi_n, self._xi_max = xi_n, float(xi_max())
+        self.preset = gc.MATERIAL_PRESETS[ranges.preset] if ranges.preset is not None else None
+        lo_hi = lambda r: np.asarray(r, dtype=np.float64)  # noqa: E731
+        validate_material_arrays(
+            lo_hi(ranges.packing) * lo_hi(ranges.bulk_density), lo_hi(ranges.mu_int), lo_hi(ranges.mu_surf)
+        )
+        names = ("rho_c", "mu_int", "mu_surf", "eta", "sigma_flat", "sigma_cone")
+        self.views = {n: wp.to_torch(getattr(model, n)) for n in names if hasattr(model, n)}
+        """Zero-copy torch views of the model's per-world parameter arrays, each [W]."""
+        self.pinned: dict[str, torch.Tensor] | None = None
+        """Per-env (rho_c, mu_int, mu_surf) used instead of drawing, set by :meth:`pin`."""
+
+    def pin(self, rho_c: torch.Tensor, mu_int: torch.Tensor, mu_surf: torch.Tensor) -> None:
+        """Fix every env's material (each tensor [W]); later resets keep it instead of drawing."""
+        validate_material_arrays(rho_c.cpu().numpy(), mu_int.cpu().numpy(), mu_surf.cpu().numpy())
+        self.pinned = {
+            "rho_c": rho_c.to(self.device),
+            "mu_int": mu_int.to(self.device),
+            "mu_surf": mu_surf.to(self.device),
+        }
+
+    def draw(self, env_ids: torch.Tensor) -> None:
+        """Set (preset) or draw (uniform DR) the material of ``env_ids``."""
+        n, r, v = len(env_ids), self.ranges, self.views
+        if self.pinned is not None:
+            for name, values in self.pinned.items():
+                v[name][env_ids] = values[env_ids]
+        elif self.preset is not None:
+            v["rho_c"][env_ids] = float(self.preset.rho_c)
+            v["mu_int"][env_ids] = float(self.preset.mu_int)
+            v["mu_surf"][env_ids] = float(self.preset.mu_surf)
+        else:
+            v["rho_c"][env_ids] = self._uniform(r.packing, n) * self._uniform(r.bulk_density, n)
+            v["mu_int"][env_ids] = self._uniform(r.mu_int, n)
+            v["mu_surf"][env_ids] = self._uniform(r.mu_surf, n)
+        for name in ("sigma_flat", "sigma_cone"):
+            if name in v:
+                v[name][env_ids] = self._uniform(getattr(r, name), n)
+        # eta = xi_n(rho_c, mu_int) / xi_max, the paper's normalized stiffness (gmloco.contact.eta).
+        v["eta"][env_ids] = self._xi_n(v["rho_c"][env_ids], v["mu_int"][env_ids]) / self._xi_max
+
+    @property
+    def eta(self) -> torch.Tensor:
+        """Normalized stiffness of every env [-], shape [W] (view)."""
+        return self.views["eta"]
+
+    def _uniform(self, bounds: tuple[float, float], n: int) -> torch.Tensor:
+        """Draw ``n`` samples from U[bounds]."""
+        lo, hi = bounds
+        return lo + (hi - lo) * torch.rand(n, device=self.device)

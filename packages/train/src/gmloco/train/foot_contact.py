@@ -17,8 +17,9 @@ from typing import TYPE_CHECKING
 import torch
 
 if TYPE_CHECKING:
-    from gmloco.train.contact_coupling import ContactCoupling
     from mjlab.envs import ManagerBasedRlEnv
+
+    from gmloco.train.contact_coupling import ContactCoupling
 
 __all__ = ["FootContactTracker", "SurfaceHeightFn"]
 

@@ -39,7 +39,7 @@ def gather_foot_state(
     foot_lin_vel_out: wp.array2d[wp.vec3],
     foot_ang_vel_out: wp.array2d[wp.vec3],
     foot_com_out: wp.array2d[wp.vec3],
-):
+) -> None:
     """Copy pose, origin velocity and CoM of each foot body into ``[W, F]`` arrays."""
     worldid, footid = wp.tid()
     bodyid = foot_bodyid[footid]
@@ -64,7 +64,7 @@ def scatter_foot_wrench(
     wrench_in: wp.array2d[wp.spatial_vector],
     # Data out:
     xfrc_applied_out: wp.array2d[wp.spatial_vector],
-):
+) -> None:
     """Overwrite ``xfrc_applied`` of each foot body with its granular wrench."""
     worldid, footid = wp.tid()
     xfrc_applied_out[worldid, foot_bodyid[footid]] = wrench_in[worldid, footid]

@@ -13,17 +13,20 @@ model and tracker state. Other terms reach it as ``env.sand`` (see :func:`get_sa
 from __future__ import annotations
 
 import math
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Any
 
 import mujoco
 import torch
+
 from gmloco.train.config import GranularTaskCfg, SandTerrainCfg
 from gmloco.train.foot_contact import FootContactTracker, SurfaceHeightFn
 
 if TYPE_CHECKING:
-    from gmloco.train.contact_coupling import ContactCoupling
     from mjlab.envs import ManagerBasedRlEnv
     from mjlab.managers.event_manager import EventTermCfg
+
+    from gmloco.train.contact_coupling import ContactCoupling
+    from gmloco.train.contact_models import MaterialWriter
 
 __all__ = [
     "FEET_FLOOR_SENSOR",
@@ -69,11 +72,11 @@ def add_sand_floor(spec: mujoco.MjSpec, feet_collide: bool) -> None:
 
 
 def make_surface_height(terrain: SandTerrainCfg) -> SurfaceHeightFn:
-    """Return the free-surface height function ``z_s(x, y)`` [m] of a sand terrain."""
+    """Return the free-surface height ``z_s(x, y) = a sin(k x) + a sin(k y)`` [m] (gmloco.contact sinusoid)."""
     amp, k = terrain.amplitude, 2.0 * math.pi / terrain.wavelength
     if amp == 0.0:
         return lambda x, y: torch.zeros_like(x)
-    return lambda x, y: amp * torch.sin(k * x) * torch.sin(k * y)
+    return lambda x, y: amp * (torch.sin(k * x) + torch.sin(k * y))
 
 
 def get_sand(env: ManagerBasedRlEnv) -> SandContact:
@@ -96,17 +99,22 @@ class SandContact:
         self.num_envs, self.device = env.num_envs, env.device
         self.surface_height = make_surface_height(task.terrain)
         self.coupling: ContactCoupling | None = None
-        self.model: object | None = None
+        self.model: Any = None
+        self.materials: MaterialWriter | None = None
+        self._eta = torch.ones(self.num_envs, device=self.device)
         if task.contact_model != "rigid":
+            from gmloco.train.contact_models import MaterialWriter
+
             self.coupling = self._install_granular(env, task)
             self.model = self.coupling.model
+            self.materials = MaterialWriter(self.model, task.material, self.device)
+            self._eta = self.materials.eta
         threshold = task.contact_force_threshold
         if threshold is None:
             threshold = 5.0 if task.contact_model == "rigid" else 40.0
         self.feet = FootContactTracker(
             env, self.coupling, FEET_FLOOR_SENSOR, FOOT_SITES, FOOT_BODIES, threshold, self.surface_height
         )
-        self._init_materials(task)
         self._init_floor(env, task)
         env.sand = self  # type: ignore[attr-defined]
 
@@ -132,11 +140,11 @@ class SandContact:
         del task
         if env_ids is None:
             env_ids = torch.arange(self.num_envs, device=self.device)
-        self._draw_materials(env_ids)
+        if self.materials is not None:
+            self.materials.draw(env_ids)
+            self.model.reset(env_ids)
         self._place_floor(env_ids)
         self.feet.reset(env_ids)
-        if self.model is not None and hasattr(self.model, "reset"):
-            self.model.reset(env_ids)  # type: ignore[attr-defined]
 
     def reset(self, env_ids: torch.Tensor | None = None) -> None:
         """Event-manager reset hook (state is already cleared in ``__call__``)."""
@@ -157,19 +165,6 @@ class SandContact:
         coupling.install()
         return coupling
 
-    def _init_materials(self, task: GranularTaskCfg) -> None:
-        """Allocate per-env material tensors (rho_c [kg/m^3], mu_int, mu_surf)."""
-        shape, dev = (self.num_envs,), self.device
-        self.rho_c = torch.zeros(shape, device=dev)
-        self.mu_int = torch.zeros(shape, device=dev)
-        self.mu_surf = torch.zeros(shape, device=dev)
-        self._eta = torch.ones(shape, device=dev)
-        self._preset = None
-        if task.material.preset is not None and self.model is not None:
-            from gmloco.contact import MATERIAL_PRESETS
-
-            self._preset = MATERIAL_PRESETS[task.material.preset]
-
     def _init_floor(self, env: ManagerBasedRlEnv, task: GranularTaskCfg) -> None:
         """Resolve the floor mocap id and draw initial curriculum levels."""
         body_id = mujoco.mj_name2id(env.sim.mj_model, mujoco.mjtObj.mjOBJ_BODY, SAND_FLOOR_BODY)
@@ -182,33 +177,8 @@ class SandContact:
 
     # Reset helpers.
 
-    def _draw_materials(self, env_ids: torch.Tensor) -> None:
-        """Sample (or set the preset) material of ``env_ids`` and push it to the contact model."""
-        if self.model is None:
-            return
-        from gmloco.train.contact_models import material_eta, set_model_materials
-
-        n, m = len(env_ids), self.task.material
-        if self._preset is not None:
-            self.rho_c[env_ids] = float(self._preset.rho_c)
-            self.mu_int[env_ids] = float(self._preset.mu_int)
-            self.mu_surf[env_ids] = float(self._preset.mu_surf)
-        else:
-            packing = _uniform(m.packing, n, self.device)
-            self.rho_c[env_ids] = packing * _uniform(m.bulk_density, n, self.device)
-            self.mu_int[env_ids] = _uniform(m.mu_int, n, self.device)
-            self.mu_surf[env_ids] = _uniform(m.mu_surf, n, self.device)
-        set_model_materials(self.model, self.rho_c, self.mu_int, self.mu_surf, env_ids)
-        self._eta[env_ids] = material_eta(self.model, self.rho_c[env_ids], self.mu_int[env_ids], env_ids)
-
     def _place_floor(self, env_ids: torch.Tensor) -> None:
         """Write the floor height of ``env_ids`` into the mocap pose (after ``sim.reset``)."""
         depth = self.floor_depth[env_ids]
         mocap_pos = self.env.sim.data.mocap_pos
         mocap_pos[env_ids, self.floor_mocap_id, 2] = -depth
-
-
-def _uniform(bounds: tuple[float, float], n: int, device: str) -> torch.Tensor:
-    """Draw ``n`` samples from U[bounds]."""
-    lo, hi = bounds
-    return lo + (hi - lo) * torch.rand(n, device=device)

@@ -35,7 +35,7 @@ from gmloco.train.mdp.rewards import (
     undesired_contacts,
     variable_posture_l1,
 )
-from gmloco.train.mdp.terminations import base_height_below
+from gmloco.train.mdp.terminations import base_height_below, roll_pitch_exceeds
 
 __all__ = [
     "action_rate_l2",
@@ -63,6 +63,7 @@ __all__ = [
     "lin_vel_z_l2",
     "no_fly",
     "reward_ramp",
+    "roll_pitch_exceeds",
     "sand_floor_levels",
     "terrain_eta",
     "track_ang_vel_z_exp",

@@ -6,6 +6,7 @@ from __future__ import annotations
 from typing import TYPE_CHECKING, Any
 
 import torch
+
 from gmloco.train.sand import get_sand
 
 if TYPE_CHECKING:
@@ -16,8 +17,10 @@ __all__ = ["reward_ramp", "sand_floor_levels"]
 
 
 def _level_moves(distance: torch.Tensor, commanded: torch.Tensor, promote_distance: float) -> torch.Tensor:
-    """+1 when the robot walked farther than ``promote_distance`` [m], -1 when it walked less than
-    half the commanded distance [m], else 0 (mjlab ``terrain_levels_vel`` rule)."""
+    """Return +1 (walked > ``promote_distance`` [m]), -1 (walked < half the commanded distance [m]) or 0.
+
+    The rule is mjlab's ``terrain_levels_vel``.
+    """
     up = distance > promote_distance
     down = (distance < 0.5 * commanded) & ~up
     return up.long() - down.long()

@@ -6,6 +6,7 @@ from __future__ import annotations
 from typing import TYPE_CHECKING
 
 import torch
+
 from gmloco.train.sand import get_sand
 
 if TYPE_CHECKING:

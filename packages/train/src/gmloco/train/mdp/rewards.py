@@ -11,10 +11,11 @@ from __future__ import annotations
 from typing import TYPE_CHECKING
 
 import torch
-from gmloco.train.sand import get_sand
 from mjlab.managers.scene_entity_config import SceneEntityCfg
 from mjlab.tasks.velocity.mdp import variable_posture
 from mjlab.utils.lab_api.math import quat_apply_inverse, wrap_to_pi, yaw_quat
+
+from gmloco.train.sand import get_sand
 
 if TYPE_CHECKING:
     from mjlab.envs import ManagerBasedRlEnv
@@ -148,9 +149,7 @@ def flat_orientation_l2(env: ManagerBasedRlEnv, asset_cfg: SceneEntityCfg = _ROB
     return torch.sum(torch.square(env.scene[asset_cfg.name].data.projected_gravity_b[:, :2]), dim=1)
 
 
-def base_height_l2(
-    env: ManagerBasedRlEnv, target_height: float, asset_cfg: SceneEntityCfg = _ROBOT
-) -> torch.Tensor:
+def base_height_l2(env: ManagerBasedRlEnv, target_height: float, asset_cfg: SceneEntityCfg = _ROBOT) -> torch.Tensor:
     """Squared deviation of the pelvis height above the sand surface from ``target_height`` [m^2]."""
     pos = env.scene[asset_cfg.name].data.root_link_pos_w
     height = pos[:, 2] - get_sand(env).surface_height(pos[:, 0], pos[:, 1])
@@ -260,9 +259,7 @@ def no_fly(env: ManagerBasedRlEnv, command_name: str, max_speed: float = 1.5) ->
     return (~feet.in_contact.any(dim=1) & slow).float()
 
 
-def feet_lateral_distance(
-    env: ManagerBasedRlEnv, min_gap: float, asset_cfg: SceneEntityCfg = _ROBOT
-) -> torch.Tensor:
+def feet_lateral_distance(env: ManagerBasedRlEnv, min_gap: float, asset_cfg: SceneEntityCfg = _ROBOT) -> torch.Tensor:
     """How far the lateral foot gap is below ``min_gap`` [m], clipped to 0.1 m."""
     feet, data = get_sand(env).feet, env.scene[asset_cfg.name].data
     return _lateral_gap_penalty(data.site_pos_w[:, feet.site_ids], data.root_link_quat_w, min_gap)
@@ -279,9 +276,7 @@ def contact_impulse(env: ManagerBasedRlEnv, command_name: str) -> torch.Tensor:
     return torch.sum(feet.landing_force, dim=1) * _moving(_command(env, command_name), 0.05)
 
 
-def foot_clearance(
-    env: ManagerBasedRlEnv, target_height: float, std: float, tanh_mult: float
-) -> torch.Tensor:
+def foot_clearance(env: ManagerBasedRlEnv, target_height: float, std: float, tanh_mult: float) -> torch.Tensor:
     """Swing feet at ``target_height`` [m] above the sand, weighted by tanh of their speed."""
     feet = get_sand(env).feet.update()
     speed = torch.linalg.vector_norm(feet.vel_w[..., :2], dim=-1)

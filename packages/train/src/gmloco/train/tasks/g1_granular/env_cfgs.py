@@ -7,19 +7,6 @@ import math
 from dataclasses import replace
 from functools import partial
 
-from gmloco.train import mdp
-from gmloco.train.config import (
-    ContactModelName,
-    GranularTaskCfg,
-    MaterialRangeCfg,
-    deep_sand_terrain,
-    flat_sand_terrain,
-    rough_sand_terrain,
-)
-from gmloco.train.sand import FEET_FLOOR_SENSOR, SAND_FLOOR_BODY, add_sand_floor
-from gmloco.train.tasks.g1_granular.events_cfg import make_events_cfg
-from gmloco.train.tasks.g1_granular.observations_cfg import make_observations_cfg
-from gmloco.train.tasks.g1_granular.rewards_cfg import make_curriculum_cfg, make_rewards_cfg
 from mjlab.asset_zoo.robots import get_g1_robot_cfg
 from mjlab.envs import ManagerBasedRlEnvCfg
 from mjlab.envs.mdp.actions import JointPositionActionCfg
@@ -31,6 +18,21 @@ from mjlab.tasks.velocity import mdp as vel_mdp
 from mjlab.tasks.velocity.mdp import UniformVelocityCommandCfg
 from mjlab.viewer import ViewerConfig
 
+from gmloco.train import mdp
+from gmloco.train.config import (
+    ContactModelName,
+    GranularTaskCfg,
+    MaterialRangeCfg,
+    TerrainName,
+    deep_sand_terrain,
+    flat_sand_terrain,
+    rough_sand_terrain,
+)
+from gmloco.train.sand import FEET_FLOOR_SENSOR, SAND_FLOOR_BODY, add_sand_floor
+from gmloco.train.tasks.g1_granular.events_cfg import make_events_cfg
+from gmloco.train.tasks.g1_granular.observations_cfg import make_observations_cfg
+from gmloco.train.tasks.g1_granular.rewards_cfg import make_curriculum_cfg, make_rewards_cfg
+
 __all__ = ["g1_granular_task", "make_g1_granular_env_cfg"]
 
 _UNDESIRED_BODIES = r"^(pelvis|torso_link|.*_hip_.*_link|.*_knee_link|.*_ankle_pitch_link|.*_shoulder_.*_link|.*_elbow_link|.*_wrist_.*_link)$"
@@ -38,7 +40,7 @@ _UNDESIRED_BODIES = r"^(pelvis|torso_link|.*_hip_.*_link|.*_knee_link|.*_ankle_p
 
 
 def g1_granular_task(
-    contact_model: ContactModelName = "rft3d", terrain: str = "flat", num_envs: int = 4096, play: bool = False
+    contact_model: ContactModelName = "rft3d", terrain: TerrainName = "flat", play: bool = False
 ) -> GranularTaskCfg:
     """Return the task config for one contact model and one terrain ("flat", "rough" or "deep")."""
     terrains = {"flat": flat_sand_terrain, "rough": rough_sand_terrain, "deep": deep_sand_terrain}
@@ -50,7 +52,6 @@ def g1_granular_task(
         contact_model=contact_model,
         terrain=terrains[terrain](),
         material=material,
-        num_envs=num_envs,
         play=play,
     )
 
@@ -60,9 +61,7 @@ def _sensors() -> tuple[ContactSensorCfg, ...]:
     floor = ContactMatch(mode="body", pattern=SAND_FLOOR_BODY)
     feet = ContactSensorCfg(
         name=FEET_FLOOR_SENSOR,
-        primary=ContactMatch(
-            mode="body", pattern=r"^(left_ankle_roll_link|right_ankle_roll_link)$", entity="robot"
-        ),
+        primary=ContactMatch(mode="body", pattern=r"^(left_ankle_roll_link|right_ankle_roll_link)$", entity="robot"),
         secondary=floor,
         fields=("found", "force"),
         reduce="netforce",
@@ -79,11 +78,11 @@ def _sensors() -> tuple[ContactSensorCfg, ...]:
     return (feet, undesired)
 
 
-def _scene(task: GranularTaskCfg) -> SceneCfg:
+def _scene(task: GranularTaskCfg, num_envs: int) -> SceneCfg:
     """G1 + mocap hard floor; the feet skip the floor only for granular models without it."""
     feet_collide = task.contact_model == "rigid" or task.terrain.floor.enabled
     return SceneCfg(
-        num_envs=task.num_envs,
+        num_envs=num_envs,
         terrain=None,
         entities={"robot": get_g1_robot_cfg()},
         sensors=_sensors(),
@@ -93,7 +92,7 @@ def _scene(task: GranularTaskCfg) -> SceneCfg:
 
 
 def _command(task: GranularTaskCfg) -> UniformVelocityCommandCfg:
-    """mjlab velocity command with GM-Loco's initial ranges."""
+    """Mjlab velocity command with GM-Loco's initial ranges."""
     return UniformVelocityCommandCfg(
         entity_name="robot",
         resampling_time_range=(3.0, 8.0),
@@ -113,18 +112,16 @@ def _terminations(task: GranularTaskCfg) -> dict[str, TerminationTermCfg]:
     """Time out, falling over (70 deg) or the pelvis sinking below 0.3 m above the sand."""
     return {
         "time_out": TerminationTermCfg(func=vel_mdp.time_out, time_out=True),
-        "fell_over": TerminationTermCfg(
-            func=vel_mdp.bad_orientation, params={"limit_angle": math.radians(70.0)}
-        ),
+        "fell_over": TerminationTermCfg(func=vel_mdp.bad_orientation, params={"limit_angle": math.radians(70.0)}),
         "base_too_low": TerminationTermCfg(func=mdp.base_height_below, params={"min_height": 0.3}),
     }
 
 
-def make_g1_granular_env_cfg(task: GranularTaskCfg) -> ManagerBasedRlEnvCfg:
-    """Build the mjlab env config: 50 Hz policy (decimation 4) over 200 Hz physics."""
+def make_g1_granular_env_cfg(task: GranularTaskCfg, num_envs: int = 4096) -> ManagerBasedRlEnvCfg:
+    """Build the mjlab env config of ``num_envs`` envs: 50 Hz policy (decimation 4) over 200 Hz physics."""
     rewards = make_rewards_cfg(task)
     return ManagerBasedRlEnvCfg(
-        scene=_scene(task),
+        scene=_scene(task, num_envs),
         observations=make_observations_cfg(task),
         actions={
             "joint_pos": JointPositionActionCfg(

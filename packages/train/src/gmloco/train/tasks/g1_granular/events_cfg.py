@@ -3,12 +3,13 @@
 
 from __future__ import annotations
 
-from gmloco.train.config import GranularTaskCfg
-from gmloco.train.sand import SandContact
 from mjlab.envs.mdp import dr
 from mjlab.managers.event_manager import EventTermCfg
 from mjlab.managers.scene_entity_config import SceneEntityCfg
 from mjlab.tasks.velocity import mdp as vel_mdp
+
+from gmloco.train.config import GranularTaskCfg
+from gmloco.train.sand import SandContact
 
 __all__ = ["FOOT_GEOMS", "make_events_cfg"]
 

@@ -3,11 +3,12 @@
 
 from __future__ import annotations
 
-from gmloco.train import mdp
-from gmloco.train.config import GranularTaskCfg
 from mjlab.managers.observation_manager import ObservationGroupCfg, ObservationTermCfg
 from mjlab.tasks.velocity import mdp as vel_mdp
 from mjlab.utils.noise import UniformNoiseCfg
+
+from gmloco.train import mdp
+from gmloco.train.config import GranularTaskCfg
 
 __all__ = ["ACTOR_TERMS", "CRITIC_EXTRA_TERMS", "make_observations_cfg"]
 
@@ -38,9 +39,7 @@ def _actor_terms(noise_scale: float) -> dict[str, ObservationTermCfg]:
             params={"sensor_name": "robot/imu_ang_vel"},
             noise=_noise(0.2, noise_scale),
         ),
-        "projected_gravity": ObservationTermCfg(
-            func=vel_mdp.projected_gravity, noise=_noise(0.05, noise_scale)
-        ),
+        "projected_gravity": ObservationTermCfg(func=vel_mdp.projected_gravity, noise=_noise(0.05, noise_scale)),
         "command": ObservationTermCfg(func=vel_mdp.generated_commands, params={"command_name": "twist"}),
         "joint_pos": ObservationTermCfg(func=vel_mdp.joint_pos_rel, noise=_noise(0.01, noise_scale)),
         "joint_vel": ObservationTermCfg(func=vel_mdp.joint_vel_rel, noise=_noise(1.5, noise_scale)),
@@ -52,9 +51,7 @@ def _critic_terms() -> dict[str, ObservationTermCfg]:
     """Noise-free actor terms plus privileged contact and terrain terms."""
     return {
         **_actor_terms(0.0),
-        "base_lin_vel": ObservationTermCfg(
-            func=vel_mdp.builtin_sensor, params={"sensor_name": "robot/imu_lin_vel"}
-        ),
+        "base_lin_vel": ObservationTermCfg(func=vel_mdp.builtin_sensor, params={"sensor_name": "robot/imu_lin_vel"}),
         "foot_height": ObservationTermCfg(func=mdp.foot_height),
         "foot_contact": ObservationTermCfg(func=mdp.foot_contact),
         "foot_contact_forces": ObservationTermCfg(func=mdp.foot_contact_forces),
@@ -68,8 +65,6 @@ def make_observations_cfg(task: GranularTaskCfg) -> dict[str, ObservationGroupCf
     history = task.policy_history_length if task.policy_history_length > 1 else None
     noise = 0.0 if task.play else task.obs_noise_scale
     return {
-        "actor": ObservationGroupCfg(
-            terms=_actor_terms(noise), enable_corruption=noise > 0.0, history_length=history
-        ),
+        "actor": ObservationGroupCfg(terms=_actor_terms(noise), enable_corruption=noise > 0.0, history_length=history),
         "critic": ObservationGroupCfg(terms=_critic_terms(), enable_corruption=False),
     }

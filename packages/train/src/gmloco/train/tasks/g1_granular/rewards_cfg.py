@@ -5,13 +5,14 @@ from __future__ import annotations
 
 import math
 
-from gmloco.train import mdp
-from gmloco.train.config import GranularTaskCfg
 from mjlab.envs import mdp as envs_mdp
 from mjlab.managers.curriculum_manager import CurriculumTermCfg
 from mjlab.managers.reward_manager import RewardTermCfg
 from mjlab.managers.scene_entity_config import SceneEntityCfg
 from mjlab.tasks.velocity.config.g1.env_cfgs import unitree_g1_rough_env_cfg
+
+from gmloco.train import mdp
+from gmloco.train.config import GranularTaskCfg
 
 __all__ = ["LOWER_BODY_JOINTS", "UPPER_BODY_JOINTS", "make_curriculum_cfg", "make_rewards_cfg"]
 
@@ -24,7 +25,7 @@ UPPER_BODY_JOINTS = (r"waist_.*", r".*_shoulder_.*", r".*_elbow_.*", r".*_wrist_
 
 
 def _posture_stds() -> dict[str, dict[str, float]]:
-    """mjlab's G1 per-joint pose tolerances (standing / walking / running) [rad]."""
+    """Mjlab's G1 per-joint pose tolerances (standing / walking / running) [rad]."""
     params = unitree_g1_rough_env_cfg().rewards["pose"].params
     return {k: params[k] for k in ("std_standing", "std_walking", "std_running")}
 
@@ -49,9 +50,7 @@ def _base_terms() -> dict[str, RewardTermCfg]:
     """Termination, base height / orientation / velocity penalties."""
     return {
         "termination_penalty": RewardTermCfg(func=envs_mdp.is_terminated, weight=-200.0),
-        "base_height_l2": RewardTermCfg(
-            func=mdp.base_height_l2, weight=-10.0, params={"target_height": 0.75}
-        ),
+        "base_height_l2": RewardTermCfg(func=mdp.base_height_l2, weight=-10.0, params={"target_height": 0.75}),
         "flat_orientation_l2": RewardTermCfg(func=mdp.flat_orientation_l2, weight=-10.0),
         "lin_vel_z_l2": RewardTermCfg(func=mdp.lin_vel_z_l2, weight=-1.0),
         "ang_vel_xy_l2": RewardTermCfg(func=mdp.ang_vel_xy_l2, weight=-0.05),
@@ -100,13 +99,9 @@ def _feet_terms() -> dict[str, RewardTermCfg]:
             func=mdp.feet_air_time, weight=0.5, params={"threshold": 0.5, "command_name": CMD}
         ),
         "no_fly": RewardTermCfg(func=mdp.no_fly, weight=-1.0, params={"command_name": CMD}),
-        "feet_lateral_distance": RewardTermCfg(
-            func=mdp.feet_lateral_distance, weight=-2.0, params={"min_gap": 0.2}
-        ),
+        "feet_lateral_distance": RewardTermCfg(func=mdp.feet_lateral_distance, weight=-2.0, params={"min_gap": 0.2}),
         "feet_slide": RewardTermCfg(func=mdp.feet_slide, weight=-0.25),
-        "contact_impulse": RewardTermCfg(
-            func=mdp.contact_impulse, weight=-0.005, params={"command_name": CMD}
-        ),
+        "contact_impulse": RewardTermCfg(func=mdp.contact_impulse, weight=-0.005, params={"command_name": CMD}),
         "foot_clearance": RewardTermCfg(
             func=mdp.foot_clearance, weight=5.0, params={"target_height": 0.10, "std": 0.05, "tanh_mult": 2.0}
         ),
@@ -124,9 +119,7 @@ def make_rewards_cfg(task: GranularTaskCfg) -> dict[str, RewardTermCfg]:
     return {name: term for name, term in rewards.items() if term.weight != 0.0}
 
 
-def make_curriculum_cfg(
-    task: GranularTaskCfg, rewards: dict[str, RewardTermCfg]
-) -> dict[str, CurriculumTermCfg]:
+def make_curriculum_cfg(task: GranularTaskCfg, rewards: dict[str, RewardTermCfg]) -> dict[str, CurriculumTermCfg]:
     """Floor-depth levels, command-range stages and tracking ramps (GM-Loco schedule)."""
     if task.play:
         return {}

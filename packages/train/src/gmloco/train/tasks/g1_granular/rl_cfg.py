@@ -11,8 +11,11 @@ __all__ = ["make_g1_granular_ppo_cfg"]
 def make_g1_granular_ppo_cfg(
     experiment_name: str = "g1_granular", hidden_dims: tuple[int, ...] = (512, 256, 128)
 ) -> RslRlOnPolicyRunnerCfg:
-    """[512, 256, 128] ELU, lr 1e-3 adaptive (KL 0.01), gamma 0.99, lambda 0.95, clip 0.2,
-    entropy 0.005, 24 steps/env, 5 epochs x 4 minibatches."""
+    """Return GM-Loco's PPO runner config.
+
+    [512, 256, 128] ELU, lr 1e-3 adaptive (KL 0.01), gamma 0.99, lambda 0.95, clip 0.2, entropy 0.005,
+    24 steps/env, 5 epochs x 4 minibatches.
+    """
     return RslRlOnPolicyRunnerCfg(
         actor=RslRlModelCfg(
             hidden_dims=hidden_dims,

@@ -1,0 +1,64 @@
+# SPDX-License-Identifier: Apache-2.0
+"""Export the actor to ONNX with deploy metadata (mjlab's exporter plus the task's own layout)."""
+
+from __future__ import annotations
+
+import json
+import os
+from pathlib import Path
+from typing import TYPE_CHECKING, Any
+
+from mjlab.rl.exporter_utils import attach_metadata_to_onnx, get_base_metadata
+
+if TYPE_CHECKING:
+    from mjlab.envs import ManagerBasedRlEnv
+    from mjlab.rl import MjlabOnPolicyRunner
+
+__all__ = ["export_policy_onnx", "policy_metadata"]
+
+
+def policy_metadata(env: ManagerBasedRlEnv, run_name: str, extra: dict[str, Any] | None = None) -> dict[str, Any]:
+    """Return mjlab's deploy metadata plus action order, observation layout and timing.
+
+    mjlab's part: ``joint_names``, ``joint_stiffness`` / ``joint_damping`` (kp/kd), ``default_joint_pos``,
+    ``action_scale``, ``observation_names`` and per-term scale / clip / history. Added here:
+    ``action_joint_names`` (order of the 29 action entries), ``observation_dims`` (per-frame width of
+    each actor term), ``observation_history_length``, ``observation_dim``, ``policy_dt`` / ``physics_dt`` [s]
+    and anything in ``extra`` (contact model, terrain, ...).
+    """
+    meta: dict[str, Any] = get_base_metadata(env, run_name)
+    om = env.observation_manager
+    action_term = env.action_manager.get_term("joint_pos")
+    term_dims = [int(d[-1]) for d in om.group_obs_term_dim["actor"]]
+    history = max(om.get_term_cfg("actor", om.active_terms["actor"][0]).history_length, 1)
+    meta.update(
+        {
+            "action_joint_names": list(action_term.target_names),  # type: ignore[attr-defined]
+            "observation_dims": [d // history for d in term_dims],
+            "observation_history_length": history,
+            "observation_dim": int(om.group_obs_dim["actor"][-1]),
+            "policy_dt": env.step_dt,
+            "physics_dt": env.physics_dt,
+        }
+    )
+    meta.update(extra or {})
+    return meta
+
+
+def export_policy_onnx(
+    runner: MjlabOnPolicyRunner, path: str | Path, run_name: str = "local", extra: dict[str, Any] | None = None
+) -> Path:
+    """Export ``runner``'s actor (with its observation normalizer) to ``path`` and attach metadata.
+
+    The file is written next to ``path`` and moved into place with ``os.replace``; a ``.json`` sidecar
+    with the same metadata is written for tools that do not read ONNX metadata.
+    """
+    path = Path(path)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    tmp_name = f".{path.name}.tmp"
+    runner.export_policy_to_onnx(str(path.parent), tmp_name)
+    meta = policy_metadata(runner.env.unwrapped, run_name, extra)
+    attach_metadata_to_onnx(str(path.parent / tmp_name), meta)
+    os.replace(path.parent / tmp_name, path)
+    path.with_suffix(".json").write_text(json.dumps(meta, indent=1, default=str))
+    return path

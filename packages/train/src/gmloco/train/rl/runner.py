@@ -1,0 +1,167 @@
+# SPDX-License-Identifier: Apache-2.0
+"""rsl-rl on-policy runner with a wall-clock budget, atomic checkpoints and run summaries."""
+
+from __future__ import annotations
+
+import os
+import re
+import statistics
+import time
+from pathlib import Path
+
+import torch
+from mjlab.rl import MjlabOnPolicyRunner
+
+from gmloco.train.sand import get_sand
+
+__all__ = ["CHECKPOINT_PATTERN", "GmlocoOnPolicyRunner", "latest_checkpoint"]
+
+CHECKPOINT_PATTERN = re.compile(r"^model_(\d+)\.pt$")
+"""File names of checkpoints: ``model_<iteration>.pt``."""
+
+
+def latest_checkpoint(run_dir: str | Path) -> Path | None:
+    """Return the checkpoint with the highest iteration in ``run_dir`` (None if there is none)."""
+    found = [(int(m.group(1)), p) for p in Path(run_dir).glob("model_*.pt") if (m := CHECKPOINT_PATTERN.match(p.name))]
+    return max(found)[1] if found else None
+
+
+class GmlocoOnPolicyRunner(MjlabOnPolicyRunner):
+    """mjlab's runner plus: time-boxed ``learn``, tmp + ``os.replace`` saves, floor levels in checkpoints.
+
+    After :meth:`learn`, :attr:`summary` holds the run's metrics (see :meth:`_summary`).
+    """
+
+    keep_checkpoints: int = 3
+    """Number of most recent ``model_*.pt`` files kept in the run directory."""
+
+    def learn(  # type: ignore[override]
+        self, num_learning_iterations: int, init_at_random_ep_len: bool = False, deadline: float | None = None
+    ) -> None:
+        """Run PPO iterations until ``num_learning_iterations`` are done or ``deadline`` is near.
+
+        Args:
+            num_learning_iterations: Iterations to run in this call.
+            init_at_random_ep_len: Randomize initial episode lengths (fresh runs).
+            deadline: ``time.monotonic()`` value by which the call must have saved and returned; the loop
+                stops when one more iteration (1.5x the slowest so far) would cross it.
+        """
+        if init_at_random_ep_len:
+            self.env.episode_length_buf = torch.randint_like(
+                self.env.episode_length_buf, high=int(self.env.max_episode_length)
+            )
+        obs = self.env.get_observations().to(self.device)
+        self.alg.train_mode()
+        self.logger.init_logging_writer()
+        start_it = self.current_learning_iteration
+        self._times: list[tuple[float, float]] = []
+        self.stopped_by_deadline = False
+        for it in range(start_it, start_it + num_learning_iterations):
+            if deadline is not None and self._times and time.monotonic() + 1.5 * self._slowest() > deadline:
+                self.stopped_by_deadline = True
+                break
+            obs = self._iteration(it, start_it, start_it + num_learning_iterations, obs)
+            self.current_learning_iteration = it + 1
+            if it % self.cfg["save_interval"] == 0:
+                self.save_checkpoint()
+        self.save_checkpoint()
+        self.logger.stop_logging_writer()
+
+    def _iteration(self, it: int, start_it: int, total_it: int, obs: object) -> object:
+        """Collect one rollout, update the policy and log (rsl-rl ``OnPolicyRunner.learn`` body)."""
+        start = time.time()
+        with torch.inference_mode():
+            # Rollout: act, step the env, store the transition, book-keep episode returns.
+            for _ in range(self.cfg["num_steps_per_env"]):
+                actions = self.alg.act(obs)
+                obs, rewards, dones, extras = self.env.step(actions.to(self.env.device))
+                obs, rewards, dones = obs.to(self.device), rewards.to(self.device), dones.to(self.device)
+                self.alg.process_env_step(obs, rewards, dones, extras)
+                self.logger.process_env_step(rewards, dones, extras, None)
+            collect_time = time.time() - start
+            start = time.time()
+            self.alg.compute_returns(obs)
+        # Learning: PPO epochs over the rollout.
+        loss_dict = self.alg.update()
+        learn_time = time.time() - start
+        self._times.append((collect_time, learn_time))
+        self.logger.log(
+            it=it,
+            start_it=start_it,
+            total_it=total_it,
+            collect_time=collect_time,
+            learn_time=learn_time,
+            loss_dict=loss_dict,
+            learning_rate=self.alg.learning_rate,
+            action_std=self.alg.get_policy().output_std,
+            rnd_weight=None,
+        )
+        return obs
+
+    def _slowest(self) -> float:
+        """Slowest iteration so far [s]."""
+        return max(c + learn for c, learn in self._times)
+
+    # Checkpoints.
+
+    def save_checkpoint(self) -> Path | None:
+        """Save ``model_<iteration>.pt`` atomically in the log dir and prune old ones."""
+        if self.logger.log_dir is None or self.logger.disable_logs:
+            return None
+        path = Path(self.logger.log_dir) / f"model_{self.current_learning_iteration}.pt"
+        self.save(str(path))
+        self._prune()
+        return path
+
+    def save(self, path: str, infos: dict | None = None) -> None:
+        """Write the checkpoint to ``path + '.tmp'`` then ``os.replace`` it (a kill never leaves half a file)."""
+        sand = getattr(self.env.unwrapped, "sand", None)
+        infos = {**(infos or {}), "sand_floor_level": None if sand is None else sand.floor_level.cpu()}
+        tmp = f"{path}.tmp"
+        super().save(tmp, infos)
+        os.replace(tmp, path)
+
+    def load(
+        self, path: str, load_cfg: dict | None = None, strict: bool = True, map_location: str | None = None
+    ) -> dict:
+        """Load a checkpoint, restoring the env step counter (curricula) and the floor levels."""
+        infos = super().load(path, load_cfg, strict, map_location or self.device)
+        levels = (infos or {}).get("sand_floor_level")
+        env = self.env.unwrapped
+        if levels is not None and levels.shape[0] == env.num_envs:
+            get_sand(env).floor_level.copy_(levels.to(env.device))
+        return infos
+
+    def _prune(self) -> None:
+        """Delete all but the newest :attr:`keep_checkpoints` checkpoints."""
+        found = sorted(
+            (int(m.group(1)), p)
+            for p in Path(self.logger.log_dir).glob("model_*.pt")  # type: ignore[arg-type]
+            if (m := CHECKPOINT_PATTERN.match(p.name))
+        )
+        for _, p in found[: -self.keep_checkpoints]:
+            p.unlink(missing_ok=True)
+
+    # Summary.
+
+    def summary(self) -> dict[str, float]:
+        """Metrics of the last :meth:`learn` call (means over its iterations)."""
+        times = self._times or [(float("nan"), float("nan"))]
+        n = len(self._times)
+        collect = sum(c for c, _ in times) / len(times)
+        learn = sum(lt for _, lt in times) / len(times)
+        steps = self.cfg["num_steps_per_env"] * self.env.num_envs
+        rew, length = self.logger.rewbuffer, self.logger.lenbuffer
+        return {
+            "iterations_done": float(n),
+            "iteration": float(self.current_learning_iteration),
+            "mean_reward": statistics.mean(rew) if rew else float("nan"),
+            "mean_episode_length": statistics.mean(length) if length else float("nan"),
+            "seconds_per_iteration": collect + learn,
+            "collection_seconds_per_iteration": collect,
+            "learning_seconds_per_iteration": learn,
+            "env_steps_per_second": steps / (collect + learn),
+            "collection_env_steps_per_second": steps / collect,
+            "env_steps": float(steps * n),
+            "stopped_by_deadline": float(self.stopped_by_deadline),
+        }

@@ -1,0 +1,141 @@
+# SPDX-License-Identifier: Apache-2.0
+"""Training entry point: ``train(TrainRunCfg) -> dict[str, float]`` (PPO on the granular G1 task).
+
+A run lives in one directory. Calling :func:`train` again with the same config resumes from the newest
+checkpoint there and continues until ``max_iterations`` iterations are done in total, so a killed or
+time-boxed run is continued by repeating the same call.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+import os
+import time
+from dataclasses import asdict, dataclass, field
+from pathlib import Path
+from typing import Any, Literal
+
+from gmloco.train.config import GranularTaskCfg
+
+__all__ = ["TrainRunCfg", "train"]
+
+_RUN_CFG_FILE = "train_cfg.json"
+"""Resolved run config written on the first call (compared on resume)."""
+_RESUME_INVARIANT = ("task", "num_envs", "num_steps_per_env", "hidden_dims", "seed")
+"""Fields that must not change between the calls of one run."""
+
+
+@dataclass
+class TrainRunCfg:
+    """One PPO run on the granular G1 task."""
+
+    task: GranularTaskCfg = field(default_factory=GranularTaskCfg)
+    """Task: contact model, terrain, materials, DR, rewards."""
+    num_envs: int = 4096
+    """Number of parallel environments."""
+    max_iterations: int = 30_000
+    """Total PPO iterations of the run (over all resumed calls)."""
+    max_minutes: float | None = None
+    """Wall-clock budget of this call [min], env construction and export included; None: no limit."""
+    seed: int = 42
+    """Seed of the env (mjlab seeds numpy, torch and warp from it) and of PPO."""
+    device: str = "cuda:0"
+    """Torch / Warp device, e.g. "cuda:0" or "cpu"."""
+    run_dir: str = "runs/train/ppo_rft3d"
+    """Run directory: checkpoints ``model_<it>.pt``, TensorBoard events, ``policy.onnx``, ``metrics.json``."""
+    resume: bool = True
+    """Continue from the newest checkpoint in ``run_dir`` if there is one."""
+    save_interval: int = 50
+    """Iterations between checkpoints (one is always written when the call ends)."""
+    num_steps_per_env: int = 24
+    """Env steps per env and iteration."""
+    hidden_dims: tuple[int, ...] = (512, 256, 128)
+    """Hidden layer widths of actor and critic."""
+    logger: Literal["tensorboard", "wandb"] = "tensorboard"
+    """rsl-rl log writer (wandb runs offline unless WANDB_MODE says otherwise)."""
+    export_onnx: bool = True
+    """Export ``policy.onnx`` (+ ``policy.json``) with deploy metadata when the call ends."""
+    export_reserve_s: float = 30.0
+    """Time kept free before the deadline for the final checkpoint and export [s]."""
+
+
+def _check_resume_cfg(run_dir: Path, cfg: TrainRunCfg) -> None:
+    """Write the run config on the first call; refuse to resume a run whose invariants changed."""
+    current = json.loads(json.dumps(asdict(cfg), default=str))
+    path = run_dir / _RUN_CFG_FILE
+    if path.exists():
+        saved = json.loads(path.read_text())
+        changed = [k for k in _RESUME_INVARIANT if saved.get(k) != current.get(k)]
+        if changed:
+            raise ValueError(f"{run_dir} was started with a different {changed}; use another run_dir")
+    tmp = path.with_suffix(".tmp")
+    tmp.write_text(json.dumps(current, indent=1))
+    os.replace(tmp, path)
+
+
+def _make_env(cfg: TrainRunCfg) -> Any:
+    """Build the mjlab env wrapped for rsl-rl."""
+    from mjlab.envs import ManagerBasedRlEnv
+    from mjlab.rl import RslRlVecEnvWrapper
+
+    from gmloco.train.tasks.g1_granular import make_g1_granular_env_cfg
+
+    env_cfg = make_g1_granular_env_cfg(cfg.task, cfg.num_envs)
+    env_cfg.seed = cfg.seed
+    return RslRlVecEnvWrapper(ManagerBasedRlEnv(cfg=env_cfg, device=cfg.device))
+
+
+def _make_runner(cfg: TrainRunCfg, env: Any, run_dir: Path) -> Any:
+    """Build the time-boxed rsl-rl runner with GM-Loco's PPO settings."""
+    from gmloco.train.rl.runner import GmlocoOnPolicyRunner
+    from gmloco.train.tasks.g1_granular import make_g1_granular_ppo_cfg
+
+    agent = make_g1_granular_ppo_cfg(experiment_name=run_dir.name, hidden_dims=cfg.hidden_dims)
+    agent.seed, agent.save_interval, agent.logger = cfg.seed, cfg.save_interval, cfg.logger
+    agent.num_steps_per_env, agent.max_iterations = cfg.num_steps_per_env, cfg.max_iterations
+    runner = GmlocoOnPolicyRunner(env, asdict(agent), str(run_dir), cfg.device)
+    runner.add_git_repo_to_log(__file__)
+    return runner
+
+
+def train(cfg: TrainRunCfg) -> dict[str, float]:
+    """Train (or resume) PPO on the granular G1 task and return summary metrics.
+
+    Args:
+        cfg: The run configuration.
+
+    Returns:
+        ``iterations_done`` (this call), ``iteration`` (total), ``mean_reward``, ``mean_episode_length``,
+        ``env_steps_per_second``, ``seconds_per_iteration`` (+ collection / learning parts),
+        ``env_steps``, ``stopped_by_deadline``, ``resumed_from_iteration``, ``wall_seconds``.
+    """
+    start = time.monotonic()
+    deadline = None if cfg.max_minutes is None else start + 60.0 * cfg.max_minutes - cfg.export_reserve_s
+    os.environ.setdefault("WANDB_MODE", "offline")
+    os.environ.setdefault("GIT_PYTHON_REFRESH", "quiet")
+    run_dir = Path(cfg.run_dir).resolve()
+    run_dir.mkdir(parents=True, exist_ok=True)
+    _check_resume_cfg(run_dir, cfg)
+
+    from gmloco.train.rl.export import export_policy_onnx
+    from gmloco.train.rl.runner import latest_checkpoint
+
+    env = _make_env(cfg)
+    runner = _make_runner(cfg, env, run_dir)
+    checkpoint = latest_checkpoint(run_dir) if cfg.resume else None
+    if checkpoint is not None:
+        runner.load(str(checkpoint))
+    resumed_from = runner.current_learning_iteration
+    remaining = cfg.max_iterations - resumed_from
+    if remaining > 0:
+        runner.learn(remaining, init_at_random_ep_len=checkpoint is None, deadline=deadline)
+    summary = runner.summary() if remaining > 0 else {"iterations_done": 0.0, "iteration": float(resumed_from)}
+    if cfg.export_onnx:
+        extra = {"contact_model": cfg.task.contact_model, "terrain": cfg.task.terrain.kind}
+        export_policy_onnx(runner, run_dir / "policy.onnx", run_name=run_dir.name, extra=extra)
+    env.close()
+    summary.update(resumed_from_iteration=float(resumed_from), wall_seconds=time.monotonic() - start)
+    clean = {k: (v if math.isfinite(v) else None) for k, v in summary.items()}
+    (run_dir / "metrics.json").write_text(json.dumps(clean, indent=1))
+    return summary
