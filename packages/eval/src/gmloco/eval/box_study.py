@@ -1,0 +1,191 @@
+# SPDX-License-Identifier: Apache-2.0
+"""Box-intrusion study: reduced-order models vs Newton implicit MPM over randomized media (issue 5).
+
+``run(cfg)`` samples ``num_trials`` media (seeded), simulates the box under every model and both launch variants,
+appends one record per (variant, trial, model) to ``out_dir`` (resumable: done records are skipped), stops
+cleanly after ``max_minutes`` and then writes ``summary.json`` and the figure from whatever is done.
+"""
+
+from __future__ import annotations
+
+import json
+import time
+from dataclasses import asdict, dataclass, field, replace
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from gmloco.eval.box import BoxCfg, box_lateral_variant
+from gmloco.eval.metrics.box import metric_lateral_force, metric_sinkage, metric_travel
+from gmloco.eval.mpm.bed import SandBedCfg
+from gmloco.eval.mpm.box_scene import MpmSolverCfg
+from gmloco.eval.rom_box import ROM_MODELS, RomBoxCfg, simulate_rom_box
+from gmloco.eval.study_io import StudyRecords
+
+__all__ = ["BoxStudyCfg", "box_study_smoke_cfg", "run", "sample_media"]
+
+
+@dataclass(frozen=True)
+class BoxStudyCfg:
+    """Configuration of the box-intrusion study."""
+
+    out_dir: str = "results/box_intrusion"
+    """Output directory (trials.csv, grf.jsonl, summary.json, fig_box_intrusion.png)."""
+    num_trials: int = 30
+    """Number of randomized media N (N >= 30 for the paper figure)."""
+    seed: int = 0
+    """Seed of the media sampling."""
+    bulk_density: tuple[float, float] = (1000.0, 3000.0)
+    """Uniform range of the grain density [kg/m^3] (GM-Loco DR)."""
+    packing: tuple[float, float] = (0.5, 1.0)
+    """Uniform range of the packing ratio [-]; rho_c = packing * bulk_density (GM-Loco DR)."""
+    mu_int: tuple[float, float] = (0.2, 0.9)
+    """Uniform range of mu_int [-] (GM-Loco code DR)."""
+    mu_surf: tuple[float, float] = (0.1, 1.0)
+    """Uniform range of mu_surf [-] (GM-Loco DR)."""
+    variants: tuple[str, ...] = ("forward", "lateral")
+    """Launch variants: ``forward`` (box aligned with its velocity), ``lateral`` (box yawed 30 deg)."""
+    models: tuple[str, ...] = ("mpm", *ROM_MODELS)
+    """Models to run; ``rft3d_fitted`` is added automatically when ``rft3d_fitted_coeffs`` is set."""
+    box: BoxCfg = field(default_factory=BoxCfg)
+    """The forward-variant box."""
+    rom: RomBoxCfg = field(default_factory=RomBoxCfg)
+    """Reduced-order numerics (its ``box`` is replaced per variant)."""
+    bed: SandBedCfg = field(default_factory=SandBedCfg)
+    """MPM sand bed."""
+    mpm: MpmSolverCfg = field(default_factory=MpmSolverCfg)
+    """MPM numerics (voxel size from the convergence check)."""
+    rft3d_fitted_coeffs: str = ""
+    """Optional fitted 3D-RFT coefficient file (``results/rft_fit/rft3d_fitted.json``) run as ``rft3d_fitted``."""
+    max_minutes: float = 60.0
+    """Wall-clock budget [min]; the runner stops before an MPM trial it expects to overrun."""
+    device: str | None = None
+    """Warp device of the MPM side; None = Warp's default (CUDA when present)."""
+    make_figure: bool = True
+    """Write ``fig_box_intrusion.png`` at the end."""
+
+
+def box_study_smoke_cfg(out_dir: str, **overrides: Any) -> BoxStudyCfg:
+    """Return a CPU smoke configuration: 1 trial, a 0.6 x 0.5 x 0.15 m bed at 6 cm voxels, 0.2 s (impact included)."""
+    box = BoxCfg(duration=0.2)
+    cfg = BoxStudyCfg(
+        out_dir=out_dir,
+        num_trials=1,
+        variants=("forward",),
+        box=box,
+        rom=RomBoxCfg(box=box, collider_resolution=3),
+        bed=SandBedCfg(size_x=0.6, size_y=0.5, depth=0.15, center_x=0.1),
+        mpm=MpmSolverCfg(voxel_size=0.06, max_iterations=20),
+        device="cpu",
+        make_figure=False,
+    )
+    return replace(cfg, **overrides)
+
+
+def sample_media(cfg: BoxStudyCfg) -> dict[str, np.ndarray]:
+    """Sample the trials' media, each [num_trials]: bulk_density, packing, rho_c, mu_int, mu_surf."""
+    rng = np.random.default_rng(cfg.seed)
+    n = cfg.num_trials
+    media = {k: rng.uniform(*getattr(cfg, k), size=n) for k in ("bulk_density", "packing", "mu_int", "mu_surf")}
+    media["rho_c"] = media["packing"] * media["bulk_density"]
+    return media
+
+
+def _variant_box(cfg: BoxStudyCfg, variant: str) -> BoxCfg:
+    """Return the box of a launch variant."""
+    if variant == "forward":
+        return cfg.box
+    if variant == "lateral":
+        return box_lateral_variant(cfg.box)
+    raise ValueError(f"variant={variant!r}: expected 'forward' or 'lateral'")
+
+
+def _record(
+    cfg: BoxStudyCfg, variant: str, trial: int, model: str, media: dict[str, np.ndarray], traj: dict[str, np.ndarray],
+    box: BoxCfg, timing: dict[str, float],
+) -> tuple[dict[str, Any], dict[str, np.ndarray]]:  # fmt: skip
+    """Build one CSV row and its series from a trajectory (pos [T,3], quat_wxyz [T,4], grf [T,3], time [T])."""
+    row: dict[str, Any] = {"variant": variant, "trial": trial, "model": model}
+    row.update({k: round(float(media[k][trial]), 6) for k in ("bulk_density", "packing", "rho_c", "mu_int", "mu_surf")})
+    row["travel"] = metric_travel(traj["pos"], box.initial_pos)
+    row["sinkage"] = metric_sinkage(traj["pos"][-1], traj["quat_wxyz"][-1], box.half_extents[2])
+    row["lateral_force"] = metric_lateral_force(traj["grf"], box.velocity)
+    row["peak_fz"] = float(np.max(traj["grf"][:, 2]))
+    row.update(timing)
+    return row, {"time": traj["time"], "grf": traj["grf"], "pos": traj["pos"]}
+
+
+def _run_rom(cfg: BoxStudyCfg, records: StudyRecords, media: dict[str, np.ndarray], models: list[str]) -> None:
+    """Run every reduced-order model on all trials of every variant that has a missing record."""
+    done = records.done()
+    for variant in cfg.variants:
+        box = _variant_box(cfg, variant)
+        for model in models:
+            missing = [t for t in range(cfg.num_trials) if records.key(variant, t, model) not in done]
+            if model == "mpm" or not missing:
+                continue
+            rom_cfg = replace(cfg.rom, box=box)
+            if model == "rft3d_fitted":
+                rom_cfg = replace(rom_cfg, rft3d_coeffs=cfg.rft3d_fitted_coeffs)
+            res = simulate_rom_box(
+                model.removesuffix("_fitted"), rom_cfg, *(media[k] for k in ("rho_c", "mu_int", "mu_surf"))
+            )
+            n_frames = res.time.shape[0]
+            timing = {"wall_s": res.wall_time / cfg.num_trials, "frames_per_s": n_frames * cfg.num_trials / res.wall_time,
+                      "particle_count": 0, "voxel_size": 0.0}  # fmt: skip
+            for t in missing:
+                traj = {"pos": res.body_pos[t], "quat_wxyz": res.body_quat[t], "grf": res.grf[t], "time": res.time}
+                records.append(*_record(cfg, variant, t, model, media, traj, box, timing))
+
+
+def _run_mpm_trial(cfg: BoxStudyCfg, box: BoxCfg, media: dict[str, np.ndarray], trial: int) -> tuple[dict, dict]:
+    """Simulate one trial in MPM; return its trajectory and timing."""
+    from gmloco.contact import MaterialCfg
+    from gmloco.eval.mpm.box_scene import MpmBoxScene, MpmBoxSceneCfg
+
+    mat = MaterialCfg(*(float(media[k][trial]) for k in ("bulk_density", "packing", "mu_int", "mu_surf")))
+    t0 = time.perf_counter()
+    scene = MpmBoxScene(MpmBoxSceneCfg(box=box, bed=cfg.bed, solver=cfg.mpm, device=cfg.device), mat)
+    scene.run()
+    scene.test_final()
+    q = np.array(scene.body_q)  # p, q_xyzw
+    traj = {"pos": q[:, :3], "quat_wxyz": q[:, [6, 3, 4, 5]], "grf": np.array(scene.sand_force),
+            "time": cfg.mpm.frame_dt * np.arange(1, len(q) + 1)}  # fmt: skip
+    timing = {"wall_s": time.perf_counter() - t0, "frames_per_s": scene.frames_per_second,
+              "particle_count": scene.particle_count, "voxel_size": cfg.mpm.voxel_size}  # fmt: skip
+    return traj, timing
+
+
+def run(cfg: BoxStudyCfg) -> dict[str, Any]:
+    """Run (or resume) the study and write its outputs; return the summary with a ``complete`` flag."""
+    from gmloco.eval.box_summary import summarize_study
+
+    t_start = time.perf_counter()
+    records = StudyRecords(cfg.out_dir)
+    media = sample_media(cfg)
+    models = list(cfg.models) + (["rft3d_fitted"] if cfg.rft3d_fitted_coeffs else [])
+    (Path(cfg.out_dir) / "config.json").write_text(json.dumps(asdict(cfg), indent=1, default=str))
+    _run_rom(cfg, records, media, models)
+    complete, last_trial_s = True, 0.0
+    if "mpm" in models:
+        for variant in cfg.variants:
+            box = _variant_box(cfg, variant)
+            for trial in range(cfg.num_trials):
+                if records.key(variant, trial, "mpm") in records.done():
+                    continue
+                if time.perf_counter() - t_start + last_trial_s > 60.0 * cfg.max_minutes:
+                    complete = False
+                    break
+                traj, timing = _run_mpm_trial(cfg, box, media, trial)
+                last_trial_s = timing["wall_s"]
+                records.append(*_record(cfg, variant, trial, "mpm", media, traj, box, timing))
+    summary = summarize_study(records, cfg, models)
+    summary["complete"] = complete
+    summary["wall_s_this_run"] = time.perf_counter() - t_start
+    (Path(cfg.out_dir) / "summary.json").write_text(json.dumps(summary, indent=1))
+    if cfg.make_figure and records.rows():
+        from gmloco.eval.figures.fig_box_intrusion import fig_box_intrusion
+
+        fig_box_intrusion(records, cfg.box.mass, Path(cfg.out_dir) / "fig_box_intrusion.png")
+    return summary
