@@ -28,8 +28,10 @@ __all__ = ["BaseEstCfg", "BaseTrajectory", "estimate_base", "odometry_base"]
 class BaseEstCfg:
     """Settings of the leg-odometry base estimator."""
 
-    penetration: float = 0.003
+    penetration: float = 0.0006
     """Assumed sinkage of the support foot's lowest sole points [m] (nominal ground under standing load)."""
+    blend_height: float = 0.01
+    """A foot this much above the lowest one gets zero weight in the velocity estimate [m]."""
     switch_margin: float = 0.004
     """Height advantage a foot needs to become the support foot [m] (hysteresis)."""
     contact_band: float = 0.004
@@ -97,19 +99,25 @@ def estimate_base(
         low = np.array([s[:, 2].min() for s in soles])
         if low[1 - support] < low[support] - cfg.switch_margin:
             support = 1 - support
-        pts = soles[support]
-        patch = pts[pts[:, 2] < low[support] + cfg.contact_band].mean(axis=0)
         z[k] = -low[support] - cfg.penetration
-        mujoco.mj_jac(model, data, jacp, None, patch, feet[support])
         qv = np.concatenate([np.zeros(3), omega[k], dq[k]])
-        vel[k] = -(jacp @ qv)
+        # Both feet near the ground (double support) share the no-slip assumption, weighted by height.
+        w = np.clip(1.0 - (low - low.min()) / cfg.blend_height, 0.0, 1.0)
+        for f in (0, 1):
+            if w[f] > 0:
+                pts = soles[f]
+                patch = pts[pts[:, 2] < low[f] + cfg.contact_band].mean(axis=0)
+                mujoco.mj_jac(model, data, jacp, None, patch, feet[f])
+                vel[k] -= w[f] / w.sum() * (jacp @ qv)
         fh[k] = low - low[support] - cfg.penetration
     pos = np.zeros((n, 3))  # x, y stay 0: flat ground makes the dynamics translation invariant
     pos[:, 2] = z
     return BaseTrajectory(pos, np.asarray(quat, float), vel, np.asarray(omega, float), fh, "leg_odometry")
 
 
-def odometry_base(model: Any, q: np.ndarray, rec_pos: np.ndarray, rec_quat: np.ndarray, v_body: np.ndarray, w_body: np.ndarray) -> BaseTrajectory:
+def odometry_base(
+    model: Any, q: np.ndarray, rec_pos: np.ndarray, rec_quat: np.ndarray, v_body: np.ndarray, w_body: np.ndarray
+) -> BaseTrajectory:
     """Wrap logged odometry (body-frame velocities) as a :class:`BaseTrajectory`, adding foot heights by FK."""
     import mujoco
 
@@ -123,5 +131,10 @@ def odometry_base(model: Any, q: np.ndarray, rec_pos: np.ndarray, rec_quat: np.n
         mujoco.mj_kinematics(model, data)
         fh[k] = [_sole_world(data, b)[:, 2].min() for b in feet]
     return BaseTrajectory(
-        np.asarray(rec_pos, float), np.asarray(rec_quat, float), quat_rotate(rec_quat, v_body), np.asarray(w_body, float), fh, "odometry"
+        np.asarray(rec_pos, float),
+        np.asarray(rec_quat, float),
+        quat_rotate(rec_quat, v_body),
+        np.asarray(w_body, float),
+        fh,
+        "odometry",
     )

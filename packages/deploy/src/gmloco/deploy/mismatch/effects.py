@@ -141,7 +141,11 @@ EFFECTS: tuple[EffectSpec, ...] = (
     EffectSpec(
         "joint.coulomb_friction",
         "Coulomb joint friction",
-        (ParamSpec("tau_c", "N*m", 1, 0.0, 8.0, 0.3, 0.3, "Friction of an 88 N*m joint; others scale by effort limit."),),
+        (
+            ParamSpec(
+                "tau_c", "N*m", 1, 0.0, 8.0, 0.3, 0.3, "Friction of an 88 N*m joint; others scale by effort limit."
+            ),
+        ),
         "Dry friction of magnitude tau_c * tau_max_j / 88 N*m (MuJoCo frictionloss constraint).",
         "Steps in the motion residual at dq sign changes; position error ~ tau_c / kp at low speed.",
         ("swing", "any"),
@@ -152,7 +156,11 @@ EFFECTS: tuple[EffectSpec, ...] = (
     EffectSpec(
         "joint.viscous_damping",
         "Viscous joint damping",
-        (ParamSpec("b", "N*m*s/rad", 1, -0.5, 6.0, 0.15, 0.15, "Damping of an 88 N*m joint; others scale by effort limit."),),
+        (
+            ParamSpec(
+                "b", "N*m*s/rad", 1, -0.5, 6.0, 0.15, 0.15, "Damping of an 88 N*m joint; others scale by effort limit."
+            ),
+        ),
         "tau_f = -b_j dq with b_j = b tau_max_j / 88 N*m. With dq* = 0 it is collinear with kd in motion, "
         "but not in tau_est, which only sees the PD torque.",
         "Motion residual ~ dq, phase lag at high swing speed; tau_est unchanged.",
@@ -175,11 +183,7 @@ EFFECTS: tuple[EffectSpec, ...] = (
     EffectSpec(
         "sensor.encoder_offset",
         "Encoder offset / calibration bias",
-        (
-            ParamSpec(
-                "offset", "rad", 12, -0.1, 0.1, 0.005, 0.006, "q_meas = q + offset, leg joints.", LEG_JOINTS
-            ),
-        ),
+        (ParamSpec("offset", "rad", 12, -0.1, 0.1, 0.005, 0.006, "q_meas = q + offset, leg joints.", LEG_JOINTS),),
         "q_meas = q_true + c_j on the leg joints; the motor PD acts on q_meas.",
         "Constant posture and gravity-torque bias per joint, phase independent.",
         ("any",),
@@ -201,7 +205,19 @@ EFFECTS: tuple[EffectSpec, ...] = (
     EffectSpec(
         "imu.misalignment",
         "IMU mounting misalignment",
-        (ParamSpec("angle", "rad", 2, -0.15, 0.15, 0.01, 0.01, "IMU roll and pitch relative to the pelvis.", ("roll", "pitch")),),
+        (
+            ParamSpec(
+                "angle",
+                "rad",
+                2,
+                -0.15,
+                0.15,
+                0.01,
+                0.01,
+                "IMU roll and pitch relative to the pelvis.",
+                ("roll", "pitch"),
+            ),
+        ),
         "R_imu = R_pelvis R_x(roll) R_y(pitch): quaternion, gyro and accelerometer rotated.",
         "Base tilt inconsistent with flat feet: stance torques, tilting motion after reset.",
         ("stance", "any"),

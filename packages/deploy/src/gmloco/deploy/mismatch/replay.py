@@ -138,7 +138,12 @@ class Replayer:
     def base(self, params: dict[str, np.ndarray], starts: np.ndarray) -> BaseTrajectory:
         """Base state at the segment starts under the sensor hypotheses of ``params`` (cached)."""
         h = _unpack(params)
-        key = (tuple(np.round(h.offset[:12], 9)), tuple(np.round(h.mis, 9)), tuple(np.round(h.gyro_bias, 9)), starts.tobytes())
+        key = (
+            tuple(np.round(h.offset[:12], 9)),
+            tuple(np.round(h.mis, 9)),
+            tuple(np.round(h.gyro_bias, 9)),
+            starts.tobytes(),
+        )
         if key not in self._base_cache:
             self._base_cache[key] = self._estimate(h, starts)
             if len(self._base_cache) > 64:
@@ -150,7 +155,14 @@ class Replayer:
         r = self.rec
         q_true = r.q[starts] - h.offset
         if r.has_odometry:
-            return odometry_base(self.model, q_true, r.base_pos[starts], r.base_quat[starts], r.base_linvel[starts], r.base_angvel[starts])
+            return odometry_base(
+                self.model,
+                q_true,
+                r.base_pos[starts],
+                r.base_quat[starts],
+                r.base_linvel[starts],
+                r.base_angvel[starts],
+            )
         qm = quat_from_roll_pitch(float(h.mis[0]), float(h.mis[1]))
         quat = quat_mul(r.imu_quat[starts], quat_conj(qm))
         omega = (r.imu_gyro[starts] - h.gyro_bias) @ quat_to_mat(qm).T

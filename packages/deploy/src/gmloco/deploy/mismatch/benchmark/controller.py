@@ -22,7 +22,13 @@ def default_pose() -> np.ndarray:
     """Knees-bent standing pose (mjlab ``KNEES_BENT_KEYFRAME``) [rad], shape [29]."""
     q = np.zeros(29)
     for i, n in enumerate(G1_JOINT_NAMES):
-        for k, v in {"hip_pitch": -0.312, "knee": 0.669, "ankle_pitch": -0.363, "elbow": 0.6, "shoulder_pitch": 0.2}.items():
+        for k, v in {
+            "hip_pitch": -0.312,
+            "knee": 0.669,
+            "ankle_pitch": -0.363,
+            "elbow": 0.6,
+            "shoulder_pitch": 0.2,
+        }.items():
             if k in n:
                 q[i] = v
     q[joint_index("left_shoulder_roll_joint")] = 0.2
@@ -35,7 +41,16 @@ def default_gains() -> tuple[np.ndarray, np.ndarray]:
     kp, kd = np.zeros(29), np.zeros(29)
     for i, n in enumerate(G1_JOINT_NAMES):
         kp[i], kd[i] = next(
-            (g for k, g in (("knee", (300.0, 8.0)), ("hip", (200.0, 5.0)), ("ankle", (150.0, 4.0)), ("waist", (150.0, 4.0))) if k in n),
+            (
+                g
+                for k, g in (
+                    ("knee", (300.0, 8.0)),
+                    ("hip", (200.0, 5.0)),
+                    ("ankle", (150.0, 4.0)),
+                    ("waist", (150.0, 4.0)),
+                )
+                if k in n
+            ),
             (40.0, 1.5),
         )
     return kp, kd
@@ -49,9 +64,9 @@ class MotionCfg:
     """Standing with arm motion, stepping in place, or slow forward stepping."""
     period: float = 0.9
     """Gait cycle [s]."""
-    lift: float = 0.25
+    lift: float = 0.15
     """Swing flexion amplitude [rad] (hip/ankle -lift, knee +2 lift)."""
-    sway: float = 0.07
+    sway: float = 0.1
     """Hip/ankle roll sway amplitude [rad]."""
     stride: float = 0.12
     """Hip pitch half-sweep while walking [rad]."""

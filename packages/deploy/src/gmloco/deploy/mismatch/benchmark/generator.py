@@ -83,7 +83,22 @@ def generate(cfg: EpisodeCfg) -> tuple[Recording, dict]:
     _initial_state(model, data, ctrl.q0)
     feet = [model.body(f"{s}_ankle_roll_link").id for s in ("left", "right")]
     n = int(round(cfg.duration * cfg.rate_hz))
-    out = {k: np.zeros((n, w)) for k, w in (("q", 29), ("dq", 29), ("tau", 29), ("qc", 29), ("quat", 4), ("gyro", 3), ("acc", 3), ("pos", 3), ("bq", 4), ("v", 3), ("w", 3))}
+    out = {
+        k: np.zeros((n, w))
+        for k, w in (
+            ("q", 29),
+            ("dq", 29),
+            ("tau", 29),
+            ("qc", 29),
+            ("quat", 4),
+            ("gyro", 3),
+            ("acc", 3),
+            ("pos", 3),
+            ("bq", 4),
+            ("v", 3),
+            ("w", 3),
+        )
+    }
     tau = np.zeros(29)
     for k in range(n):
         mujoco.mj_forward(model, data)
@@ -109,10 +124,16 @@ def generate(cfg: EpisodeCfg) -> tuple[Recording, dict]:
         out["v"][k], out["w"][k] = rot.T @ data.qvel[:3], data.qvel[3:6]
         if data.qpos[2] < 0.45:
             raise RuntimeError(f"truth robot fell at t = {k * dt_log:.2f} s (effect {cfg.effect.id})")
-    return _to_recording(cfg, out, n, dt_log, kp, kd, rng), {"effect": cfg.effect.id, "params": cfg.effect.params, "seed": cfg.seed}
+    return _to_recording(cfg, out, n, dt_log, kp, kd, rng), {
+        "effect": cfg.effect.id,
+        "params": cfg.effect.params,
+        "seed": cfg.seed,
+    }
 
 
-def _to_recording(cfg: EpisodeCfg, o: dict, n: int, dt: float, kp: np.ndarray, kd: np.ndarray, rng: np.random.Generator) -> Recording:
+def _to_recording(
+    cfg: EpisodeCfg, o: dict, n: int, dt: float, kp: np.ndarray, kd: np.ndarray, rng: np.random.Generator
+) -> Recording:
     """Pack arrays as a :class:`Recording` (with dropped samples marked invalid)."""
     valid = np.ones(n, bool)
     if cfg.drop_fraction > 0:
