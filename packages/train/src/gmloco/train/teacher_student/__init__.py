@@ -1,0 +1,50 @@
+# SPDX-License-Identifier: Apache-2.0
+"""GM-Loco teacher-student learning as rsl-rl plug-ins (Kamohara et al., arXiv 2603.13707, Sec. IV).
+
+* Teacher: :class:`TeacherActor` (actor over ``[o_t, z_t]``, VAE terrain encoder, eta decoder) trained by
+  :class:`TeacherPPO` (L_PPO + eta reconstruction + beta * KL), with rsl-rl's ``MLPModel`` as asymmetric critic.
+* Student: :class:`StudentActor` (three 1-D convolutions + MLP over the N-step history) trained by
+  :class:`StudentPPO` (DAgger + weighted PPO, frozen teacher) under :class:`StudentRunner`.
+* Configs: :class:`TeacherCfg`, :class:`StudentCfg`, :class:`DistillCfg`, :class:`ObsGroupsCfg`, :class:`PpoCfg`.
+"""
+
+from gmloco.train.teacher_student.config import (
+    CRITIC_CLASS,
+    STUDENT_ACTOR_CLASS,
+    STUDENT_PPO_CLASS,
+    STUDENT_RUNNER_CLASS,
+    TEACHER_ACTOR_CLASS,
+    TEACHER_PPO_CLASS,
+    DistillCfg,
+    ObsGroupsCfg,
+    PpoCfg,
+    StudentCfg,
+    TeacherCfg,
+)
+from gmloco.train.teacher_student.curriculum import LinearRamp
+from gmloco.train.teacher_student.runner import StudentRunner
+from gmloco.train.teacher_student.student import DEFAULT_HISTORY_LENGTH, StudentActor
+from gmloco.train.teacher_student.student_ppo import StudentPPO
+from gmloco.train.teacher_student.teacher import TeacherActor
+from gmloco.train.teacher_student.teacher_ppo import TeacherPPO
+
+__all__ = [
+    "CRITIC_CLASS",
+    "DEFAULT_HISTORY_LENGTH",
+    "STUDENT_ACTOR_CLASS",
+    "STUDENT_PPO_CLASS",
+    "STUDENT_RUNNER_CLASS",
+    "TEACHER_ACTOR_CLASS",
+    "TEACHER_PPO_CLASS",
+    "DistillCfg",
+    "LinearRamp",
+    "ObsGroupsCfg",
+    "PpoCfg",
+    "StudentActor",
+    "StudentCfg",
+    "StudentPPO",
+    "StudentRunner",
+    "TeacherActor",
+    "TeacherCfg",
+    "TeacherPPO",
+]

@@ -1,0 +1,293 @@
+# SPDX-License-Identifier: Apache-2.0
+"""Typed configuration of the GM-Loco teacher, student and distillation, and their rsl-rl dicts.
+
+Pure data. ``TeacherCfg.to_rsl_rl`` and ``DistillCfg.to_rsl_rl`` return the ``actor`` / ``critic`` /
+(``teacher``) / ``algorithm`` / ``obs_groups`` entries of an rsl-rl train cfg; merge them onto a runner cfg, e.g.
+``asdict(RslRlOnPolicyRunnerCfg(...)) | teacher.to_rsl_rl(groups)``. Network sizes follow Kamohara et al.,
+arXiv 2603.13707; values the paper does not give are marked "ours".
+"""
+
+from __future__ import annotations
+
+from dataclasses import asdict, dataclass, field
+from typing import Literal
+
+from gmloco.train.teacher_student.student import DEFAULT_HISTORY_LENGTH
+
+__all__ = [
+    "CRITIC_CLASS",
+    "STUDENT_ACTOR_CLASS",
+    "STUDENT_PPO_CLASS",
+    "STUDENT_RUNNER_CLASS",
+    "TEACHER_ACTOR_CLASS",
+    "TEACHER_PPO_CLASS",
+    "DistillCfg",
+    "ObsGroupsCfg",
+    "PpoCfg",
+    "StudentCfg",
+    "TeacherCfg",
+]
+
+_PKG = "gmloco.train.teacher_student"
+TEACHER_ACTOR_CLASS = f"{_PKG}.teacher:TeacherActor"
+"""rsl-rl ``class_name`` of the teacher actor."""
+TEACHER_PPO_CLASS = f"{_PKG}.teacher_ppo:TeacherPPO"
+"""rsl-rl ``class_name`` of the teacher algorithm (run by mjlab's / rsl-rl's on-policy runner)."""
+STUDENT_ACTOR_CLASS = f"{_PKG}.student:StudentActor"
+"""rsl-rl ``class_name`` of the student actor."""
+STUDENT_PPO_CLASS = f"{_PKG}.student_ppo:StudentPPO"
+"""rsl-rl ``class_name`` of the DAgger + PPO distillation algorithm."""
+STUDENT_RUNNER_CLASS = f"{_PKG}.runner:StudentRunner"
+"""Runner class for distillation (loads the teacher checkpoint)."""
+CRITIC_CLASS = "MLPModel"
+"""The asymmetric critic is rsl-rl's stock MLP model on the privileged group."""
+
+
+@dataclass
+class ObsGroupsCfg:
+    """Names of the environment's observation groups (defined by the env) and where eta sits."""
+
+    policy: tuple[str, ...] = ("actor",)
+    """Groups concatenated into o_t, ``[num_envs, obs_dim]``: base ang vel, projected gravity, command,
+    joint pos, joint vel, last action (96 for the 29-DoF G1)."""
+    critic: tuple[str, ...] = ("critic",)
+    """Groups of the asymmetric critic: o_t plus base lin vel, foot heights, contact state and forces, swing time,
+    eta."""
+    privileged: tuple[str, ...] = ("critic",)
+    """Groups forming s_t for the teacher's terrain encoder (with the history appended)."""
+    history: str = "history"
+    """Group holding o_{t-N:t}: ``[num_envs, N, obs_dim]`` (mjlab ``flatten_history_dim=False``, oldest first,
+    current frame last), or flattened term-major with ``StudentCfg.history_term_dims`` set."""
+    eta_group: str = "critic"
+    """Group holding eta = xi / xi_max, the normalized stiffness in [0, 1]."""
+    eta_index: int = -1
+    """Column of eta in ``eta_group`` (-1: last column)."""
+
+    def to_rsl_rl(self) -> dict[str, list[str]]:
+        """Return rsl-rl observation sets: actor, critic, teacher, encoder, history."""
+        return {
+            "actor": list(self.policy),
+            "critic": list(self.critic),
+            "teacher": list(self.policy),
+            "encoder": [*self.privileged, self.history],
+            "history": [self.history],
+        }
+
+
+@dataclass
+class PpoCfg:
+    """PPO hyper-parameters, the keyword arguments of rsl-rl's ``PPO`` (same names and defaults as mjlab's cfg)."""
+
+    num_learning_epochs: int = 5
+    """Passes over the rollout per update."""
+    num_mini_batches: int = 4
+    """Mini-batches per pass; mini-batch size = num_envs * num_steps_per_env / num_mini_batches."""
+    learning_rate: float = 1e-3
+    """Adam learning rate (initial value under the adaptive schedule)."""
+    schedule: Literal["adaptive", "fixed"] = "adaptive"
+    """Learning-rate schedule; adaptive keeps the policy KL near ``desired_kl``."""
+    gamma: float = 0.99
+    """Discount factor per policy step."""
+    lam: float = 0.95
+    """GAE lambda."""
+    entropy_coef: float = 0.005
+    """Entropy bonus weight."""
+    desired_kl: float = 0.01
+    """Target KL divergence per update [nats] for the adaptive schedule."""
+    max_grad_norm: float = 1.0
+    """Gradient-norm clip, applied to actor and critic separately."""
+    value_loss_coef: float = 1.0
+    """Weight of the value loss."""
+    use_clipped_value_loss: bool = True
+    """Clip the value update around the rollout values."""
+    clip_param: float = 0.2
+    """PPO ratio clip epsilon."""
+    normalize_advantage_per_mini_batch: bool = False
+    """Normalize advantages per mini-batch instead of over the whole rollout."""
+    optimizer: Literal["adam", "adamw", "sgd", "rmsprop"] = "adam"
+    """Optimizer name resolved by rsl-rl."""
+
+
+def _gaussian(init_std: float) -> dict:
+    """Return rsl-rl's state-independent Gaussian action distribution cfg."""
+    return {"class_name": "GaussianDistribution", "init_std": init_std, "std_type": "scalar"}
+
+
+def _ppo_kwargs(ppo: PpoCfg, class_name: str) -> dict:
+    """Return PPO keyword arguments with our algorithm class."""
+    kwargs = asdict(ppo)
+    kwargs.update(class_name=class_name, rnd_cfg=None, symmetry_cfg=None)
+    return kwargs
+
+
+@dataclass
+class TeacherCfg:
+    """GM-Loco teacher: actor/critic MLPs, VAE terrain encoder, eta decoder, PPO + VAE loss."""
+
+    actor_hidden_dims: tuple[int, ...] = (512, 256, 128)
+    """Actor MLP hidden widths (paper)."""
+    critic_hidden_dims: tuple[int, ...] = (512, 256, 128)
+    """Critic MLP hidden widths (paper)."""
+    activation: str = "elu"
+    """Activation of every network (paper: ELU)."""
+    encoder_hidden_dims: tuple[int, ...] = (256, 128, 64)
+    """Terrain encoder MLP widths (paper); linear mu / log-variance heads follow."""
+    decoder_hidden_dims: tuple[int, ...] = (64, 128, 256)
+    """Stiffness decoder MLP widths (paper); output is eta, shape ``[num_envs, 1]``."""
+    latent_dim: int = 16
+    """Size of the terrain latent z (ours; not given by the paper)."""
+    encoder_history_steps: int | None = None
+    """Newest history frames fed to the encoder (None: all N)."""
+    obs_normalization: bool = True
+    """Running mean/std normalization of o_t, the encoder input and the critic input."""
+    init_std: float = 1.0
+    """Initial action std [normalized action units]."""
+    actor_latent: Literal["mean", "sample"] = "mean"
+    """Latent fed to the actor: mu (exact PPO ratio; ours) or a reparameterised sample."""
+    kl_weight: float = 1e-3
+    """beta, weight of KL(q(z|.) || N(0, I)) (ours; small to avoid posterior collapse)."""
+    reconstruction_weight: float = 1.0
+    """Weight of (eta - psi(z))^2 (paper: 1)."""
+    ppo: PpoCfg = field(default_factory=PpoCfg)
+    """PPO hyper-parameters of the teacher."""
+
+    def actor_dict(self, groups: ObsGroupsCfg) -> dict:
+        """Return the rsl-rl model cfg of the teacher actor."""
+        del groups  # the encoder reads the "encoder" observation set built by ObsGroupsCfg.to_rsl_rl
+        return {
+            "class_name": TEACHER_ACTOR_CLASS,
+            "hidden_dims": self.actor_hidden_dims,
+            "activation": self.activation,
+            "obs_normalization": self.obs_normalization,
+            "distribution_cfg": _gaussian(self.init_std),
+            "encoder_obs_set": "encoder",
+            "encoder_hidden_dims": self.encoder_hidden_dims,
+            "decoder_hidden_dims": self.decoder_hidden_dims,
+            "latent_dim": self.latent_dim,
+            "encoder_history_steps": self.encoder_history_steps,
+            "encoder_obs_normalization": self.obs_normalization,
+            "actor_latent": self.actor_latent,
+        }
+
+    def critic_dict(self) -> dict:
+        """Return the rsl-rl model cfg of the asymmetric critic."""
+        return {
+            "class_name": CRITIC_CLASS,
+            "hidden_dims": self.critic_hidden_dims,
+            "activation": self.activation,
+            "obs_normalization": self.obs_normalization,
+        }
+
+    def to_rsl_rl(self, groups: ObsGroupsCfg) -> dict:
+        """Return the actor, critic, algorithm and obs_groups entries of the teacher's rsl-rl train cfg."""
+        algorithm = _ppo_kwargs(self.ppo, TEACHER_PPO_CLASS)
+        algorithm.update(
+            eta_group=groups.eta_group,
+            eta_index=groups.eta_index,
+            kl_weight=self.kl_weight,
+            reconstruction_weight=self.reconstruction_weight,
+        )
+        return {
+            "actor": self.actor_dict(groups),
+            "critic": self.critic_dict(),
+            "algorithm": algorithm,
+            "obs_groups": groups.to_rsl_rl(),
+        }
+
+
+@dataclass
+class StudentCfg:
+    """GM-Loco student: temporal-convolution history encoder and an actor over ``[o_t, z_hat]``."""
+
+    actor_hidden_dims: tuple[int, ...] = (512, 256, 128)
+    """Actor MLP widths; equal to the teacher's so distillation can start from the teacher's actor."""
+    history_length: int = DEFAULT_HISTORY_LENGTH
+    """N, history frames (ours: 50 = 1.0 s at the 50 Hz policy rate)."""
+    history_term_dims: tuple[int, ...] | None = None
+    """Per-term frame sizes when the history group is flattened (mjlab term-major), else None."""
+    tcn_channels: tuple[int, int, int] = (32, 32, 32)
+    """Output channels of the three 1-D convolutions (ours)."""
+    tcn_kernel_sizes: tuple[int, int, int] = (8, 5, 5)
+    """Kernel sizes [frames] (ours; N = 50 -> 11 -> 7 -> 3 frames)."""
+    tcn_strides: tuple[int, int, int] = (4, 1, 1)
+    """Strides [frames] (ours)."""
+    tcn_mlp_hidden_dims: tuple[int, ...] = (128,)
+    """Hidden widths of the MLP after the convolutions (ours)."""
+    obs_normalization: bool = True
+    """Running normalization of o_t (starts from the teacher's statistics)."""
+    history_obs_normalization: bool = True
+    """Per-feature running normalization of the history frames."""
+
+    def actor_dict(self, teacher: TeacherCfg) -> dict:
+        """Return the rsl-rl model cfg of the student actor (latent and decoder sizes from the teacher)."""
+        return {
+            "class_name": STUDENT_ACTOR_CLASS,
+            "hidden_dims": self.actor_hidden_dims,
+            "activation": teacher.activation,
+            "obs_normalization": self.obs_normalization,
+            "distribution_cfg": _gaussian(teacher.init_std),
+            "history_obs_set": "history",
+            "history_length": self.history_length,
+            "history_term_dims": self.history_term_dims,
+            "history_obs_normalization": self.history_obs_normalization,
+            "latent_dim": teacher.latent_dim,
+            "tcn_channels": self.tcn_channels,
+            "tcn_kernel_sizes": self.tcn_kernel_sizes,
+            "tcn_strides": self.tcn_strides,
+            "tcn_mlp_hidden_dims": self.tcn_mlp_hidden_dims,
+            "decoder_hidden_dims": teacher.decoder_hidden_dims,
+        }
+
+
+@dataclass
+class DistillCfg:
+    """DAgger + PPO distillation: loss weights, their curriculum, and the teacher checkpoint."""
+
+    w_ppo_start: float = 0.0
+    """w_PPO at the start (ours: pure imitation first)."""
+    w_ppo_end: float = 1.0
+    """w_PPO after the curriculum."""
+    w_dist_start: float = 1.0
+    """w_dist, weight of ||a - a_hat||^2, at the start."""
+    w_dist_end: float = 0.1
+    """w_dist after the curriculum (ours)."""
+    curriculum_begin: int = 0
+    """Learning iteration at which both weights start to ramp."""
+    curriculum_finish: int = 1000
+    """Learning iteration at which both weights reach their end values (ours)."""
+    latent_loss_weight: float = 1.0
+    """Weight of ||z - z_hat||^2 (paper: 1)."""
+    decoder_loss_weight: float = 1.0
+    """Weight of (psi(z) - psi(z_hat))^2 (paper: 1)."""
+    init_from_teacher: bool = True
+    """Start the student's actor MLP, o_t normalizer, action std and critic from the teacher (ours)."""
+    teacher_checkpoint: str | None = None
+    """Path of the TeacherPPO checkpoint (``model_<it>.pt``); StudentRunner loads it at construction."""
+    ppo: PpoCfg = field(default_factory=lambda: PpoCfg(learning_rate=5e-4, schedule="fixed", entropy_coef=0.001))
+    """PPO hyper-parameters of the student (ours: fixed learning rate, the distillation terms dominate early)."""
+
+    def to_rsl_rl(self, teacher: TeacherCfg, student: StudentCfg, groups: ObsGroupsCfg) -> dict:
+        """Return the actor, critic, teacher, algorithm, obs_groups, runner class and teacher path entries."""
+        algorithm = _ppo_kwargs(self.ppo, STUDENT_PPO_CLASS)
+        algorithm.update(
+            w_ppo_start=self.w_ppo_start,
+            w_ppo_end=self.w_ppo_end,
+            w_dist_start=self.w_dist_start,
+            w_dist_end=self.w_dist_end,
+            curriculum_begin=self.curriculum_begin,
+            curriculum_finish=self.curriculum_finish,
+            latent_loss_weight=self.latent_loss_weight,
+            decoder_loss_weight=self.decoder_loss_weight,
+            init_from_teacher=self.init_from_teacher,
+            eta_group=groups.eta_group,
+            eta_index=groups.eta_index,
+        )
+        return {
+            "class_name": STUDENT_RUNNER_CLASS,
+            "actor": student.actor_dict(teacher),
+            "critic": teacher.critic_dict(),
+            "teacher": teacher.actor_dict(groups),
+            "algorithm": algorithm,
+            "obs_groups": groups.to_rsl_rl(),
+            "teacher_checkpoint": self.teacher_checkpoint,
+        }
