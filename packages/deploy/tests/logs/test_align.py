@@ -31,7 +31,7 @@ def test_gap_becomes_nan() -> None:
 
 
 def test_quaternion_sign_flip_is_interpolated_on_the_short_arc() -> None:
-    """q and -q are the same rotation: a sign flip between samples must not pass through zero."""
+    """Interpolate a sign-flipped quaternion pair: q and -q are the same rotation: a sign flip between samples must not pass through zero."""
     q0 = np.array([1.0, 0.0, 0.0, 0.0])
     q1 = -np.array([np.cos(0.05), 0.0, 0.0, np.sin(0.05)])  # 0.1 rad yaw, stored with the opposite sign
     out = resample(np.array([0.0, 1.0]), np.stack([q0, q1]), np.array([0.5]), "quat", max_gap=2.0)

@@ -90,7 +90,7 @@ def test_missing_optional_channels_are_absent(tmp_path: Path, synthetic: Any, wr
     assert not log.has("odom.linear_velocity") and not log.has("student.eta")
     a = log.aligned()
     assert "odom.linear_velocity" not in a and "lowstate.q" in a
-    with pytest.raises(KeyError, match="has no 'student.eta'"):
+    with pytest.raises(KeyError, match=r"has no 'student\.eta'"):
         log.signal("student.eta")
 
 
@@ -111,14 +111,21 @@ def test_unknown_joint_names(tmp_path: Path) -> None:
     """Unitree SDK motor names instead of G1 joint names are refused, listing the unknown names."""
     names = list(G1_JOINT_NAMES)
     names[0] = "L_LEG_HIP_PITCH"
-    with pytest.raises(JointOrderError, match=r"unknown names \['L_LEG_HIP_PITCH'\].*missing \['left_hip_pitch_joint'\]"):
+    with pytest.raises(
+        JointOrderError, match=r"unknown names \['L_LEG_HIP_PITCH'\].*missing \['left_hip_pitch_joint'\]"
+    ):
         read_log(_fake_log(tmp_path / "sdk.mcap", names))
 
 
 def test_writer_rejects_wrong_shapes(tmp_path: Path) -> None:
     """The writer refuses arrays of the wrong length, naming the field."""
-    with G1LogWriter(tmp_path / "w.mcap", RunMetadata(controller="x")) as w, pytest.raises(ValueError, match="q: expected shape"):
-        w.write_lowstate(0.0, np.zeros(28), np.zeros(29), np.zeros(29), np.array([1, 0, 0, 0]), np.zeros(3), np.zeros(3))
+    with (
+        G1LogWriter(tmp_path / "w.mcap", RunMetadata(controller="x")) as w,
+        pytest.raises(ValueError, match=r"q: expected shape"),
+    ):
+        w.write_lowstate(
+            0.0, np.zeros(28), np.zeros(29), np.zeros(29), np.array([1, 0, 0, 0]), np.zeros(3), np.zeros(3)
+        )
 
 
 def test_units_mismatch_is_refused(tmp_path: Path, synthetic: Any, write_log: Any) -> None:
@@ -140,14 +147,16 @@ def test_degrees_without_declaration_warn(tmp_path: Path, synthetic: Any, write_
 def test_accelerometer_in_g_warns(tmp_path: Path, synthetic: Any, write_log: Any) -> None:
     """An accelerometer logged in g (norm ~1) is flagged."""
     synthetic.acc = synthetic.acc / 9.81
-    with pytest.warns(LogContractWarning, match="accelerometer norm 1.00"):
+    with pytest.warns(LogContractWarning, match=r"accelerometer norm 1\.00"):
         read_log(write_log(tmp_path / "g.mcap", synthetic))
 
 
 def test_non_monotonic_timestamps_warn_and_sort(tmp_path: Path) -> None:
     """Timestamps that go backwards are reported with the position, then sorted."""
     path = _fake_log(tmp_path / "back.mcap", list(G1_JOINT_NAMES), times=[0, 10_000_000, 5_000_000, 15_000_000])
-    with pytest.warns(LogContractWarning, match=r"/lowstate/joint_states: 1 timestamps go backwards \(first after message 1"):
+    with pytest.warns(
+        LogContractWarning, match=r"/lowstate/joint_states: 1 timestamps go backwards \(first after message 1"
+    ):
         log = read_log(path)
     np.testing.assert_allclose(log.signal("lowstate.q")[0], [0.0, 0.005, 0.010, 0.015])
 
@@ -161,7 +170,7 @@ def test_not_a_gmloco_log(tmp_path: Path) -> None:
         w = Writer(f)
         w.start()
         w.finish()
-    with pytest.raises(LogFormatError, match="no 'gmloco.run' metadata record.*G1LogWriter"):
+    with pytest.raises(LogFormatError, match=r"no 'gmloco.run' metadata record.*G1LogWriter"):
         read_log(path)
 
 

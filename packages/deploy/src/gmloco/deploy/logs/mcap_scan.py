@@ -289,7 +289,13 @@ def scan_mcap(path: str | Path) -> ScanResult:
             elif op == 0x02:
                 out.complete = data[end : end + 8] == _MAGIC
                 if not out.complete:
-                    out.damage.append(DamageReport("truncated", end, f"file ends inside the closing magic at byte {end}; all records before it were read"))
+                    out.damage.append(
+                        DamageReport(
+                            "truncated",
+                            end,
+                            f"file ends inside the closing magic at byte {end}; all records before it were read",
+                        )
+                    )
                 break
             else:
                 _read_top_record(op, payload, out)

@@ -263,8 +263,15 @@ class G1LogWriter:
         *,
         tf: bool = True,
     ) -> None:
-        """Write the base state: position [m] and orientation (w, x, y, z) of the pelvis in ``odom``,
-        linear [m/s] and angular [rad/s] velocity in the pelvis frame; also ``/tf`` when ``tf``.
+        """Write the base state (odometry) and, when ``tf``, the ``odom -> pelvis`` transform.
+
+        Args:
+            t: Log time [s].
+            position: Pelvis position in ``odom`` [m], shape [3].
+            orientation: Pelvis orientation (w, x, y, z), shape [4].
+            linear_velocity: Linear velocity in the pelvis frame [m/s], shape [3].
+            angular_velocity: Angular velocity in the pelvis frame [rad/s], shape [3].
+            tf: Also write ``/tf`` for Foxglove's 3D panel.
         """
         from foxglove_schemas_protobuf.FrameTransform_pb2 import FrameTransform
         from foxglove_schemas_protobuf.FrameTransforms_pb2 import FrameTransforms

@@ -41,7 +41,7 @@ def _to_heading(quat: np.ndarray, v_body: np.ndarray) -> np.ndarray:
 def smooth(t: np.ndarray, x: np.ndarray, window_s: float) -> np.ndarray:
     """Centered moving average over ``window_s`` [s] along axis 0, NaN-aware."""
     dt = float(np.median(np.diff(t))) if len(t) > 1 else 1.0
-    n = max(1, int(round(window_s / dt)))
+    n = max(1, round(window_s / dt))
     kernel = np.ones(n)
     x2 = np.atleast_2d(x.T).T
     valid = np.isfinite(x2)

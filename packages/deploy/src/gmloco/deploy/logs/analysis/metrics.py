@@ -3,6 +3,7 @@
 
 from __future__ import annotations
 
+import itertools
 from dataclasses import dataclass
 
 import numpy as np
@@ -36,7 +37,7 @@ def command_segments(t: np.ndarray, cmd: np.ndarray) -> list[tuple[int, int]]:
     finite = np.isfinite(cmd)
     change = np.flatnonzero((np.diff(cmd) != 0) | (np.diff(finite) != 0)) + 1
     bounds = np.concatenate([[0], change, [len(cmd)]])
-    return [(int(a), int(b)) for a, b in zip(bounds[:-1], bounds[1:], strict=True) if b > a and finite[a]]
+    return [(int(a), int(b)) for a, b in itertools.pairwise(bounds) if b > a and finite[a]]
 
 
 def velocity_tracking(t: np.ndarray, cmd: np.ndarray, v: np.ndarray, cfg: MetricsCfg | None = None) -> list[dict]:

@@ -11,6 +11,7 @@ while unequal sinkage biases touchdown late (documented limitation; a torque-bas
 
 from __future__ import annotations
 
+import itertools
 from dataclasses import dataclass
 
 import numpy as np
@@ -77,7 +78,7 @@ def segment_stance(t: np.ndarray, heights: np.ndarray, cfg: SegmentationCfg | No
     cfg = cfg or SegmentationCfg()
     rel = relative_heights(heights)
     dt = float(np.median(np.diff(t))) if len(t) > 1 else 1.0
-    min_len = max(1, int(round(cfg.min_phase_s / dt)))
+    min_len = max(1, round(cfg.min_phase_s / dt))
     cols = [_debounce(_hysteresis(rel[:, k], cfg.touchdown_height, cfg.liftoff_height), min_len) for k in range(2)]
     return np.stack(cols, axis=1)
 
@@ -93,7 +94,7 @@ def phase_windows(mask: np.ndarray, value: bool = True, complete_only: bool = Tr
     m = np.asarray(mask) == value
     edges = np.flatnonzero(np.diff(m.astype(np.int8))) + 1
     bounds = np.concatenate([[0], edges, [len(m)]])
-    out = [(int(a), int(b)) for a, b in zip(bounds[:-1], bounds[1:], strict=True) if m[a]]
+    out = [(int(a), int(b)) for a, b in itertools.pairwise(bounds) if m[a]]
     if complete_only:
         out = [(a, b) for a, b in out if a > 0 and b < len(m)]
     return out
