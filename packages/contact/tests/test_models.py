@@ -197,10 +197,21 @@ def test_monotone_loading_is_unchanged_by_at_rest_modes(device: str) -> None:
     results = []
     for mode in ("none", "unloading"):
         model = make_contact_model(ContactRFT3DCfg(collider=g1_foot_box_cfg("box", 3), at_rest=mode), W, F, device)
-        shallower = (feet[0] + np.array([0, 0, 0.005]),) + feet[1:]
+        shallower = (feet[0] + np.array([0, 0, 0.005]), *feet[1:])
         model.update_state(*foot_arrays(*shallower))  # memory of a shallower pose
         results.append(run(model, feet))
     np.testing.assert_array_equal(results[0], results[1])
+
+
+def level_foot(depth: float, v_z: float) -> tuple[np.ndarray, ...]:
+    """Return a level G1 foot [1, 1, ...] whose sole (z = -0.03539 in the body) is ``depth`` deep [m]."""
+    return (
+        np.array([[[0.0, 0.0, 0.03539 - depth]]]),
+        np.eye(3)[None, None],
+        np.array([[[0.0, 0.0, v_z]]]),
+        np.zeros((1, 1, 3)),
+        np.zeros((1, 1, 3)),
+    )
 
 
 def test_cone_kernels_match_reference(device: str) -> None:
@@ -209,21 +220,13 @@ def test_cone_kernels_match_reference(device: str) -> None:
         model = make_contact_model(cfg_type(unloading_ratio=5.0, unloading_damping=0.0), 1, 1, device)
         r_h = model.radii.numpy()[0]
         p = ConeParams(r_h=float(r_h), mu=0.4, unloading_ratio=5.0)
-        z_sole = -0.03539
-        foot = lambda z, vz: (
-            np.array([[[0, 0, -z_sole - z]]]),
-            np.eye(3)[None, None],  # noqa: E731
-            np.array([[[0.0, 0.0, vz]]]),
-            np.zeros((1, 1, 3)),
-            np.zeros((1, 1, 3)),
-        )
         out = wp.zeros((1, 1), dtype=wp.spatial_vector, device=device)
-        model.compute(*foot_arrays(*foot(0.02, -0.3)), out)  # penetrating at 0.3 m/s
+        model.compute(*foot_arrays(*level_foot(0.02, -0.3)), out)  # penetrating at 0.3 m/s
         f_ref, state = cone_step(0.02, 0.3, np.zeros(2), ConeState(), p)
         n = model.num_points
         np.testing.assert_allclose(out.numpy()[0, 0, 2], n * f_ref[2], rtol=1e-5)
-        model.update_state(*foot_arrays(*foot(0.02, -0.3)))
-        model.compute(*foot_arrays(*foot(0.019, 0.1)), out)  # withdrawing 1 mm: elastic line
+        model.update_state(*foot_arrays(*level_foot(0.02, -0.3)))
+        model.compute(*foot_arrays(*level_foot(0.019, 0.1)), out)  # withdrawing 1 mm: elastic line
         f_ref, _ = cone_step(0.019, -0.1, np.zeros(2), state, p)
         np.testing.assert_allclose(out.numpy()[0, 0, 2], n * f_ref[2], rtol=1e-4)
         assert multi == (n == 25)

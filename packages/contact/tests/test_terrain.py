@@ -31,7 +31,7 @@ def test_tiled_levels() -> None:
 
 
 def test_material_transition() -> None:
-    """basalt -> dry sand -> poppy seed along x, blended linearly across each edge."""
+    """Basalt -> dry sand -> poppy seed along x, blended linearly across each edge."""
     mats = tuple(MATERIAL_PRESETS[k] for k in ("basalt", "dry_sand", "poppy_seed"))
     t = terrain_transition(mats, (0.0, 5.0), blend=1.0)
     m = terrain_material(t, np.array([-3.0, 0.0, 2.0, 9.0]))
