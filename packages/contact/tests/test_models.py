@@ -301,5 +301,7 @@ def test_set_materials_in_place_and_validated(device: str) -> None:
 def test_rigid_model_writes_zero(device: str) -> None:
     """The rigid baseline flags itself and writes zero wrenches."""
     model = make_contact_model(ContactRigidCfg(), W, F, device)
-    assert model.is_rigid
+    assert model.is_rigid and not model.is_stateful
+    assert make_contact_model(ContactConeSingleCfg(at_rest="none"), 1, 1, device).is_stateful
+    assert not make_contact_model(ContactRFT3DCfg(at_rest="none"), 1, 1, device).is_stateful
     np.testing.assert_array_equal(run(model, random_feet(1)), 0.0)

@@ -100,6 +100,13 @@ class ContactModel:
         self.nan_count = wp.zeros(1, dtype=int, device=device)
         self._scratch_count = wp.zeros(1, dtype=int, device=device)
 
+    @property
+    def is_stateful(self) -> bool:
+        """Whether update_state() changes what compute() returns (False: it may be skipped)."""
+        return not self.is_rigid and (self.at_rest_code != 0 or self._always_stateful)
+
+    _always_stateful: bool = False
+
     # -- materials -------------------------------------------------------------------------------------------
 
     def _world_ids(self, env_ids: Any, count: int) -> wp.array:

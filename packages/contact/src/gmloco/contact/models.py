@@ -98,6 +98,7 @@ class ContactConeSingle(ContactModel):
     _eval_points = staticmethod(eval_cone_point_forces)
     _vertical_only = 1
     _multi = False
+    _always_stateful = True  # plastic unloading needs z_max
 
     def __init__(
         self, cfg: ContactConeSingleCfg, num_worlds: int, num_feet: int, device: str, terrain: TerrainCfg | None = None
