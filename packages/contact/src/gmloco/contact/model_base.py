@@ -21,7 +21,7 @@ DEFAULT_MATERIAL = MATERIAL_PRESETS["dry_sand"]
 """Material every world starts with until :meth:`ContactModel.set_materials` is called."""
 
 
-def make_terrain_data(cfg: TerrainCfg, device: str) -> TerrainData:
+def make_terrain_data(cfg: TerrainCfg, device: str) -> Any:  # a TerrainData instance (Warp struct)
     """Upload a :class:`TerrainCfg` into the kernels' :class:`TerrainData` struct."""
     t = TerrainData()
     t.kind = HEIGHT_KINDS[cfg.height]
@@ -147,9 +147,9 @@ class ContactModel:
         for name, values in arrays.items():
             self._scatter(values, ids, getattr(self, name))
         if "rho_c" in arrays or "mu_int" in arrays:
-            ids_np = ids.numpy()
-            rho = arrays.get("rho_c", self.rho_c.numpy()[ids_np])
-            mu = arrays.get("mu_int", self.mu_int.numpy()[ids_np])
+            ids_np = np.asarray(ids.numpy(), dtype=np.int64)
+            rho = arrays["rho_c"] if "rho_c" in arrays else self.rho_c.numpy()[ids_np].astype(np.float64)
+            mu = arrays["mu_int"] if "mu_int" in arrays else self.mu_int.numpy()[ids_np].astype(np.float64)
             self._scatter(eta(rho, mu), ids, self.eta)
             self._scatter(eta(rho, mu, "log"), ids, self.eta_log)
 

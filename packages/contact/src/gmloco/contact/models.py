@@ -4,6 +4,7 @@
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
 from typing import Any
 
 import numpy as np
@@ -154,7 +155,7 @@ class ContactRigid(ContactModel):
         """Do nothing: the rigid model is stateless."""
 
 
-_MODELS: list[tuple[type, type[ContactModel]]] = [
+_MODELS: list[tuple[type, Callable[..., ContactModel]]] = [
     (ContactRFT3DCfg, ContactRFT3D),
     (ContactHeuristicRFTCfg, ContactHeuristicRFT),
     (ContactConeMultiCfg, ContactConeMulti),  # before its parent class ContactConeSingleCfg

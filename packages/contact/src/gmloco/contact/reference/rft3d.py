@@ -135,6 +135,8 @@ def rft3d_alpha(
     g_n = np.sum(generic * n, -1, keepdims=True) * n
     g_t = generic - g_n
     if sign_fix:
+        if velocities is None:
+            raise ValueError("sign_fix needs velocities")
         g_n = -np.abs(np.sum(generic * n, -1, keepdims=True)) * n
         along = np.sum(g_t * unit_velocity(velocities), -1, keepdims=True) > 0.0
         g_t = np.where(along, -g_t, g_t)
