@@ -1,0 +1,230 @@
+# SPDX-License-Identifier: Apache-2.0
+"""Attribution: screen every effect, fit the best, select with autocorrelation-aware statistics, decide.
+
+1. Screening (all effects): finite-difference sensitivities ``S_h = d y_sim / d theta_h`` at zero, a score
+   (LM) test ``r' S (S'S)^-1 S' r`` as the energy a linearised fit removes, turned into a linearised
+   Delta-BIC with the effective sample size (``shared/reference/mismatch-discovery.md`` section 3.2 step 6).
+   Effects whose tolerance-sized change moves the residual less than one effective noise unit are
+   *untestable* on this recording and reported with the excitation they need.
+2. Confirmation (top-k): bounded Levenberg-Marquardt in the simulator on training segments; Delta-BIC with
+   n_eff; held-out energy reduction with a block-bootstrap p-value; Gauss-Newton 95% intervals inflated by
+   ``n / n_eff`` (autocorrelated residuals).
+3. Decision: ``explained`` when the best effect passes all thresholds and removes at least ``explain_min`` of
+   the held-out excess energy; ``unexplained`` when the nominal residual exceeds the floor but no effect
+   explains it; ``no_mismatch`` otherwise. No effect id is special-cased.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+
+from gmloco.deploy.mismatch.effects import EFFECTS, EffectSpec
+from gmloco.deploy.mismatch.problem import Problem, effective_samples
+
+__all__ = ["AttributionCfg", "Hypothesis", "confirm", "decide", "screen"]
+
+
+@dataclass
+class AttributionCfg:
+    """Thresholds and budgets of the attribution."""
+
+    top_k: int = 3
+    """Effects confirmed by a nonlinear fit."""
+    max_iter: int = 4
+    """Levenberg-Marquardt iterations per fit."""
+    bic_min: float = 10.0
+    """Delta-BIC (with n_eff) an effect needs (Kass-Raftery 'very strong')."""
+    heldout_min: float = 0.03
+    """Held-out relative energy reduction an effect needs [-]."""
+    p_max: float = 0.01
+    """Block-bootstrap p-value an effect must beat."""
+    explain_min: float = 0.5
+    """Share of the held-out excess energy the winner must remove for ``explained`` [-]."""
+    mismatch_ratio: float = 1.5
+    """Nominal residual energy per element (floor = 1) above which a mismatch exists [-]."""
+    n_boot: int = 400
+    """Bootstrap resamples."""
+    seed: int = 0
+    """Bootstrap seed."""
+    effects: tuple[str, ...] | None = None
+    """Effect ids to screen (all by default); a subset keeps tests and quick looks fast."""
+    testable_energy: float = 9.0
+    """A tolerance-sized change must move the normalised residual energy by this much to be testable."""
+
+
+@dataclass
+class Hypothesis:
+    """Screening and (if confirmed) fit results of one effect."""
+
+    spec: EffectSpec
+    """The effect."""
+    sens: np.ndarray
+    """Sensitivities on all segments, shape [S, P, 93, k]."""
+    testable: bool
+    """Whether a tolerance-sized change is visible above the noise."""
+    dbic_lin: float = -np.inf
+    """Linearised Delta-BIC from screening."""
+    theta_lin: np.ndarray | None = None
+    """Linearised estimate, clipped to bounds."""
+    theta: np.ndarray | None = None
+    """Confirmed estimate."""
+    ci: np.ndarray | None = None
+    """95% intervals, shape [k, 2]."""
+    dbic: float = -np.inf
+    """Delta-BIC of the confirmed fit (training segments)."""
+    heldout_gain: float = 0.0
+    """Relative held-out energy reduction [-]."""
+    p_boot: float = 1.0
+    """Block-bootstrap p-value of the held-out reduction."""
+    corr_max: float = 0.0
+    """Largest absolute parameter correlation (identifiability)."""
+    e_held: float = np.nan
+    """Held-out residual energy with the fit."""
+    passed: bool = False
+    """Whether all detection thresholds are met."""
+
+
+def _sim_params(spec: EffectSpec, theta: np.ndarray) -> dict[str, np.ndarray]:
+    """Parameter dict with one effect set."""
+    return {spec.id: np.asarray(theta, float)}
+
+
+def screen(
+    pb: Problem, r0: np.ndarray, y0: np.ndarray, n_eff: float, cfg: AttributionCfg, progress: Any = None
+) -> list[Hypothesis]:
+    """Screen every effect with finite-difference sensitivities at zero (one replay per component)."""
+    out = []
+    w = pb.weight / pb.sigma
+    for spec in EFFECTS:
+        if cfg.effects is not None and spec.id not in cfg.effects:
+            continue
+        steps = spec.flat("fd_step")
+        cols = []
+        for i, h in enumerate(steps):
+            th = np.zeros(spec.size)
+            lo, hi = spec.bounds()
+            h = h if hi[i] >= h else -h
+            th[i] = h
+            cols.append((pb.simulate(_sim_params(spec, th)) - y0) / h * w)
+            if progress:
+                progress()
+        sens = np.stack(cols, axis=-1)
+        tol_energy = np.max(np.sum((sens[pb.train] * spec.flat("tolerance")) ** 2, axis=(0, 1, 2)))
+        hyp = Hypothesis(spec, sens, testable=bool(tol_energy >= cfg.testable_energy))
+        S = sens[pb.train].reshape(-1, spec.size)
+        rt = r0[pb.train].ravel()
+        theta, *_ = np.linalg.lstsq(S, rt, rcond=None)
+        lo, hi = spec.bounds()
+        theta = np.clip(theta, lo, hi)
+        rss1 = float(np.sum((rt - S @ theta) ** 2))
+        rss0 = float(rt @ rt)
+        hyp.theta_lin = theta
+        hyp.dbic_lin = n_eff * np.log(rss0 / max(rss1, 1e-300)) - spec.size * np.log(n_eff)
+        out.append(hyp)
+    return out
+
+
+def _lm(pb: Problem, hyp: Hypothesis, cfg: AttributionCfg) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Bounded Levenberg-Marquardt on training segments; returns (theta, residual, jacobian)."""
+    spec, m = hyp.spec, pb.train
+    lo, hi = spec.bounds()
+    steps = spec.flat("fd_step")
+    theta = hyp.theta_lin.copy()
+    r = pb.resid(_sim_params(spec, theta), m).ravel()
+    lam = 1e-3
+    J = None
+    for _ in range(cfg.max_iter):
+        J = np.empty((r.size, spec.size))
+        for i in range(spec.size):
+            th = theta.copy()
+            h = steps[i] * 0.5 if theta[i] + steps[i] * 0.5 <= hi[i] else -steps[i] * 0.5
+            th[i] += h
+            J[:, i] = (pb.resid(_sim_params(spec, th), m).ravel() - r) / h
+        g, A = J.T @ r, J.T @ J
+        improved = False
+        for _ in range(3):
+            step = np.linalg.solve(A + lam * np.diag(np.diag(A) + 1e-12), -g)
+            cand = np.clip(theta + step, lo, hi)
+            rc = pb.resid(_sim_params(spec, cand), m).ravel()
+            if rc @ rc < r @ r:
+                theta, r, lam, improved = cand, rc, lam * 0.3, True
+                break
+            lam *= 10
+        if not improved or np.all(np.abs(step) < 0.05 * steps):
+            break
+    return theta, r, J
+
+
+def _boot_p(d: np.ndarray, blocks: np.ndarray, n_boot: int, rng: np.random.Generator) -> float:
+    """One-sided block-bootstrap p-value that the mean per-segment improvement ``d`` is <= 0."""
+    ub = np.unique(blocks)
+    sums = np.array([d[blocks == b].sum() for b in ub])
+    cnts = np.array([np.sum(blocks == b) for b in ub])
+    idx = rng.integers(0, len(ub), size=(n_boot, len(ub)))
+    means = sums[idx].sum(1) / cnts[idx].sum(1)
+    return float((np.sum(means <= 0) + 1) / (n_boot + 1))
+
+
+def confirm(
+    pb: Problem, hyps: list[Hypothesis], r0: np.ndarray, cfg: AttributionCfg, progress: Any = None
+) -> list[Hypothesis]:
+    """Fit the top-k testable effects and score them on held-out segments; returns them ranked."""
+    rng = np.random.default_rng(cfg.seed)
+    cand = sorted([h for h in hyps if h.testable], key=lambda h: -h.dbic_lin)[: cfg.top_k]
+    e0_seg = np.sum(r0[pb.held] ** 2, axis=(1, 2))
+    for hyp in cand:
+        theta, r, J = _lm(pb, hyp, cfg)
+        n, k = r.size, hyp.spec.size
+        rss0, rss1 = float(np.sum(r0[pb.train] ** 2)), float(r @ r)
+        n_eff = effective_samples(r.reshape(r0[pb.train].shape))
+        hyp.theta, hyp.dbic = theta, n_eff * np.log(rss0 / max(rss1, 1e-300)) - k * np.log(n_eff)
+        cov = rss1 / max(n - k, 1) * np.linalg.pinv(J.T @ J) * (n / n_eff)
+        sd = np.sqrt(np.clip(np.diag(cov), 0, None))
+        hyp.ci = np.stack([theta - 1.96 * sd, theta + 1.96 * sd], axis=1)
+        if k > 1:
+            c = cov / np.outer(sd + 1e-300, sd + 1e-300)
+            hyp.corr_max = float(np.max(np.abs(c - np.eye(k))))
+        rh = pb.resid(_sim_params(hyp.spec, theta), pb.held)
+        eh_seg = np.sum(rh**2, axis=(1, 2))
+        hyp.e_held = float(eh_seg.sum())
+        hyp.heldout_gain = float(1.0 - eh_seg.sum() / max(e0_seg.sum(), 1e-300))
+        hyp.p_boot = _boot_p(e0_seg - eh_seg, pb.block[pb.held], cfg.n_boot, rng)
+        ci_excl = np.any((hyp.ci[:, 0] > 0) | (hyp.ci[:, 1] < 0))
+        big = np.any(np.abs(theta) >= hyp.spec.flat("tolerance"))
+        hyp.passed = bool(
+            hyp.dbic >= cfg.bic_min
+            and hyp.heldout_gain >= cfg.heldout_min
+            and hyp.p_boot < cfg.p_max
+            and ci_excl
+            and big
+        )
+        if progress:
+            progress()
+    return sorted(cand, key=lambda h: (not h.passed, -h.heldout_gain))
+
+
+def decide(pb: Problem, r0: np.ndarray, ranked: list[Hypothesis], cfg: AttributionCfg) -> dict:
+    """Return the verdict and the evidence it rests on."""
+    held = r0[pb.held]
+    active = float(np.mean(pb.weight > 0))
+    ratio = float(np.mean(held**2) / max(active, 1e-9))
+    e0 = float(np.sum(held**2))
+    floor_e = held.size * active
+    best = ranked[0] if ranked and ranked[0].passed else None
+    excess = max(e0 - floor_e, 1e-9)
+    explained = 0.0 if best is None else float((e0 - best.e_held) / excess)
+    if best is not None and (explained >= cfg.explain_min or ratio < cfg.mismatch_ratio):
+        verdict = "explained"
+    elif ratio >= cfg.mismatch_ratio:
+        verdict = "unexplained"
+    else:
+        verdict = "no_mismatch"
+    return {
+        "verdict": verdict,
+        "winner": best.spec.id if best is not None and verdict == "explained" else None,
+        "nominal_energy_ratio": ratio,
+        "explained_fraction": min(explained, 1.0),
+    }

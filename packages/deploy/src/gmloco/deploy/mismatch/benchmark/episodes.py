@@ -1,0 +1,51 @@
+# SPDX-License-Identifier: Apache-2.0
+"""Benchmark episode list: each library effect at three strengths, nulls, and out-of-library effects."""
+
+from __future__ import annotations
+
+from gmloco.deploy.mismatch.benchmark.truth import TruthEffect
+
+__all__ = ["MID", "STRENGTHS", "episode_list"]
+
+_OFF = [0.0] * 12
+_OFF[3], _OFF[6], _OFF[4] = 0.03, -0.03, 0.02  # left knee, right hip pitch, left ankle pitch [rad]
+
+MID: dict[str, dict[str, list[float]]] = {
+    "actuator.delay": {"delay": [0.008]},
+    "actuator.gain_scale": {"kp_scale": [-0.2]},
+    "joint.coulomb_friction": {"tau_c": [1.5]},
+    "joint.viscous_damping": {"b": [1.0]},
+    "joint.armature": {"scale": [1.5]},
+    "sensor.encoder_offset": {"offset": _OFF},
+    "imu.gyro_bias": {"bias": [0.03, -0.02, 0.015]},
+    "imu.misalignment": {"angle": [0.03, -0.04]},
+    "body.mass_error": {"delta_mass": [4.0]},
+    "terrain.stiffness_scale": {"zeta": [2.0]},
+    "terrain.cohesion": {"cohesion": [6000.0]},
+    "actuator.torque_speed": {"droop": [0.05]},
+}
+"""Mid-strength truth parameters per effect (tool units)."""
+
+STRENGTHS: dict[str, float] = {"low": 0.4, "mid": 1.0, "high": 2.0}
+"""Multipliers of the mid strength."""
+
+OOL: dict[str, dict[str, list[float]]] = {"ool.shank_length": {"dl": [0.03]}, "ool.current_lag": {"tau_lag": [0.01]}}
+"""Out-of-library effects (the right answer is ``unexplained``)."""
+
+
+def episode_list(seeds: int = 2, nulls: int = 8, strengths: tuple[str, ...] = ("mid",)) -> list[dict]:
+    """Return episode dicts ``{name, effect, params, strength, seed}``."""
+    eps = []
+    for s in strengths:
+        for eid, p in MID.items():
+            for seed in range(seeds):
+                scaled = {k: [v * STRENGTHS[s] for v in vals] for k, vals in p.items()}
+                eps.append(
+                    {"name": f"{eid}-{s}-{seed}", "effect": eid, "params": scaled, "strength": s, "seed": 100 + seed}
+                )
+    for seed in range(nulls):
+        eps.append({"name": f"none-{seed}", "effect": "none", "params": {}, "strength": "none", "seed": 200 + seed})
+    for eid, p in OOL.items():
+        for seed in range(max(1, seeds)):
+            eps.append({"name": f"{eid}-{seed}", "effect": eid, "params": p, "strength": "mid", "seed": 300 + seed})
+    return eps

@@ -1,0 +1,226 @@
+# SPDX-License-Identifier: Apache-2.0
+"""Data-contract checks: joint map, units, time base, gaps. Failures are reported as such, never as physics."""
+
+from __future__ import annotations
+
+import xml.etree.ElementTree as ET
+from dataclasses import asdict, dataclass, field
+from functools import lru_cache
+from typing import Literal
+
+import numpy as np
+
+from gmloco.deploy.mismatch.recording import Recording
+
+__all__ = ["ContractCfg", "ContractError", "ContractIssue", "JointMapError", "check_recording", "joint_ranges"]
+
+
+@dataclass
+class ContractIssue:
+    """One finding of a contract check."""
+
+    check: str
+    """Check name (``joint_map``, ``units``, ``time_base``, ``gaps``, ``channels``, ``length``)."""
+    severity: Literal["error", "warning"]
+    """Errors stop the analysis; warnings are reported."""
+    message: str
+    """What is wrong and how to fix it."""
+    detail: dict = field(default_factory=dict)
+    """Machine-readable evidence."""
+
+    def to_dict(self) -> dict:
+        """JSON-ready form."""
+        return asdict(self)
+
+
+class ContractError(ValueError):
+    """The recording breaks the data contract; :attr:`issues` says how."""
+
+    def __init__(self, issues: list[ContractIssue]) -> None:
+        """Keep the issues and format them."""
+        self.issues = issues
+        super().__init__("; ".join(f"[{i.check}] {i.message}" for i in issues if i.severity == "error"))
+
+
+class JointMapError(ContractError):
+    """Joint columns do not belong to the joints they are labelled with."""
+
+
+@dataclass
+class ContractCfg:
+    """Thresholds of the contract checks."""
+
+    range_slack: float = 0.15
+    """Allowed excursion beyond the MJCF joint range [rad]."""
+    map_ratio: float = 0.5
+    """A command column matches another state column this much better (median distance ratio) -> map error."""
+    map_min_error: float = 0.08
+    """Median |q_cmd - q| above which a joint's pairing is questioned [rad]."""
+    jitter_max: float = 0.2
+    """Largest tolerated std(dt) / median(dt) [-]."""
+    min_duration: float = 2.0
+    """Shorter recordings cannot be analysed [s]."""
+
+
+@lru_cache(maxsize=1)
+def joint_ranges() -> dict[str, tuple[float, float]]:
+    """Joint ranges [rad] read from mjlab's G1 MJCF (plain XML parsing, no mujoco import)."""
+    from gmloco.deploy.mismatch.g1model import g1_mjcf_path
+
+    root = ET.parse(g1_mjcf_path()).getroot()
+    out = {}
+    for j in root.iter("joint"):
+        if j.get("range") and j.get("name"):
+            lo, hi = (float(x) for x in j.get("range").split())
+            out[j.get("name")] = (lo, hi)
+    return out
+
+
+def _joint_map(rec: Recording, cfg: ContractCfg) -> list[ContractIssue]:
+    """Ranges and command/state pairing per joint."""
+    issues = []
+    ranges = joint_ranges()
+    out_of_range = []
+    for i, n in enumerate(rec.joint_names):
+        lo, hi = ranges.get(n, (-np.inf, np.inf))
+        frac = float(np.mean((rec.q[:, i] < lo - cfg.range_slack) | (rec.q[:, i] > hi + cfg.range_slack)))
+        if frac > 0.05:
+            out_of_range.append((n, round(frac, 3)))
+    dist = np.median(np.abs(rec.q_cmd[:, :, None] - rec.q[:, None, :]), axis=0)  # [cmd joint, state joint]
+    corr = _xcorr(rec.q_cmd, rec.q)
+    swaps = []
+    for j, n in enumerate(rec.joint_names):
+        k = int(np.argmin(dist[j]))
+        c = int(np.nanargmax(corr[j])) if np.any(np.isfinite(corr[j])) else j
+        by_dist = k != j and dist[j, j] > cfg.map_min_error and dist[j, k] < cfg.map_ratio * dist[j, j]
+        by_corr = c != j and corr[j, c] > 0.8 and not corr[j, j] > 0.5
+        if by_dist or by_corr:
+            m = k if by_dist else c
+            swaps.append(
+                {
+                    "command": n,
+                    "state_column_matching": rec.joint_names[m],
+                    "median_err_rad": round(float(dist[j, j]), 3),
+                }
+            )
+    if swaps or out_of_range:
+        msg = "joint columns do not match their labels: "
+        if swaps:
+            msg += (
+                "commands track other state columns "
+                + ", ".join(f"{s['command']}->{s['state_column_matching']}" for s in swaps)
+                + ". "
+            )
+        if out_of_range:
+            msg += f"positions outside the MJCF range: {out_of_range}. "
+        msg += "Fix the joint order (Unitree motor index order, see gmloco.deploy.logs.g1.G1_JOINT_NAMES)."
+        issues.append(ContractIssue("joint_map", "error", msg, {"swaps": swaps, "out_of_range": out_of_range}))
+    return issues
+
+
+def _xcorr(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """Correlation matrix between the columns of ``a`` and ``b`` (NaN for constant columns), shape [29, 29]."""
+    az = a - a.mean(0)
+    bz = b - b.mean(0)
+    sa, sb = az.std(0), bz.std(0)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        c = (az.T @ bz) / len(a) / np.outer(sa, sb)
+    c[sa < 1e-3, :] = np.nan
+    return c
+
+
+def _units(rec: Recording) -> list[ContractIssue]:
+    """Degrees for radians, g for m/s^2, quaternion order and norm."""
+    issues = []
+    if np.nanmax(np.abs(rec.q)) > 2 * np.pi:
+        issues.append(ContractIssue("units", "error", "joint positions exceed 2*pi: degrees logged as radians?"))
+    acc = float(np.nanmedian(np.linalg.norm(rec.imu_acc, axis=1)))
+    if not 6.0 < acc < 14.0:
+        issues.append(
+            ContractIssue(
+                "units",
+                "error",
+                f"median |accelerometer| = {acc:.2f}, expected ~9.81 m/s^2 (g units?)",
+                {"acc_norm": acc},
+            )
+        )
+    qn = np.linalg.norm(rec.imu_quat, axis=1)
+    if np.nanmax(np.abs(qn - 1.0)) > 0.05:
+        issues.append(ContractIssue("units", "error", "IMU quaternion is not unit norm"))
+    elif np.nanmedian(np.abs(rec.imu_quat[:, 0])) < 0.5 < np.nanmedian(np.abs(rec.imu_quat[:, 3])):
+        issues.append(ContractIssue("units", "error", "IMU quaternion looks (x, y, z, w); the schema is (w, x, y, z)"))
+    if np.nanmedian(np.abs(rec.imu_gyro)) > 5.0:
+        issues.append(ContractIssue("units", "error", "gyro magnitudes look like deg/s; the schema is rad/s"))
+    return issues
+
+
+def _time_base(rec: Recording, cfg: ContractCfg) -> list[ContractIssue]:
+    """Monotonic uniform time base, gaps, duration."""
+    issues = []
+    d = np.diff(rec.t)
+    if rec.n < 3 or np.any(d <= 0):
+        return [ContractIssue("time_base", "error", "timestamps are not strictly increasing")]
+    jitter = float(np.std(d) / np.median(d))
+    if jitter > cfg.jitter_max:
+        issues.append(
+            ContractIssue("time_base", "error", f"non-uniform sampling (std/median dt = {jitter:.2f}); resample first")
+        )
+    gaps = float(np.mean(~rec.valid_mask()))
+    if gaps > 0:
+        issues.append(
+            ContractIssue(
+                "gaps",
+                "warning",
+                f"{100 * gaps:.2f}% of samples are gap-filled; segments across gaps are skipped",
+                {"fraction": gaps},
+            )
+        )
+    dur = float(rec.t[-1] - rec.t[0])
+    if dur < cfg.min_duration:
+        issues.append(
+            ContractIssue(
+                "length",
+                "error",
+                f"recording lasts {dur:.2f} s < {cfg.min_duration} s: too short to test any effect",
+                {"duration_s": dur},
+            )
+        )
+    return issues
+
+
+def _channels(rec: Recording) -> list[ContractIssue]:
+    """Non-finite values and constant channels."""
+    issues = []
+    for name in ("q", "dq", "tau_est", "q_cmd", "kp", "kd", "imu_quat", "imu_gyro", "imu_acc"):
+        a = getattr(rec, name)
+        if not np.all(np.isfinite(a)):
+            issues.append(ContractIssue("channels", "error", f"{name} has non-finite values (missing channel?)"))
+    if np.all(rec.kp == 0):
+        issues.append(
+            ContractIssue("channels", "error", "all kp are zero: LowCmd missing or torque-only control (not supported)")
+        )
+    if np.allclose(rec.tau_est, 0):
+        issues.append(
+            ContractIssue(
+                "channels", "warning", "tau_est is all zero: torque channels excluded", {"tau_est": "missing"}
+            )
+        )
+    return issues
+
+
+def check_recording(rec: Recording, cfg: ContractCfg | None = None, raise_on_error: bool = True) -> list[ContractIssue]:
+    """Run every contract check.
+
+    Raises:
+        JointMapError: If the joint map check fails (reported before any physics).
+        ContractError: On any other error-severity issue.
+    """
+    cfg = cfg or ContractCfg()
+    issues = _channels(rec)
+    if not any(i.severity == "error" for i in issues):
+        issues += _time_base(rec, cfg) + _units(rec) + _joint_map(rec, cfg)
+    errors = [i for i in issues if i.severity == "error"]
+    if raise_on_error and errors:
+        cls = JointMapError if any(i.check == "joint_map" for i in errors) else ContractError
+        raise cls(issues)
+    return issues
