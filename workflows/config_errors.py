@@ -31,8 +31,9 @@ class ConfigInputError(ValueError):
 
 
 def groups(conf_dir: Path = CONF_DIR) -> list[str]:
-    """User-selectable config groups (folders of ``conf/``, except ``hydra``)."""
-    return sorted(p.name for p in conf_dir.iterdir() if p.is_dir() and p.name != "hydra")
+    """User-selectable config groups: folders under ``conf/`` holding YAML (``a/b`` when nested), not ``hydra``."""
+    found = {p.parent.relative_to(conf_dir).as_posix() for p in conf_dir.rglob("*.yaml") if p.parent != conf_dir}
+    return sorted(g for g in found if g.split("/")[0] not in ("hydra", "local"))
 
 
 def group_options(group: str, conf_dir: Path = CONF_DIR) -> list[str]:

@@ -17,7 +17,7 @@ from collections.abc import Callable, Sequence
 import hydra
 from hydra import compose, initialize_config_dir
 from hydra._internal.utils import get_args_parser
-from omegaconf import DictConfig, OmegaConf
+from omegaconf import DictConfig, OmegaConf, open_dict
 from omegaconf.errors import OmegaConfBaseException
 from rich.markup import escape
 
@@ -76,7 +76,7 @@ def _check_appended(overrides: Sequence[str]) -> None:
         if not o.startswith("+") or o.startswith("++") or "=" not in o:
             continue
         key = o[1:].split("=", 1)[0].split("@", 1)[0]
-        if key.split("/")[0] not in groups():
+        if key not in groups():
             raise unknown_key_error(key, o)
 
 
@@ -97,8 +97,14 @@ def check_config(cfg: DictConfig, overrides: Sequence[str] = ()) -> None:
             OmegaConf.to_container(value, resolve=True)
 
 
-def compose_checked(config_name: str, overrides: Sequence[str]) -> DictConfig:
-    """Compose like Hydra would and check the result; raise :class:`ConfigInputError` on bad input."""
+def compose_checked(config_name: str, overrides: Sequence[str], keep_hydra: bool = False) -> DictConfig:
+    """Compose like Hydra would and check the result; raise :class:`ConfigInputError` on bad input.
+
+    Args:
+        config_name: primary config in ``conf/``.
+        overrides: command-line overrides.
+        keep_hydra: keep the ``hydra`` node (``@hydra.main`` tasks never see it).
+    """
     try:
         with initialize_config_dir(config_dir=str(CONF_DIR), version_base="1.3"):
             cfg = compose(config_name, overrides=list(overrides), return_hydra_config=True)
@@ -109,6 +115,9 @@ def compose_checked(config_name: str, overrides: Sequence[str]) -> DictConfig:
         if _full_error():
             raise
         raise explain(e, overrides) from e
+    if not keep_hydra:
+        with open_dict(cfg):
+            del cfg["hydra"]
     return cfg
 
 
@@ -145,8 +154,16 @@ def _smoke_needed(overrides: Sequence[str], multirun: bool, config_name: str) ->
     if multirun:  # sweep syntax cannot be composed once; decide from the text
         chosen = any(o.lstrip("+").startswith(("scale=", "debug=")) for o in overrides)
         return not chosen and not _cuda_available()
-    cfg = compose_checked(config_name, overrides)
+    cfg = compose_checked(config_name, overrides, keep_hydra=True)
     return "scale" not in cfg.hydra.runtime.choices and not _cuda_available()
+
+
+def _multirun() -> bool:
+    """Whether Hydra runs this task as one job of a multirun sweep."""
+    from hydra.core.hydra_config import HydraConfig
+    from hydra.types import RunMode
+
+    return HydraConfig.initialized() and HydraConfig.get().mode == RunMode.MULTIRUN
 
 
 def _guarded(task: Callable[[DictConfig], int]) -> Callable[[DictConfig], None]:
@@ -161,7 +178,7 @@ def _guarded(task: Callable[[DictConfig], int]) -> Callable[[DictConfig], None]:
                 raise
             _fail(ConfigInputError(getattr(e, "key", ""), str(e).splitlines()[0]))
             return
-        if code:
+        if code and not _multirun():  # in a sweep, one job's status must not stop the others
             sys.exit(code)
 
     return wrapper

@@ -55,7 +55,7 @@ class StageRecord:
     outputs: dict[str, int] = field(default_factory=dict)
     """Files under ``out_dir`` (relative path -> size in bytes) when the stage finished."""
     out_dir: str = ""
-    """Absolute output folder of the stage."""
+    """Output folder of the stage when the record was written (informative; checks use the current one)."""
     metrics: dict[str, Any] = field(default_factory=dict)
     """What ``run(cfg)`` returned."""
     started_at: str = ""
@@ -65,9 +65,9 @@ class StageRecord:
     invocation: int = 0
     """Index into ``Manifest.invocations`` of the attempt that produced this record."""
 
-    def outputs_intact(self) -> bool:
-        """Check that every recorded output still exists with its recorded size."""
-        current = list_outputs(self.out_dir)
+    def outputs_intact(self, out_dir: str) -> bool:
+        """Check that every recorded output exists under ``out_dir`` with its recorded size."""
+        current = list_outputs(out_dir)
         return all(current.get(rel) == size for rel, size in self.outputs.items())
 
     def to_dict(self) -> dict[str, Any]:
@@ -117,7 +117,10 @@ class Manifest:
             },
         )
 
-    def is_satisfied(self, stage: str, config_hash: str) -> bool:
-        """Whether ``stage`` finished earlier for ``config_hash`` and its outputs are intact."""
+    def is_satisfied(self, stage: str, config_hash: str, out_dir: str) -> bool:
+        """Whether ``stage`` finished earlier for ``config_hash`` and its outputs are intact in ``out_dir``.
+
+        ``out_dir`` is the stage's current folder, so a run directory that was moved or copied still resumes.
+        """
         rec = self.stages.get(stage)
-        return bool(rec and rec.status.satisfied and rec.config_hash == config_hash and rec.outputs_intact())
+        return bool(rec and rec.status.satisfied and rec.config_hash == config_hash and rec.outputs_intact(out_dir))

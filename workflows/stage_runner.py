@@ -148,7 +148,7 @@ class StageRunner:
         name, h = spec.name, self.hashes[spec.name]
         if name not in self.cfg.stages:
             return StageOutcome(name, StageStatus.DISABLED, "not in 'stages'", spec.issues)
-        if name not in self.forced and self.manifest.is_satisfied(name, h):
+        if name not in self.forced and self._satisfied(name):
             rec = self.manifest.stages[name]
             msg = f"done earlier for config {h}"
             return StageOutcome(name, StageStatus.SKIPPED, msg, spec.issues, 0.0, rec.metrics, len(rec.outputs))
@@ -165,7 +165,7 @@ class StageRunner:
         if getattr(fn, "gmloco_not_implemented", None):
             msg = f"not implemented yet ({issue_text(spec.issues)})"
             return self._record(spec, h, StageStatus.NOT_IMPLEMENTED, msg, 0.0, {})
-        missing = [u for u in spec.needs if not self.manifest.is_satisfied(u, self.hashes[u])]
+        missing = [u for u in spec.needs if not self._satisfied(u)]
         if missing:
             why = ", ".join(f"{u} ({self._status_of(u)})" for u in missing)
             return self._record(spec, h, StageStatus.BLOCKED, f"needs {why}", 0.0, {})
@@ -173,6 +173,10 @@ class StageRunner:
         if remaining is not None and remaining <= 0:
             return self._record(spec, h, StageStatus.DEFERRED, "pipeline time box used up; rerun to continue", 0, {})
         return self._execute(spec, h, fn, remaining)
+
+    def _satisfied(self, name: str) -> bool:
+        """Whether ``name`` is done for its current hash with intact outputs in its current folder."""
+        return self.manifest.is_satisfied(name, self.hashes[name], str(self.cfg[name].out_dir))
 
     def _status_of(self, name: str) -> str:
         """Latest recorded status of ``name`` (or 'never run')."""
