@@ -26,6 +26,7 @@ import tempfile
 import time
 from dataclasses import asdict
 from pathlib import Path
+from typing import Any
 
 
 def _parse() -> argparse.Namespace:
@@ -50,7 +51,7 @@ def _sync() -> None:
         torch.cuda.synchronize()
 
 
-def bench_sim(env, steps: int) -> dict[str, float]:
+def bench_sim(env: Any, steps: int) -> dict[str, float]:
     """Time bare physics substeps of an already built env [physics steps/s summed over worlds]."""
     for _ in range(20):
         env.sim.step()
@@ -63,9 +64,7 @@ def bench_sim(env, steps: int) -> dict[str, float]:
     return {"sim_physics_steps_per_s": steps * env.num_envs / dt, "sim_s_per_substep": dt / steps}
 
 
-def bench_ppo(
-    task: str, num_envs: int, iterations: int, warmup: int, sim_steps: int, device: str
-) -> dict[str, float]:
+def bench_ppo(task: str, num_envs: int, iterations: int, warmup: int, sim_steps: int, device: str) -> dict[str, float]:
     """Build the task's env and runner as mjlab's train script does, then time PPO iterations."""
     from mjlab.envs import ManagerBasedRlEnv
     from mjlab.rl import MjlabOnPolicyRunner, RslRlVecEnvWrapper
@@ -88,11 +87,11 @@ def bench_ppo(
     rewards: list[float] = []
     original_log = runner.logger.log
 
-    def _log(*args, **kwargs):  # record rsl-rl's own collection/learning timers
+    def _log(*args: Any, **kwargs: Any) -> None:  # record rsl-rl's own collection/learning timers
         times.append((kwargs["collect_time"], kwargs["learn_time"]))
         if len(runner.logger.rewbuffer) > 0:
             rewards.append(statistics.mean(runner.logger.rewbuffer))
-        return original_log(*args, **kwargs)
+        original_log(*args, **kwargs)
 
     runner.logger.log = _log
     t0 = time.perf_counter()
