@@ -1,0 +1,184 @@
+# SPDX-License-Identifier: Apache-2.0
+"""The passive-callback coupling against MuJoCo C (oracle) and against Newton's second law.
+
+A constant-wrench source stands in for a contact model (it is a test double for the coupling, not a
+granular model): whatever wrench it writes must reach the feet exactly as ``xfrc_applied`` does in MuJoCo C.
+"""
+
+from __future__ import annotations
+
+import importlib.util
+from pathlib import Path
+
+import mujoco
+import numpy as np
+import pytest
+import torch
+import warp as wp
+
+from gmloco.train.contact_coupling import ContactCoupling
+
+FEET = ("left_ankle_roll_link", "right_ankle_roll_link")
+DT = 0.005
+"""Physics step [s]."""
+
+
+@wp.kernel
+def _constant_wrench(wrench_in: wp.array[wp.spatial_vector], wrench_out: wp.array2d[wp.spatial_vector]) -> None:
+    """wrench_out[w, f] = wrench_in[f]."""
+    world, foot = wp.tid()
+    wrench_out[world, foot] = wrench_in[foot]
+
+
+class ConstantWrench:
+    """Test double of a contact model: a fixed (force, torque about CoM) per foot; counts state updates."""
+
+    def __init__(self, wrenches: np.ndarray) -> None:
+        self.wrench = wp.array(wrenches.astype(np.float32), dtype=wp.spatial_vector, device="cpu")
+        self.updates = 0
+
+    def compute(self, pos: wp.array, mat: wp.array, lin: wp.array, ang: wp.array, com: wp.array, out: wp.array) -> None:
+        """Write the fixed wrenches."""
+        wp.launch(_constant_wrench, dim=out.shape, inputs=[self.wrench], outputs=[out], device=out.device)
+
+    def update_state(self, *inputs: wp.array) -> None:
+        """Count substeps."""
+        self.updates += 1
+
+
+def _g1_model(gravity: float) -> mujoco.MjModel:
+    """mjlab's G1 MJCF (free-floating, no floor), rigid contact off."""
+    origin = importlib.util.find_spec("mjlab").origin  # type: ignore[union-attr]
+    xml = Path(origin).parent / "asset_zoo" / "robots" / "unitree_g1" / "xmls" / "g1.xml"  # type: ignore[arg-type]
+    model = mujoco.MjModel.from_xml_path(str(xml))
+    model.opt.gravity[:] = (0.0, 0.0, -gravity)
+    model.opt.disableflags |= mujoco.mjtDisableBit.mjDSBL_CONTACT
+    return model
+
+
+def _simulation(model: mujoco.MjModel, num_envs: int, device: str) -> object:
+    """An mjlab ``Simulation`` of the bare G1 (MujocoCfg keeps the model's gravity and flags)."""
+    from mjlab.sim import MujocoCfg, SimulationCfg
+    from mjlab.sim.sim import Simulation
+
+    g = tuple(float(x) for x in model.opt.gravity)
+    cfg = SimulationCfg(mujoco=MujocoCfg(timestep=DT, gravity=g, disableflags=("contact",)))  # type: ignore[arg-type]
+    return Simulation(num_envs=num_envs, cfg=cfg, model=model, device=device)
+
+
+def _random_state(model: mujoco.MjModel, seed: int) -> tuple[np.ndarray, np.ndarray]:
+    """A random but valid (qpos, qvel): pelvis 1 m up, unit quaternion, joints within +-0.3 rad."""
+    rng = np.random.default_rng(seed)
+    qpos = model.qpos0.copy()
+    qpos[:3] = (0.1, -0.2, 1.0)
+    quat = rng.normal(size=4)
+    qpos[3:7] = quat / np.linalg.norm(quat)
+    qpos[7:] += rng.uniform(-0.3, 0.3, model.nq - 7)
+    return qpos, rng.uniform(-1.0, 1.0, model.nv)
+
+
+@pytest.fixture(scope="module")
+def g1() -> mujoco.MjModel:
+    """The G1 with gravity."""
+    return _g1_model(9.81)
+
+
+def test_gather_matches_mujoco_c(g1: mujoco.MjModel, device: str) -> None:
+    """Gathered foot pose, origin velocity and CoM equal MuJoCo C's ``xpos``/``xmat``/``xipos`` and
+    ``mj_objectVelocity(mjOBJ_XBODY)`` (velocity of the body frame origin, world axes) to float32 precision.
+    """
+    qpos, qvel = _random_state(g1, 0)
+    sim = _simulation(g1, 1, device)
+    feet = [g1.body(n).id for n in FEET]
+    coupling = ContactCoupling(ConstantWrench(np.zeros((2, 6))), sim, feet)
+    coupling.install()
+    sim.data.qpos[0] = torch.tensor(qpos, dtype=torch.float32)
+    sim.data.qvel[0] = torch.tensor(qvel, dtype=torch.float32)
+    sim.forward()
+    data = mujoco.MjData(g1)
+    data.qpos[:], data.qvel[:] = qpos, qvel
+    mujoco.mj_forward(g1, data)
+    vel = np.zeros((2, 6))
+    for i, b in enumerate(feet):
+        mujoco.mj_objectVelocity(g1, data, mujoco.mjtObj.mjOBJ_XBODY, b, vel[i], 0)  # (ang, lin)
+    np.testing.assert_allclose(coupling.foot_pos_w.numpy()[0], data.xpos[feet], atol=2e-5)
+    np.testing.assert_allclose(coupling.foot_mat_w.numpy()[0], data.xmat[feet].reshape(2, 3, 3), atol=2e-5)
+    np.testing.assert_allclose(coupling.foot_com_w.numpy()[0], data.xipos[feet], atol=2e-5)
+    np.testing.assert_allclose(coupling.foot_ang_vel_w.numpy()[0], vel[:, :3], atol=1e-4)
+    np.testing.assert_allclose(coupling.foot_lin_vel_w.numpy()[0], vel[:, 3:], atol=1e-4)
+
+
+def test_wrench_response_matches_mujoco_c(g1: mujoco.MjModel, device: str) -> None:
+    """The change of qacc caused by the foot wrenches equals MuJoCo C with the same ``xfrc_applied``.
+
+    Wrenches: left (30, -20, 150) N with torque (2, -1, 3) N m about its CoM, right (-10, 40, 90) N with
+    (-4, 0.5, 1) N m. Tolerance: 1e-3 of the largest response (float32 vs float64 dynamics).
+    """
+    wrenches = np.array([[30.0, -20.0, 150.0, 2.0, -1.0, 3.0], [-10.0, 40.0, 90.0, -4.0, 0.5, 1.0]])
+    qpos, qvel = _random_state(g1, 1)
+    feet = [g1.body(n).id for n in FEET]
+    responses = []
+    for wrench in (np.zeros_like(wrenches), wrenches):
+        sim = _simulation(g1, 1, device)
+        ContactCoupling(ConstantWrench(wrench), sim, feet).install()
+        sim.data.qpos[0] = torch.tensor(qpos, dtype=torch.float32)
+        sim.data.qvel[0] = torch.tensor(qvel, dtype=torch.float32)
+        sim.forward()
+        responses.append(sim.data.qacc[0].cpu().numpy().astype(np.float64))
+    warp_delta = responses[1] - responses[0]
+    data = mujoco.MjData(g1)
+    data.qpos[:], data.qvel[:] = qpos, qvel
+    mujoco.mj_forward(g1, data)
+    base = data.qacc.copy()
+    data.xfrc_applied[feet] = wrenches
+    mujoco.mj_forward(g1, data)
+    c_delta = data.qacc - base
+    assert np.abs(c_delta).max() > 1.0  # the wrench matters
+    np.testing.assert_allclose(warp_delta, c_delta, atol=1e-3 * np.abs(c_delta).max())
+
+
+def _linear_momentum(sim: object, model: mujoco.MjModel) -> np.ndarray:
+    """Total linear momentum sum_i m_i v_i [kg m/s] per world, v_i the velocity of body i's CoM."""
+    cvel = sim.data.cvel.cpu().numpy().astype(np.float64)  # (ang, lin) at the root subtree CoM
+    xipos = sim.data.xipos.cpu().numpy().astype(np.float64)
+    com = sim.data.subtree_com.cpu().numpy().astype(np.float64)[:, model.body_rootid]
+    v = cvel[..., 3:] + np.cross(cvel[..., :3], xipos - com)
+    return np.einsum("b,wbk->wk", model.body_mass, v)
+
+
+def _c_momentum(model: mujoco.MjModel, data: mujoco.MjData) -> np.ndarray:
+    """MuJoCo C linear momentum of the whole robot [kg m/s]."""
+    mujoco.mj_forward(model, data)
+    mujoco.mj_subtreeVel(model, data)
+    root = model.body("pelvis").id
+    return data.subtree_linvel[root] * model.body_subtreemass[root]
+
+
+def test_foot_wrenches_push_the_robot_as_in_mujoco_c(device: str) -> None:
+    """Zero gravity, no contact, 40 substeps with constant foot wrenches (forces 50 N up plus small side
+    forces, torques about the feet CoMs): the trajectory equals MuJoCo C stepping with the same
+    ``xfrc_applied``, and the robot's linear momentum is the impulse n dt (F_L + F_R) = (1.0, -0.6, 20) kg m/s.
+
+    Newton's law holds only to O(dt) in MuJoCo's discrete dynamics (MuJoCo C itself is off by 0.10 kg m/s
+    in z after 40 steps), hence 1 % on the impulse; the oracle comparison is at float32 precision.
+    The model's state update runs once per substep, never in forward().
+    """
+    model = _g1_model(0.0)
+    sim = _simulation(model, 2, device)  # applies mjlab's MujocoCfg (integrator, timestep) to ``model``
+    feet = [model.body(n).id for n in FEET]
+    wrenches = np.array([[5.0, 0.0, 50.0, 0.0, 1.0, 0.0], [0.0, -3.0, 50.0, 0.5, 0.0, 0.0]])
+    source = ConstantWrench(wrenches)
+    ContactCoupling(source, sim, feet).install()
+    data = mujoco.MjData(model)
+    n = 40
+    for _ in range(n):
+        sim.step()
+        data.xfrc_applied[feet] = wrenches
+        mujoco.mj_step(model, data)
+    sim.forward()
+    np.testing.assert_allclose(sim.data.qpos.cpu().numpy(), np.broadcast_to(data.qpos, (2, model.nq)), atol=1e-4)
+    momentum = _linear_momentum(sim, model)
+    np.testing.assert_allclose(momentum, np.broadcast_to(_c_momentum(model, data), (2, 3)), atol=2e-3)
+    impulse = n * DT * wrenches[:, :3].sum(axis=0)
+    np.testing.assert_allclose(momentum, np.broadcast_to(impulse, (2, 3)), atol=0.01 * np.linalg.norm(impulse))
+    assert source.updates == n

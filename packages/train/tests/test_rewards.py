@@ -1,0 +1,75 @@
+# SPDX-License-Identifier: Apache-2.0
+"""Reward and curriculum arithmetic on hand-computed cases (no simulator)."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import torch
+
+from gmloco.train.mdp.curriculums import _level_moves
+from gmloco.train.mdp.rewards import (
+    _clearance,
+    _exp_kernel,
+    _lateral_gap_penalty,
+    _moving,
+    _single_stance_time,
+    _wrapped_abs_diff,
+)
+
+
+def test_exp_kernel() -> None:
+    """exp(-e / std^2): e = 0.5, std = sqrt(0.5) -> exp(-1) = 0.3679."""
+    np.testing.assert_allclose(_exp_kernel(torch.tensor([0.0, 0.5]), math.sqrt(0.5)), [1.0, math.exp(-1.0)], rtol=1e-6)
+
+
+def test_wrapped_abs_diff_wraps_across_pi() -> None:
+    """|wrap(a_R - a_L)|: (0.1, 0.3) -> 0.2; (3.1, -3.1) -> 2 pi - 6.2 = 0.0832 (not 6.2)."""
+    angles = torch.tensor([[0.1, 0.3], [3.1, -3.1]])
+    np.testing.assert_allclose(_wrapped_abs_diff(angles), [0.2, 2 * math.pi - 6.2], rtol=1e-5)
+
+
+def test_single_stance_time() -> None:
+    """Single stance rewards min(stance time, swing time) up to the threshold; double stance and flight give 0.
+
+    Row 0: left stance 0.3 s, right swing 0.2 s -> 0.2. Row 1: swing 0.8 s vs stance 0.9 s -> clamp 0.5.
+    Row 2: both in contact -> 0. Row 3: both in the air -> 0.
+    """
+    air = torch.tensor([[0.0, 0.2], [0.8, 0.0], [0.0, 0.0], [0.4, 0.3]])
+    contact = torch.tensor([[0.3, 0.0], [0.0, 0.9], [0.5, 0.6], [0.0, 0.0]])
+    np.testing.assert_allclose(_single_stance_time(air, contact, 0.5), [0.2, 0.5, 0.0, 0.0], rtol=1e-6)
+
+
+def test_clearance() -> None:
+    """exp(-sum (h - 0.1)^2 tanh(2 |v|) / 0.05): foot at target -> 1; h = 0, |v| = 1 m/s on one foot:
+    0.01 * tanh(2) / 0.05 = 0.19281 -> exp(-0.19281) = 0.82464; a resting foot (v = 0) costs nothing.
+    """
+    height = torch.tensor([[0.1, 0.0], [0.0, 0.0]])
+    speed = torch.tensor([[1.0, 0.0], [1.0, 0.0]])
+    expected = [1.0, math.exp(-0.01 * math.tanh(2.0) / 0.05)]
+    np.testing.assert_allclose(_clearance(height, speed, 0.1, 0.05, 2.0), expected, rtol=1e-6)
+
+
+def test_lateral_gap_penalty_in_yaw_frame() -> None:
+    """Feet 0.1 m apart laterally -> penalty 0.2 - 0.1 = 0.1; the same feet seen by a base yawed 90 deg
+    (feet apart along world x) are still 0.1 m apart in the base y; 0.3 m apart -> 0.
+    """
+    feet = torch.tensor(
+        [[[0.0, 0.05, 0.0], [0.0, -0.05, 0.0]], [[0.05, 0.0, 0.0], [-0.05, 0.0, 0.0]], [[0, 0.15, 0], [0, -0.15, 0]]]
+    )
+    c, s = math.cos(math.pi / 4), math.sin(math.pi / 4)  # quaternion (w, x, y, z) of a 90 deg yaw
+    quat = torch.tensor([[1.0, 0.0, 0.0, 0.0], [c, 0.0, 0.0, s], [1.0, 0.0, 0.0, 0.0]])
+    np.testing.assert_allclose(_lateral_gap_penalty(feet, quat, 0.2), [0.1, 0.1, 0.0], atol=1e-6)
+
+
+def test_moving_threshold() -> None:
+    """|v_xy| + |w_z| > 0.05 counts as a motion command."""
+    cmd = torch.tensor([[0.0, 0.0, 0.0], [0.03, 0.04, 0.0], [0.0, 0.0, -0.1]])
+    np.testing.assert_array_equal(_moving(cmd, 0.05), [0.0, 0.0, 1.0])
+
+
+def test_level_moves() -> None:
+    """Walked 5 m of 4 needed -> +1; walked 1 m of 10 m commanded -> -1; 3 m of 4 m commanded -> 0."""
+    moves = _level_moves(torch.tensor([5.0, 1.0, 3.0]), torch.tensor([20.0, 10.0, 4.0]), 4.0)
+    np.testing.assert_array_equal(moves, [1, -1, 0])
