@@ -92,7 +92,13 @@ def _joint_map(rec: Recording, cfg: ContractCfg) -> list[ContractIssue]:
     for j, n in enumerate(rec.joint_names):
         k = int(np.argmin(dist[j]))
         c = int(np.nanargmax(corr[j])) if np.any(np.isfinite(corr[j])) else j
+        # Distance alone is fooled by joints with similar set-points under load sag: it needs the
+        # correlation to agree, or a gross error when the command is constant (correlation undefined).
         by_dist = k != j and dist[j, j] > cfg.map_min_error and dist[j, k] < cfg.map_ratio * dist[j, j]
+        if np.isfinite(corr[j, j]) and np.isfinite(corr[j, k]):
+            by_dist = by_dist and corr[j, k] > corr[j, j] + 0.2
+        else:
+            by_dist = by_dist and dist[j, j] > 3 * cfg.map_min_error
         by_corr = c != j and corr[j, c] > 0.8 and not corr[j, j] > 0.5
         if by_dist or by_corr:
             m = k if by_dist else c

@@ -5,7 +5,7 @@ from __future__ import annotations
 
 import numpy as np
 
-__all__ = ["quat_conj", "quat_from_roll_pitch", "quat_mul", "quat_rotate", "quat_to_mat", "quat_tilt"]
+__all__ = ["quat_conj", "quat_from_roll_pitch", "quat_mul", "quat_rotate", "quat_tilt", "quat_to_mat"]
 
 
 def quat_mul(a: np.ndarray, b: np.ndarray) -> np.ndarray:

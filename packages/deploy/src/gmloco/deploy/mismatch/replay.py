@@ -12,7 +12,6 @@ sensor, model edits) or in :mod:`gmloco.deploy.mismatch.terrain`, and all are ex
 from __future__ import annotations
 
 from dataclasses import dataclass, field
-from typing import Any
 
 import numpy as np
 
@@ -227,6 +226,8 @@ class Replayer:
             k = k0 + j
             kp, kd = r.kp[k], r.kd[k]
             for sub in range(cfg.substeps):
+                # Damping enters qfrc_passive in mj_step1 and the implicit Euler update in mj_step2: set it first.
+                m.dof_damping[6:] = h.gain * kd + bj
                 mujoco.mj_step1(m, d)
                 qm = d.qpos[7:] + h.offset
                 v = d.qvel[6:]
@@ -235,7 +236,6 @@ class Replayer:
                 tau = np.clip(tau, -lim, lim)
                 # The -kd*dq part is integrated implicitly through dof_damping (Euler integrator), so add it back.
                 d.qfrc_applied[6:] = tau + h.gain * kd * v
-                m.dof_damping[6:] = h.gain * kd + bj
                 if terrain:
                     self._terrain(h.terrain)
                 mujoco.mj_step2(m, d)

@@ -54,7 +54,7 @@ def segment_phases(foot_height: np.ndarray, dt: float, cfg: SegmentationCfg | No
             stance[k] = s
         lab = np.where(stance, 2, 0)
         edges = np.flatnonzero(np.diff(stance.astype(int)))
-        w_td, w_lo = int(round(cfg.td_window / dt)), int(round(cfg.lo_window / dt))
+        w_td, w_lo = round(cfg.td_window / dt), round(cfg.lo_window / dt)
         for e in edges:
             if stance[e + 1]:
                 seg = slice(e + 1, min(n, e + 1 + w_td))

@@ -3,8 +3,6 @@
 
 from __future__ import annotations
 
-from gmloco.deploy.mismatch.benchmark.truth import TruthEffect
-
 __all__ = ["MID", "STRENGTHS", "episode_list"]
 
 _OFF = [0.0] * 12

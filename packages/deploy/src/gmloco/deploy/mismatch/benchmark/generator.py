@@ -82,7 +82,7 @@ def generate(cfg: EpisodeCfg) -> tuple[Recording, dict]:
     kp, kd = default_gains()
     _initial_state(model, data, ctrl.q0)
     feet = [model.body(f"{s}_ankle_roll_link").id for s in ("left", "right")]
-    n = int(round(cfg.duration * cfg.rate_hz))
+    n = round(cfg.duration * cfg.rate_hz)
     out = {
         k: np.zeros((n, w))
         for k, w in (

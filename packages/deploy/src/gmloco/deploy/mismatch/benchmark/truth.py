@@ -77,7 +77,7 @@ class TruthActuator:
     def __init__(self, e: TruthEffect, effort: np.ndarray, dt: float, rng: np.random.Generator, nuisance: bool) -> None:
         """Set up the delay FIFO and per-joint errors."""
         self.dt = dt
-        steps = int(round(float(_p(e, "actuator.delay", "delay")[0]) / dt))
+        steps = round(float(_p(e, "actuator.delay", "delay")[0]) / dt)
         self.fifo: deque = deque(maxlen=steps + 1)
         self.gain = (1.0 + float(_p(e, "actuator.gain_scale", "kp_scale")[0])) * (
             1.0 + (rng.uniform(-0.03, 0.03, 29) if nuisance else 0.0)
