@@ -67,7 +67,7 @@ class BoxStudyCfg:
 
 
 def box_study_smoke_cfg(out_dir: str, **overrides: Any) -> BoxStudyCfg:
-    """Return a CPU smoke configuration: 1 trial, a 0.6 x 0.5 x 0.15 m bed at 6 cm voxels, 0.2 s (impact included)."""
+    """Return a CPU smoke configuration: 1 trial, a 0.6 x 0.5 x 0.2 m bed at 5 cm voxels, 0.2 s (impact included)."""
     box = BoxCfg(duration=0.2)
     cfg = BoxStudyCfg(
         out_dir=out_dir,
@@ -75,8 +75,8 @@ def box_study_smoke_cfg(out_dir: str, **overrides: Any) -> BoxStudyCfg:
         variants=("forward",),
         box=box,
         rom=RomBoxCfg(box=box, collider_resolution=3),
-        bed=SandBedCfg(size_x=0.6, size_y=0.5, depth=0.15, center_x=0.1),
-        mpm=MpmSolverCfg(voxel_size=0.06, max_iterations=20),
+        bed=SandBedCfg(size_x=0.6, size_y=0.5, depth=0.2, center_x=0.1),
+        mpm=MpmSolverCfg(voxel_size=0.05, max_iterations=30),
         device="cpu",
         make_figure=False,
     )

@@ -88,7 +88,7 @@ def emit_sand_bed(
 
 
 def add_bed_container(builder: Any, bed: SandBedCfg, friction: float, thickness: float = 0.05) -> None:
-    """Add a static floor at z = -depth and (optionally) four walls around the bed to a Newton builder."""
+    """Add a static ground plane at z = -depth and (optionally) four walls around the bed to a Newton builder."""
     import newton
     import warp as wp
 
@@ -98,7 +98,9 @@ def add_bed_container(builder: Any, bed: SandBedCfg, friction: float, thickness:
     hx, hy, t = 0.5 * (hi[0] - lo[0]), 0.5 * (hi[1] - lo[1]), thickness
     wall_hz = 0.5 * bed.depth + 0.3
     wall_cz = -bed.depth + wall_hz
-    boxes = [((cx, cy, lo[2] - t), (hx + 2 * t, hy + 2 * t, t))]
+    # floor: a ground plane (as Newton's MPM examples); thin box floors let a shallow coarse bed leak through
+    builder.add_ground_plane(height=float(lo[2]), cfg=cfg)
+    boxes = []
     if bed.walls:
         boxes += [
             ((lo[0] - t, cy, wall_cz), (t, hy + 2 * t, wall_hz)),

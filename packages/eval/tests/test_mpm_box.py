@@ -1,0 +1,63 @@
+# SPDX-License-Identifier: Apache-2.0
+"""MPM box scene on CPU: force balance of a box resting in a small sand bed."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from gmloco.contact import MATERIAL_PRESETS
+from gmloco.eval.box import BoxCfg
+from gmloco.eval.mpm.bed import SandBedCfg
+from gmloco.eval.mpm.box_scene import MpmBoxScene, MpmBoxSceneCfg, MpmSolverCfg
+from gmloco.eval.mpm.materials import mpm_material
+
+GRAVITY = 9.81
+
+
+def test_material_mapping() -> None:
+    """rho_c -> particle density, mu_int -> Drucker-Prager friction, mu_surf -> collider friction; cohesionless."""
+    mat = MATERIAL_PRESETS["dry_sand"]  # bulk 2500 x packing 0.6 -> rho_c 1500
+    m = mpm_material(mat)
+    np.testing.assert_allclose([m.density, m.friction, m.collider_friction], [1500.0, 0.6, 0.4])
+    assert m.yield_stress == 0.0 and m.tensile_yield_ratio == 0.0 and m.critical_fraction == 0.0
+
+
+@pytest.fixture(scope="module")
+def resting_box() -> MpmBoxScene:
+    """A 35 kg box placed on a 0.6 x 0.6 x 0.2 m bed (5 cm voxels, ~4.6k particles), 40 frames."""
+    box = BoxCfg(velocity=(0.0, 0.0), drop_height=0.0, duration=0.4)
+    cfg = MpmBoxSceneCfg(
+        box=box,
+        bed=SandBedCfg(size_x=0.6, size_y=0.6, depth=0.2, center_x=0.0),
+        solver=MpmSolverCfg(voxel_size=0.05),
+        device="cpu",
+    )
+    scene = MpmBoxScene(cfg, MATERIAL_PRESETS["dry_sand"])
+    scene.run()
+    return scene
+
+
+def test_resting_box_force_balance(resting_box: MpmBoxScene) -> None:
+    """Frame-averaged sand force on a resting box equals m g within the momentum-derived bound.
+
+    The force logged in frame k acts on the box during frame k + 1 (lagged coupling), so over frames a..b
+    sum_k (F_k - m g) dt = m (v_b - v_a): |mean F_z - m g| <= m |v_b - v_a| / ((b - a) dt). The box must also be
+    at rest (|v| small) for this to be a force *balance*.
+    """
+    s, m = resting_box, resting_box.cfg.box.mass
+    dt = s.frame_dt
+    a, b = 15, len(s.sand_force) - 1  # skip the settling transient
+    f = np.array(s.sand_force)[a:b]
+    vz = np.array(s.body_qd)[:, 2]
+    bound = m * abs(vz[b] - vz[a]) / ((b - a) * dt) + 1e-3 * m * GRAVITY  # + float32 round-off of sums
+    assert abs(f[:, 2].mean() - m * GRAVITY) <= bound
+    assert bound < 0.15 * m * GRAVITY, "box is not at rest: the balance would be vacuous"
+    assert np.all(np.abs(np.mean(f[:, :2], axis=0)) < 0.05 * m * GRAVITY)  # no net horizontal force at rest
+
+
+def test_resting_box_sinkage_is_small_and_positive(resting_box: MpmBoxScene) -> None:
+    """The box sinks into the bed by less than one voxel and stays well above the floor."""
+    resting_box.test_final()
+    z_bottom = resting_box.body_q[-1][2] - 0.5 * resting_box.cfg.box.size[2]
+    assert -resting_box.cfg.solver.voxel_size < z_bottom < 0.01
