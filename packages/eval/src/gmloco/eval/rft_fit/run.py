@@ -140,9 +140,12 @@ def run(cfg: RftFitCfg) -> dict[str, Any]:
     (out / "config.json").write_text(json.dumps(asdict(cfg), indent=1, default=str))
     material = MATERIAL_PRESETS[cfg.material]
     complete = _sweep(cfg, material, material.xi, out / "plate_runs.jsonl", t_start)
-    runs = [r for r in _done_runs(out / "plate_runs.jsonl") if r["samples"] > 0 and np.all(np.isfinite(r["G"]))]
-    summary: dict[str, Any] = {"complete": complete, "runs_used": len(runs), "material": asdict(material),
-                               "xi_n": material.xi}  # fmt: skip
+    all_runs = _done_runs(out / "plate_runs.jsonl")
+    # a run whose plate felt no force at all is a failed coupling, not data (README, "Known issue")
+    runs = [r for r in all_runs if r["samples"] > 0 and np.all(np.isfinite(r["G"])) and np.any(np.abs(r["G"]) > 0)]
+    summary: dict[str, Any] = {"complete": complete, "runs_done": len(all_runs), "runs_used": len(runs),
+                               "runs_zero_force": sum(1 for r in all_runs if not np.any(np.abs(r["G"]) > 0)),
+                               "material": asdict(material), "xi_n": material.xi}  # fmt: skip
     if runs:
         nrm = np.array([r["leading_normal"] for r in runs])
         vel = np.array([r["velocity_dir"] for r in runs])
