@@ -47,7 +47,7 @@ class ConstantWrench:
 
 
 def _g1_model(gravity: float) -> mujoco.MjModel:
-    """mjlab's G1 MJCF (free-floating, no floor), rigid contact off."""
+    """Return mjlab's G1 MJCF (free-floating, no floor) with rigid contact off."""
     origin = importlib.util.find_spec("mjlab").origin  # type: ignore[union-attr]
     xml = Path(origin).parent / "asset_zoo" / "robots" / "unitree_g1" / "xmls" / "g1.xml"  # type: ignore[arg-type]
     model = mujoco.MjModel.from_xml_path(str(xml))
@@ -84,8 +84,10 @@ def g1() -> mujoco.MjModel:
 
 
 def test_gather_matches_mujoco_c(g1: mujoco.MjModel, device: str) -> None:
-    """Gathered foot pose, origin velocity and CoM equal MuJoCo C's ``xpos``/``xmat``/``xipos`` and
-    ``mj_objectVelocity(mjOBJ_XBODY)`` (velocity of the body frame origin, world axes) to float32 precision.
+    """Gathered foot pose, origin velocity and CoM equal MuJoCo C's to float32 precision.
+
+    References: ``xpos``/``xmat``/``xipos`` and ``mj_objectVelocity(mjOBJ_XBODY)`` (velocity of the body frame
+    origin, world axes).
     """
     qpos, qvel = _random_state(g1, 0)
     sim = _simulation(g1, 1, device)
@@ -155,9 +157,11 @@ def _c_momentum(model: mujoco.MjModel, data: mujoco.MjData) -> np.ndarray:
 
 
 def test_foot_wrenches_push_the_robot_as_in_mujoco_c(device: str) -> None:
-    """Zero gravity, no contact, 40 substeps with constant foot wrenches (forces 50 N up plus small side
-    forces, torques about the feet CoMs): the trajectory equals MuJoCo C stepping with the same
-    ``xfrc_applied``, and the robot's linear momentum is the impulse n dt (F_L + F_R) = (1.0, -0.6, 20) kg m/s.
+    """Constant foot wrenches move the robot as in MuJoCo C and change its momentum by their impulse.
+
+    Zero gravity, no contact, 40 substeps with forces 50 N up plus small side forces and torques about the
+    feet CoMs: the trajectory equals MuJoCo C stepping with the same ``xfrc_applied``, and the robot's
+    linear momentum is the impulse n dt (F_L + F_R) = (1.0, -0.6, 20) kg m/s.
 
     Newton's law holds only to O(dt) in MuJoCo's discrete dynamics (MuJoCo C itself is off by 0.10 kg m/s
     in z after 40 steps), hence 1 % on the impulse; the oracle comparison is at float32 precision.

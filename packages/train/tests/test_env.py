@@ -45,8 +45,9 @@ def test_env_builds_and_steps(make_env, contact_model: str) -> None:  # noqa: AN
 
 
 def test_standing_robot_sinks_as_rft_predicts(make_env) -> None:  # noqa: ANN001
-    """A PD-held G1 (zero actions, no DR, no floor under the feet) on 3D-RFT dry sand carries its weight
-    on the granular force and sinks to the static RFT depth.
+    """A PD-held G1 on 3D-RFT dry sand carries its weight on the granular force and sinks to the static depth.
+
+    Zero actions, no DR, no floor under the feet.
 
     Static prediction (spec 5.3): each flat sole carries W/2 = G_z xi A d, G_z = 0.8757 (spec 5.1 case A),
     xi = rho_c g f(mu_int) of dry sand, A = 0.206 x 0.0736 m^2 -> d ~ 7.8 mm for the 33 kg G1. The model's

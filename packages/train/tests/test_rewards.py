@@ -42,8 +42,10 @@ def test_single_stance_time() -> None:
 
 
 def test_clearance() -> None:
-    """exp(-sum (h - 0.1)^2 tanh(2 |v|) / 0.05): foot at target -> 1; h = 0, |v| = 1 m/s on one foot:
-    0.01 * tanh(2) / 0.05 = 0.19281 -> exp(-0.19281) = 0.82464; a resting foot (v = 0) costs nothing.
+    """Clearance reward exp(-sum (h - 0.1)^2 tanh(2 |v|) / 0.05) on two hand-computed rows.
+
+    Foot at target -> 1; h = 0, |v| = 1 m/s on one foot: 0.01 * tanh(2) / 0.05 = 0.19281 -> exp(-0.19281)
+    = 0.82464; a resting foot (v = 0) costs nothing.
     """
     height = torch.tensor([[0.1, 0.0], [0.0, 0.0]])
     speed = torch.tensor([[1.0, 0.0], [1.0, 0.0]])
@@ -52,8 +54,10 @@ def test_clearance() -> None:
 
 
 def test_lateral_gap_penalty_in_yaw_frame() -> None:
-    """Feet 0.1 m apart laterally -> penalty 0.2 - 0.1 = 0.1; the same feet seen by a base yawed 90 deg
-    (feet apart along world x) are still 0.1 m apart in the base y; 0.3 m apart -> 0.
+    """Lateral foot gap penalty, measured in the base yaw frame.
+
+    Feet 0.1 m apart laterally -> penalty 0.2 - 0.1 = 0.1; the same feet seen by a base yawed 90 deg (feet
+    apart along world x) are still 0.1 m apart in the base y; 0.3 m apart -> 0.
     """
     feet = torch.tensor(
         [[[0.0, 0.05, 0.0], [0.0, -0.05, 0.0]], [[0.05, 0.0, 0.0], [-0.05, 0.0, 0.0]], [[0, 0.15, 0], [0, -0.15, 0]]]
