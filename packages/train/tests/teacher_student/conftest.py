@@ -73,9 +73,7 @@ class ToyTerrainEnv(VecEnv):
 @pytest.fixture
 def dims() -> SimpleNamespace:
     """Sizes of the toy problem (test modules cannot import conftest under importlib mode)."""
-    return SimpleNamespace(
-        num_envs=NUM_ENVS, num_actions=NUM_ACTIONS, obs_dim=OBS_DIM, history=HISTORY, latent=LATENT
-    )
+    return SimpleNamespace(num_envs=NUM_ENVS, num_actions=NUM_ACTIONS, obs_dim=OBS_DIM, history=HISTORY, latent=LATENT)
 
 
 @pytest.fixture

@@ -3,23 +3,48 @@
 
 from __future__ import annotations
 
+from collections.abc import Callable
+from types import SimpleNamespace
+
 import numpy as np
 import pytest
 import torch
+from rsl_rl.env import VecEnv
 
-from gmloco.train.teacher_student import LinearRamp, StudentActor, StudentPPO, TeacherPPO
+from gmloco.train.teacher_student import (
+    DistillCfg,
+    LinearRamp,
+    ObsGroupsCfg,
+    StudentActor,
+    StudentCfg,
+    StudentPPO,
+    TeacherCfg,
+    TeacherPPO,
+)
 
 
 @pytest.fixture
-def teacher_ckpt(toy_env, teacher_cfg, groups, runner_cfg) -> dict:
+def teacher_ckpt(
+    toy_env: VecEnv, teacher_cfg: TeacherCfg, groups: ObsGroupsCfg, runner_cfg: Callable[[dict], dict]
+) -> dict:
     """A randomly initialised TeacherPPO checkpoint dict (``actor_state_dict``, ``critic_state_dict``, ...)."""
     torch.manual_seed(1)
-    alg = TeacherPPO.construct_algorithm(toy_env.get_observations(), toy_env, runner_cfg(teacher_cfg.to_rsl_rl(groups)), "cpu")
+    alg = TeacherPPO.construct_algorithm(
+        toy_env.get_observations(), toy_env, runner_cfg(teacher_cfg.to_rsl_rl(groups)), "cpu"
+    )
     return alg.save()
 
 
 @pytest.fixture
-def student_alg(toy_env, teacher_cfg, student_cfg, distill_cfg, groups, runner_cfg, teacher_ckpt) -> StudentPPO:
+def student_alg(
+    toy_env: VecEnv,
+    teacher_cfg: TeacherCfg,
+    student_cfg: StudentCfg,
+    distill_cfg: DistillCfg,
+    groups: ObsGroupsCfg,
+    runner_cfg: Callable[[dict], dict],
+    teacher_ckpt: dict,
+) -> StudentPPO:
     """StudentPPO built by its construct_algorithm from the typed cfgs, with the teacher loaded."""
     torch.manual_seed(0)
     cfg = runner_cfg(distill_cfg.to_rsl_rl(teacher_cfg, student_cfg, groups))
@@ -28,7 +53,7 @@ def student_alg(toy_env, teacher_cfg, student_cfg, distill_cfg, groups, runner_c
     return alg
 
 
-def _rollout(alg: StudentPPO, env, steps: int) -> torch.Tensor:
+def _rollout(alg: StudentPPO, env: VecEnv, steps: int) -> torch.Tensor:
     """Collect ``steps`` transitions; return the actions the env received, ``[steps, num_envs, A]``."""
     obs, sent = env.get_observations(), []
     with torch.inference_mode():
@@ -46,7 +71,7 @@ def _snapshot(alg: StudentPPO) -> dict:
     return {k: (v.clone() if torch.is_tensor(v) else v) for k, v in vars(alg.storage).items()}
 
 
-def test_student_actor_shapes_and_jit_export(student_alg, toy_env, dims) -> None:
+def test_student_actor_shapes_and_jit_export(student_alg: StudentPPO, toy_env: VecEnv, dims: SimpleNamespace) -> None:
     """The student maps obs to [B, A], caches z_hat [B, Z], and its TorchScript export keeps the encoder."""
     actor, obs = student_alg.actor.eval(), toy_env.get_observations()
     assert isinstance(actor, StudentActor)
@@ -59,7 +84,7 @@ def test_student_actor_shapes_and_jit_export(student_alg, toy_env, dims) -> None
     )
 
 
-def test_loading_the_teacher_initialises_the_student(student_alg, teacher_ckpt) -> None:
+def test_loading_the_teacher_initialises_the_student(student_alg: StudentPPO, teacher_ckpt: dict) -> None:
     """Teacher weights load; psi, the actor MLP, the o_t normalizer and the critic are copied into the student."""
     assert student_alg.teacher_loaded
     for key, value in teacher_ckpt["actor_state_dict"].items():
@@ -71,7 +96,7 @@ def test_loading_the_teacher_initialises_the_student(student_alg, teacher_ckpt) 
         assert torch.equal(student_alg.critic.state_dict()[key], value)
 
 
-def test_teacher_stays_frozen_during_distillation(student_alg, toy_env) -> None:
+def test_teacher_stays_frozen_during_distillation(student_alg: StudentPPO, toy_env: VecEnv) -> None:
     """After rollouts and updates the teacher is bit-identical, has requires_grad False and stays in eval mode."""
     before = {k: v.clone() for k, v in student_alg.teacher.state_dict().items()}
     decoder_before = {k: v.clone() for k, v in student_alg.actor.decoder.state_dict().items()}
@@ -88,13 +113,13 @@ def test_teacher_stays_frozen_during_distillation(student_alg, toy_env) -> None:
     assert not optimized & {id(p) for p in student_alg.teacher.parameters()}
 
 
-def test_dagger_the_env_receives_student_actions(student_alg, toy_env) -> None:
+def test_dagger_the_env_receives_student_actions(student_alg: StudentPPO, toy_env: VecEnv) -> None:
     """DAgger: the stored (and executed) actions are the student's samples, not the teacher's labels."""
     sent = _rollout(student_alg, toy_env, steps=2)
     np.testing.assert_array_equal(student_alg.storage.actions[:2].numpy(), sent.numpy())
 
 
-def test_distillation_steps_reduce_action_and_latent_losses(student_alg, toy_env) -> None:
+def test_distillation_steps_reduce_action_and_latent_losses(student_alg: StudentPPO, toy_env: VecEnv) -> None:
     """A few DAgger updates on one fixed batch lower ||a - a_hat||^2 and ||z - z_hat||^2."""
     student_alg.train_mode()
     _rollout(student_alg, toy_env, steps=4)
@@ -115,7 +140,13 @@ def _snapshot_copy(batch: dict) -> dict:
 
 
 def test_student_checkpoint_round_trip_keeps_curriculum_and_teacher(
-    student_alg, toy_env, teacher_cfg, student_cfg, distill_cfg, groups, runner_cfg
+    student_alg: StudentPPO,
+    toy_env: VecEnv,
+    teacher_cfg: TeacherCfg,
+    student_cfg: StudentCfg,
+    distill_cfg: DistillCfg,
+    groups: ObsGroupsCfg,
+    runner_cfg: Callable[[dict], dict],
 ) -> None:
     """save() then load() into a fresh StudentPPO restores student, teacher and the curriculum position."""
     student_alg.train_mode()
@@ -139,7 +170,7 @@ def test_linear_ramp_curriculum() -> None:
     assert step(5) == 1.0 and step(6) == 0.1
 
 
-def test_student_ppo_weight_follows_the_curriculum(student_alg) -> None:
+def test_student_ppo_weight_follows_the_curriculum(student_alg: StudentPPO) -> None:
     """w_PPO and w_dist are read at the current update count."""
     student_alg.w_ppo = LinearRamp(0.0, 1.0, 0, 4)
     student_alg.num_updates = 2

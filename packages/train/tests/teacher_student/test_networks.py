@@ -74,7 +74,7 @@ def test_tcn_refuses_a_too_short_history() -> None:
 
 
 def test_history_term_major_layout_is_rearranged_time_major() -> None:
-    """mjlab's flattened term-major history [A_t0..A_tN-1, B_t0..] becomes [B, N, dA + dB]."""
+    """Rearrange mjlab's flattened term-major history [A_t0..A_tN-1, B_t0..] becomes [B, N, dA + dB]."""
     n, d_a, d_b = 3, 2, 1
     frames = torch.arange(n * (d_a + d_b), dtype=torch.float32).reshape(1, n, d_a + d_b)  # ground truth
     flat = torch.cat([frames[:, :, :d_a].reshape(1, -1), frames[:, :, d_a:].reshape(1, -1)], dim=-1)

@@ -4,6 +4,7 @@
 from __future__ import annotations
 
 from collections.abc import Callable
+from types import SimpleNamespace
 
 import numpy as np
 import pytest
@@ -13,7 +14,6 @@ from rsl_rl.models import MLPModel
 
 from gmloco.train.teacher_student import ObsGroupsCfg, TeacherActor, TeacherCfg, TeacherPPO
 from gmloco.train.teacher_student.teacher_ppo import eta_target
-
 
 
 def _build(env: VecEnv, cfg: TeacherCfg, groups: ObsGroupsCfg, complete: Callable[[dict], dict]) -> TeacherPPO:
@@ -31,7 +31,13 @@ def _rollout(alg: TeacherPPO, env: VecEnv, steps: int) -> None:
         alg.compute_returns(obs)
 
 
-def test_teacher_actor_shapes_and_latent_cache(toy_env, teacher_cfg, groups, runner_cfg, dims) -> None:
+def test_teacher_actor_shapes_and_latent_cache(
+    toy_env: VecEnv,
+    teacher_cfg: TeacherCfg,
+    groups: ObsGroupsCfg,
+    runner_cfg: Callable[[dict], dict],
+    dims: SimpleNamespace,
+) -> None:
     """The actor maps the obs to [B, A]; the encoder sees critic + flattened history; mu/logvar are cached."""
     alg = _build(toy_env, teacher_cfg, groups, runner_cfg)
     actor, obs = alg.actor, toy_env.get_observations()
@@ -44,7 +50,9 @@ def test_teacher_actor_shapes_and_latent_cache(toy_env, teacher_cfg, groups, run
     np.testing.assert_array_equal(eta_target(obs, "critic", -1).numpy(), toy_env.eta.numpy())
 
 
-def test_teacher_export_wrappers_keep_the_encoder(toy_env, teacher_cfg, groups, runner_cfg) -> None:
+def test_teacher_export_wrappers_keep_the_encoder(
+    toy_env: VecEnv, teacher_cfg: TeacherCfg, groups: ObsGroupsCfg, runner_cfg: Callable[[dict], dict]
+) -> None:
     """as_jit / as_onnx take (obs, encoder_obs) and reproduce the deterministic actor exactly."""
     alg = _build(toy_env, teacher_cfg, groups, runner_cfg)
     actor, obs = alg.actor.eval(), toy_env.get_observations()
@@ -54,10 +62,14 @@ def test_teacher_export_wrappers_keep_the_encoder(toy_env, teacher_cfg, groups, 
     got = onnx_like(obs["actor"], actor.encoder_input(obs))
     np.testing.assert_allclose(got.detach().numpy(), expected.numpy(), atol=1e-6)
     scripted = torch.jit.script(actor.as_jit())
-    np.testing.assert_allclose(scripted(obs["actor"], actor.encoder_input(obs)).detach().numpy(), expected.numpy(), atol=1e-6)
+    np.testing.assert_allclose(
+        scripted(obs["actor"], actor.encoder_input(obs)).detach().numpy(), expected.numpy(), atol=1e-6
+    )
 
 
-def test_teacher_ppo_update_trains_encoder_decoder_and_logs_vae_terms(toy_env, teacher_cfg, groups, runner_cfg) -> None:
+def test_teacher_ppo_update_trains_encoder_decoder_and_logs_vae_terms(
+    toy_env: VecEnv, teacher_cfg: TeacherCfg, groups: ObsGroupsCfg, runner_cfg: Callable[[dict], dict]
+) -> None:
     """One PPO update on a filled storage runs, logs the VAE terms, and moves encoder and decoder."""
     torch.manual_seed(0)
     alg = _build(toy_env, teacher_cfg, groups, runner_cfg)
@@ -72,7 +84,9 @@ def test_teacher_ppo_update_trains_encoder_decoder_and_logs_vae_terms(toy_env, t
     assert any(not torch.equal(a, b) for a, b in zip(dec0, alg.actor.decoder.parameters(), strict=True))
 
 
-def test_teacher_vae_loss_decreases_on_a_fixed_batch(toy_env, teacher_cfg, groups, runner_cfg) -> None:
+def test_teacher_vae_loss_decreases_on_a_fixed_batch(
+    toy_env: VecEnv, teacher_cfg: TeacherCfg, groups: ObsGroupsCfg, runner_cfg: Callable[[dict], dict]
+) -> None:
     """Twenty PPO + VAE updates on one stored rollout drive the eta error below the best constant guess.
 
     eta ~ U[0, 1], so predicting its mean scores Var(eta) = 1/12 ~ 0.083; beating it means z carries eta.
@@ -93,9 +107,15 @@ def test_teacher_vae_loss_decreases_on_a_fixed_batch(toy_env, teacher_cfg, group
     assert last < 1.0 / 12.0
 
 
-def test_teacher_ppo_refuses_a_plain_mlp_actor(toy_env, groups, runner_cfg) -> None:
+def test_teacher_ppo_refuses_a_plain_mlp_actor(
+    toy_env: VecEnv, groups: ObsGroupsCfg, runner_cfg: Callable[[dict], dict]
+) -> None:
     """TeacherPPO needs the encoder; a stock MLPModel actor is a clear TypeError."""
     cfg = runner_cfg(TeacherCfg(actor_hidden_dims=(8,), critic_hidden_dims=(8,)).to_rsl_rl(groups))
-    cfg["actor"] = {"class_name": "MLPModel", "hidden_dims": [8], "distribution_cfg": {"class_name": "GaussianDistribution"}}
+    cfg["actor"] = {
+        "class_name": "MLPModel",
+        "hidden_dims": [8],
+        "distribution_cfg": {"class_name": "GaussianDistribution"},
+    }
     with pytest.raises(TypeError, match="TeacherActor"):
         TeacherPPO.construct_algorithm(toy_env.get_observations(), toy_env, cfg, "cpu")
