@@ -85,7 +85,14 @@ def main(argv: list[str] | None = None) -> None:
     p.add_argument("--duration", type=float, default=8.0)
     p.add_argument("--strengths", default="mid")
     p.add_argument("--only", default=None, help="comma-separated episode-name prefixes")
+    p.add_argument("--score-only", action="store_true", help="score the rows already under OUT/rows and exit")
     a = p.parse_args(argv)
+    if a.score_only:
+        rows = [json.loads(f.read_text()) for f in sorted((a.out / "rows").glob("*.json"))]
+        (a.out / "summary.json").write_text(
+            json.dumps({**score(rows), "episodes_scored": len(rows)}, indent=2, default=float)
+        )
+        return
     eps = episode_list(a.seeds, a.nulls, tuple(a.strengths.split(",")))
     if a.only:
         eps = [e for e in eps if any(e["name"].startswith(s) for s in a.only.split(","))]
