@@ -18,7 +18,7 @@ import gmloco.contact as gc
 from gmloco.contact.materials import validate_material_arrays, xi_max, xi_n
 from gmloco.train.config import ContactModelName, GranularTaskCfg, MaterialRangeCfg, SandTerrainCfg
 
-__all__ = ["MaterialWriter", "build_contact_model", "contact_model_cfg", "contact_terrain_cfg"]
+__all__ = ["MaterialWriter", "build_contact_model", "contact_model_cfg", "contact_terrain_cfg", "reset_model_state"]
 
 NUM_FEET = 2
 """Feet per robot that carry a granular wrench."""
@@ -50,6 +50,19 @@ def build_contact_model(task: GranularTaskCfg, num_envs: int, device: wp.context
     terrain = contact_terrain_cfg(task.terrain)
     model = gc.make_contact_model(cfg, num_envs, NUM_FEET, str(device), terrain=terrain)
     return model, bool(getattr(model, "is_stateful", True))
+
+
+def reset_model_state(model: Any, env_ids: torch.Tensor) -> None:
+    """Clear the contact-model memory of ``env_ids`` without a host round trip (stateless models: no-op).
+
+    ``ContactModel.reset`` converts the ids through numpy; at 4,096 envs some env resets on almost every
+    step, so the ids go to the model's reset launcher as a zero-copy Warp view instead.
+    """
+    if not getattr(model, "is_stateful", True) or env_ids.numel() == 0:
+        return
+    from gmloco.contact.kernels_state import eval_reset_state
+
+    eval_reset_state(model, wp.from_torch(env_ids.to(torch.int32), dtype=wp.int32))
 
 
 class MaterialWriter:

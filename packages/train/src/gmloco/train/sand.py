@@ -141,8 +141,10 @@ class SandContact:
         if env_ids is None:
             env_ids = torch.arange(self.num_envs, device=self.device)
         if self.materials is not None:
+            from gmloco.train.contact_models import reset_model_state
+
             self.materials.draw(env_ids)
-            self.model.reset(env_ids)
+            reset_model_state(self.model, env_ids)
         self._place_floor(env_ids)
         self.feet.reset(env_ids)
 
