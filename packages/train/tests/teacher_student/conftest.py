@@ -11,7 +11,15 @@ import torch
 from rsl_rl.env import VecEnv
 from tensordict import TensorDict
 
-from gmloco.train.teacher_student import DistillCfg, ObsGroupsCfg, PpoCfg, StudentCfg, TeacherCfg
+from gmloco.train.teacher_student import (
+    DistillCfg,
+    ObsGroupsCfg,
+    PpoCfg,
+    StudentCfg,
+    StudentPPO,
+    TeacherCfg,
+    TeacherPPO,
+)
 
 NUM_ENVS = 16
 NUM_ACTIONS = 2
@@ -138,3 +146,33 @@ def runner_cfg() -> Callable[[dict], dict]:
         return {"num_steps_per_env": 4, "save_interval": 1000, "logger": "tensorboard", "multi_gpu": None} | entries
 
     return complete
+
+
+@pytest.fixture
+def teacher_ckpt(
+    toy_env: VecEnv, teacher_cfg: TeacherCfg, groups: ObsGroupsCfg, runner_cfg: Callable[[dict], dict]
+) -> dict:
+    """A randomly initialised TeacherPPO checkpoint dict (``actor_state_dict``, ``critic_state_dict``, ...)."""
+    torch.manual_seed(1)
+    alg = TeacherPPO.construct_algorithm(
+        toy_env.get_observations(), toy_env, runner_cfg(teacher_cfg.to_rsl_rl(groups)), "cpu"
+    )
+    return alg.save()
+
+
+@pytest.fixture
+def student_alg(
+    toy_env: VecEnv,
+    teacher_cfg: TeacherCfg,
+    student_cfg: StudentCfg,
+    distill_cfg: DistillCfg,
+    groups: ObsGroupsCfg,
+    runner_cfg: Callable[[dict], dict],
+    teacher_ckpt: dict,
+) -> StudentPPO:
+    """StudentPPO built by its construct_algorithm from the typed cfgs, with the teacher loaded."""
+    torch.manual_seed(0)
+    cfg = runner_cfg(distill_cfg.to_rsl_rl(teacher_cfg, student_cfg, groups))
+    alg = StudentPPO.construct_algorithm(toy_env.get_observations(), toy_env, cfg, "cpu")
+    alg.load(teacher_ckpt, None, strict=True)
+    return alg
