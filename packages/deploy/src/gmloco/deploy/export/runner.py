@@ -92,9 +92,8 @@ class OnnxPolicyRunner:
         single = np.ndim(obs) == 1
         obs2 = np.asarray(obs, dtype=np.float32).reshape(self.num_envs, self.metadata.obs_dim)
         self.push(obs2)
-        outputs = dict(
-            zip(self.output_names, self.session.run(None, {"obs": obs2, "history": self.history}), strict=True)
-        )
+        results = self.session.run(None, {"obs": obs2, "history": self.history})
+        outputs = {name: np.asarray(r) for name, r in zip(self.output_names, results, strict=True)}
         self.latent, self.eta = outputs.get("latent"), outputs.get("eta")
         actions = outputs[self.output_names[0]]
         return actions[0] if single else actions

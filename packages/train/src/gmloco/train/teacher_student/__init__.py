@@ -6,6 +6,7 @@
 * Student: :class:`StudentActor` (three 1-D convolutions + MLP over the N-step history) trained by
   :class:`StudentPPO` (DAgger + weighted PPO, frozen teacher) under :class:`StudentRunner`.
 * Configs: :class:`TeacherCfg`, :class:`StudentCfg`, :class:`DistillCfg`, :class:`ObsGroupsCfg`, :class:`PpoCfg`.
+* Export: :func:`policy_metadata_kwargs` maps mjlab's export metadata onto ``gmloco.deploy.export.PolicyMetadata``.
 """
 
 from gmloco.train.teacher_student.config import (
@@ -22,6 +23,7 @@ from gmloco.train.teacher_student.config import (
     TeacherCfg,
 )
 from gmloco.train.teacher_student.curriculum import LinearRamp
+from gmloco.train.teacher_student.deploy_metadata import policy_metadata_kwargs
 from gmloco.train.teacher_student.runner import StudentRunner
 from gmloco.train.teacher_student.student import DEFAULT_HISTORY_LENGTH, StudentActor
 from gmloco.train.teacher_student.student_ppo import StudentPPO
@@ -47,4 +49,5 @@ __all__ = [
     "TeacherActor",
     "TeacherCfg",
     "TeacherPPO",
+    "policy_metadata_kwargs",
 ]

@@ -62,6 +62,7 @@ class StudentRunner(OnPolicyRunner):
         """Load a student (or teacher) checkpoint and restore the env's ``common_step_counter`` if saved."""
         infos = super().load(path, load_cfg, strict, map_location)
         env_state = (infos or {}).get("env_state")
-        if env_state is not None and hasattr(getattr(self.env, "unwrapped", self.env), "common_step_counter"):
-            getattr(self.env, "unwrapped", self.env).common_step_counter = env_state["common_step_counter"]
+        target = getattr(self.env, "unwrapped", self.env)
+        if env_state is not None and hasattr(target, "common_step_counter"):
+            target.common_step_counter = env_state["common_step_counter"]  # type: ignore[attr-defined]
         return infos
