@@ -185,6 +185,7 @@ def test_unloading_branch_matches_reference(device: str) -> None:
                 ratio=3.0,
                 tangential_damping=cfg.tangential_damping,
                 damping=0.002,
+                unloading_speed=cfg.unloading_speed,
             )
             assert np.abs(ref).max() > 0.0
             np.testing.assert_allclose(forces[w, f], ref, atol=1e-4 * np.abs(ref).max())
@@ -217,7 +218,9 @@ def level_foot(depth: float, v_z: float) -> tuple[np.ndarray, ...]:
 def test_cone_kernels_match_reference(device: str) -> None:
     """Cone single and multi vertical forces equal cone_step for level soles (plastic and elastic cases)."""
     for cfg_type, multi in ((ContactConeSingleCfg, False), (ContactConeMultiCfg, True)):
-        model = make_contact_model(cfg_type(unloading_ratio=5.0, unloading_damping=0.0), 1, 1, device)
+        model = make_contact_model(
+            cfg_type(unloading_ratio=5.0, unloading_damping=0.0, unloading_speed=0.0), 1, 1, device
+        )
         r_h = model.radii.numpy()[0]
         p = ConeParams(r_h=float(r_h), mu=0.4, unloading_ratio=5.0)
         out = wp.zeros((1, 1), dtype=wp.spatial_vector, device=device)

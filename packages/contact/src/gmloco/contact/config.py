@@ -26,7 +26,8 @@ AtRestMode = Literal["none", "unloading", "ema"]
 """How a model behaves when a loaded foot comes to rest (README, "At rest"):
 
 * ``"none"``: the published model (RFT: trailing elements get zero force; cone: plastic unloading).
-* ``"unloading"``: elastic unloading branch below the remembered maximum depth (project default).
+* ``"unloading"``: elastic unloading branch below the remembered maximum depth with impact damping (project
+  default).
 * ``"ema"``: Choi 2023 S16 anti-drift EMA filter on the element force (GM-Loco's optional filter).
 """
 
@@ -43,6 +44,11 @@ class _AtRestCfg:
     rate under 200 Hz explicit coupling (README, "At rest")."""
     unloading_damping: float = 0.001
     """Kelvin-Voigt time constant of the elastic branch [s]: d_eff += damping * ratio * d_depth/dt."""
+    unloading_speed: float = 0.15
+    """Impact-damping speed u0 of the elastic branch [m/s]: d_eff *= 1 + d_depth/dt / u0, clamped to [0, z_max], so
+    an element rising at u0 or faster gets no elastic force back. Active until the element's velocity has reversed
+    twice in contact (EMA reversal counter tau_r < 1 at the default ema_rate 0.5), so it damps the recovery after
+    an impact but never the step-rate chatter of a light foot; 0 turns it off (README, "At rest")."""
     tangential_damping: float = 1.0e4
     """Viscous cap of the elastic branch's Coulomb friction per element area, F_t = -min(mu F_n, c_t dS |v_t|)
     [N s/m^3] (3D-RFT only; 150 N s/m for the G1 sole)."""

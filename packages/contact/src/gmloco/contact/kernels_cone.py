@@ -9,7 +9,14 @@ import warp as wp
 
 from gmloco.contact.kernels_geometry import TerrainData, foot_point_kinematics, terrain_height
 from gmloco.contact.kernels_rft2d import coulomb_tangential
-from gmloco.contact.kernels_state import AT_REST_EMA, AT_REST_UNLOADING, ema_filter, ema_rigidity, unloading_depth
+from gmloco.contact.kernels_state import (
+    AT_REST_EMA,
+    AT_REST_UNLOADING,
+    ema_filter,
+    ema_rigidity,
+    impact_damping,
+    unloading_depth,
+)
 
 __all__ = ["cone_flat_area", "cone_quasi_static", "eval_cone_point_forces"]
 
@@ -55,6 +62,7 @@ def cone_point_force_kernel(
     at_rest: int,
     unloading_ratio: float,
     unloading_damping: float,
+    unloading_speed: float,
     ema_rate: float,
     # Data in:
     foot_pos_in: wp.array2d[wp.vec3],
@@ -103,7 +111,13 @@ def cone_point_force_kernel(
                 f_n += mass_rate * cone_flat_integral(z, r_h, k_cone) * z_ddot
             f_n = wp.max(f_n, 0.0)
         elif at_rest == AT_REST_UNLOADING:
-            d_eff = unloading_depth(z, z_max, unloading_ratio, unloading_damping, z_dot)
+            d_eff = impact_damping(
+                unloading_depth(z, z_max, unloading_ratio, unloading_damping, z_dot),
+                z_max,
+                z_dot,
+                unloading_speed,
+                ema_tau_in[w, f, p],
+            )
             f_n = cone_quasi_static(z_max, r_h, k_cone, cos_theta, s_flat, s_cone) * d_eff / z_max
     force = coulomb_tangential(f_n, v, mu_surf[w % mu_surf.shape[0]], k_f) + wp.vec3(0.0, 0.0, f_n)
     if at_rest == AT_REST_EMA:
@@ -139,6 +153,7 @@ def eval_cone_point_forces(model: Any, inputs: tuple, nan_count_out: wp.array) -
             model.at_rest_code,
             cfg.unloading_ratio,
             cfg.unloading_damping,
+            cfg.unloading_speed,
             cfg.ema_rate,
             foot_pos,
             foot_mat,

@@ -15,7 +15,14 @@ from gmloco.contact.kernels_geometry import (
     terrain_height,
 )
 from gmloco.contact.kernels_rft3d import G_HAT, unit_velocity
-from gmloco.contact.kernels_state import AT_REST_EMA, AT_REST_UNLOADING, ema_filter, ema_rigidity, unloading_depth
+from gmloco.contact.kernels_state import (
+    AT_REST_EMA,
+    AT_REST_UNLOADING,
+    ema_filter,
+    ema_rigidity,
+    impact_damping,
+    unloading_depth,
+)
 
 __all__ = ["eval_heuristic_point_forces", "rft2d_alpha_z", "rft2d_angles"]
 
@@ -86,6 +93,7 @@ def heuristic_point_force_kernel(
     at_rest: int,
     unloading_ratio: float,
     unloading_damping: float,
+    unloading_speed: float,
     ema_rate: float,
     # Data in:
     foot_pos_in: wp.array2d[wp.vec3],
@@ -128,7 +136,13 @@ def heuristic_point_force_kernel(
     depth_max = depth_max_in[w, f, p]
     if at_rest == AT_REST_UNLOADING and depth > 0.0 and depth < depth_max:
         v_hat = G_HAT  # elastic branch: static resistance on the unloading line
-        depth_eff = unloading_depth(depth, depth_max, unloading_ratio, unloading_damping, -v[2])
+        depth_eff = impact_damping(
+            unloading_depth(depth, depth_max, unloading_ratio, unloading_damping, -v[2]),
+            depth_max,
+            -v[2],
+            unloading_speed,
+            ema_tau_in[w, f, p],
+        )
     force = wp.vec3(0.0)
     if depth > 0.0:
         angles = rft2d_angles(n, v_hat)
@@ -165,6 +179,7 @@ def eval_heuristic_point_forces(model: Any, inputs: tuple, nan_count_out: wp.arr
             model.at_rest_code,
             cfg.unloading_ratio,
             cfg.unloading_damping,
+            cfg.unloading_speed,
             cfg.ema_rate,
             foot_pos,
             foot_mat,

@@ -19,6 +19,7 @@ from gmloco.contact.kernels_state import (
     AT_REST_UNLOADING,
     ema_filter,
     ema_rigidity,
+    impact_damping,
     unloading_depth,
 )
 
@@ -109,15 +110,20 @@ def rft3d_elastic_force(
     coeffs: wp.array2d[float],
     ratio: float,
     damping: float,
+    speed: float,
+    tau_rev: float,
     tangential_damping: float,
 ) -> wp.vec3:
     """Return the elastic-branch force inside the crater: static alpha on d_eff plus capped viscous friction [N].
+
+    d_eff is the unloading line with Kelvin-Voigt and impact damping (:func:`impact_damping`).
 
     F_t = -min(mu |F.n|, c_t dS |v_t|) v_t / |v_t| in the element plane (the viscous cap keeps the explicit
     coupling stable, like GM-Loco's k_f for its baselines).
     """
     alpha_s = rft3d_alpha(rft3d_generic(n, G_HAT, coeffs), n, xi, mu_surf, G_HAT, 0)
-    f = alpha_s * (unloading_depth(depth, depth_max, ratio, damping, -v[2]) * area)
+    d_eff = impact_damping(unloading_depth(depth, depth_max, ratio, damping, -v[2]), depth_max, -v[2], speed, tau_rev)
+    f = alpha_s * (d_eff * area)
     v_t = v - wp.dot(v, n) * n
     speed = wp.length(v_t)
     if speed <= 0.0:
@@ -142,6 +148,7 @@ def rft3d_point_force_kernel(
     at_rest: int,
     unloading_ratio: float,
     unloading_damping: float,
+    unloading_speed: float,
     tangential_damping: float,
     ema_rate: float,
     # Data in:
@@ -182,7 +189,19 @@ def rft3d_point_force_kernel(
     force = wp.vec3(0.0)
     if at_rest == AT_REST_UNLOADING and depth > 0.0 and depth < depth_max:
         force = rft3d_elastic_force(
-            n, v, depth, depth_max, areas[p], xi, mat[2], coeffs, unloading_ratio, unloading_damping, tangential_damping
+            n,
+            v,
+            depth,
+            depth_max,
+            areas[p],
+            xi,
+            mat[2],
+            coeffs,
+            unloading_ratio,
+            unloading_damping,
+            unloading_speed,
+            ema_tau_in[w, f, p],
+            tangential_damping,
         )
     else:
         force = rft3d_plastic_force(n, v, depth, areas[p], xi, mat[2], coeffs, v_eps, sign_fix)
@@ -216,6 +235,7 @@ def eval_rft3d_point_forces(model: Any, inputs: tuple, nan_count_out: wp.array) 
             model.at_rest_code,
             cfg.unloading_ratio,
             cfg.unloading_damping,
+            cfg.unloading_speed,
             cfg.tangential_damping,
             cfg.ema_rate,
             foot_pos,

@@ -14,6 +14,7 @@ __all__ = [
     "eval_reset_state",
     "eval_state_update",
     "eval_zero_wrench",
+    "impact_damping",
     "unloading_depth",
 ]
 
@@ -32,6 +33,23 @@ def unloading_depth(depth: float, depth_max: float, ratio: float, damping: float
     d = z_max and vanishes once the element has risen by z_max / r (project choice, README "At rest").
     """
     return wp.max(0.0, depth_max - ratio * (depth_max - depth) + damping * ratio * depth_rate)
+
+
+@wp.func
+def impact_damping(depth_eff: float, depth_max: float, depth_rate: float, speed: float, tau_rev: float) -> float:
+    """Return the elastic-branch depth after impact damping, clamp(d_eff (1 + d_dot / u0), 0, z_max) [m].
+
+    Hunt-Crossley-like: the damping force is proportional to the elastic force, so a body recovering from an
+    impact rises no faster than about u0 (1 - F_static / F_el) and arrives at rest at its static depth. It acts
+    only while the reversal counter tau_r < 1 (at most one velocity reversal in contact), which cuts it off for
+    step-rate (Nyquist) oscillations that an explicit damper would feed. The clamp at z_max keeps the elastic
+    branch at or below the yield force of its crater (project choice, README "At rest"); u0 <= 0 disables the
+    damping but keeps the clamp.
+    """
+    d = depth_eff
+    if speed > 0.0 and tau_rev < 1.0:
+        d = d * (1.0 + depth_rate / speed)
+    return wp.clamp(d, 0.0, depth_max)
 
 
 @wp.func

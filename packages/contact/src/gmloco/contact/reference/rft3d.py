@@ -206,6 +206,8 @@ def rft3d_unloading_forces(
     surface_z: float | np.ndarray = 0.0,
     coeffs: Coeffs = "pnas",
     v_eps: float = 1e-4,
+    unloading_speed: float = 0.0,
+    impact_damped: bool | np.ndarray = True,
 ) -> np.ndarray:
     """Return 3D-RFT forces with the project's elastic unloading branch [N], shape [N, 3].
 
@@ -232,6 +234,9 @@ def rft3d_unloading_forces(
     static_v = np.tile(G_HAT, (len(n), 1))
     alpha_s = rft3d_alpha(rft3d_generic(n, static_v, coeffs), n, xi_n(rho_c, mu_int), mu_surf)
     d_eff = np.maximum(0.0, depth_max - ratio * (depth_max - depth) - damping * ratio * v[:, 2])
+    if unloading_speed > 0.0:
+        d_eff = np.where(impact_damped, d_eff * (1.0 - v[:, 2] / unloading_speed), d_eff)
+    d_eff = np.clip(d_eff, 0.0, depth_max)
     f_el = alpha_s * (d_eff * areas)[:, None]
     v_t = v - np.sum(v * n, -1, keepdims=True) * n
     speed_t = np.linalg.norm(v_t, axis=-1, keepdims=True)
