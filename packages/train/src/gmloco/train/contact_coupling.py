@@ -85,12 +85,12 @@ class ContactCoupling:
         """Foot angular velocity [rad/s], world frame, shape [W, F]."""
         self.foot_com_w = wp.zeros(shape, dtype=wp.vec3, device=device)
         """Foot body CoM position [m], world frame, shape [W, F]."""
-        self.wrench = wp.zeros(shape, dtype=wp.spatial_vector, device=device)
+        self.wrench = wp.zeros(shape, dtype=wp.spatial_vector, device=device)  # type: ignore[arg-type]
         """Granular wrench (force [N], torque about CoM [N m]), world frame, shape [W, F]."""
         self.wrench_torch = wp.to_torch(self.wrench).view(*shape, 6)
         """Zero-copy torch view of :attr:`wrench`, shape [W, F, 6]."""
         self._sim_step: Callable[[], None] | None = None
-        self._state_graph: object | None = None
+        self._state_graph: wp.Graph | None = None
 
     @property
     def foot_state(self) -> tuple[wp.array, wp.array, wp.array, wp.array, wp.array]:

@@ -77,7 +77,8 @@ class MaterialWriter:
     def __init__(self, model: Any, ranges: MaterialRangeCfg, device: str) -> None:
         self.ranges = ranges
         self.device = device
-        self._xi_n, self._xi_max = xi_n, float(xi_max())
+        self._xi_n: Any = xi_n  # plain arithmetic: evaluates on torch tensors too
+        self._xi_max = float(xi_max())
         self.preset = gc.MATERIAL_PRESETS[ranges.preset] if ranges.preset is not None else None
         lo_hi = lambda r: np.asarray(r, dtype=np.float64)  # noqa: E731
         validate_material_arrays(

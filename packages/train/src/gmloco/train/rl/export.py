@@ -4,6 +4,7 @@
 from __future__ import annotations
 
 import json
+import math
 import os
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
@@ -29,14 +30,14 @@ def policy_metadata(env: ManagerBasedRlEnv, run_name: str, extra: dict[str, Any]
     meta: dict[str, Any] = get_base_metadata(env, run_name)
     om = env.observation_manager
     action_term = env.action_manager.get_term("joint_pos")
-    term_dims = [int(d[-1]) for d in om.group_obs_term_dim["actor"]]
+    term_dims = [math.prod(d) for d in om.group_obs_term_dim["actor"]]  # flat 1-D terms: history x width
     history = max(om.get_term_cfg("actor", om.active_terms["actor"][0]).history_length, 1)
     meta.update(
         {
             "action_joint_names": list(action_term.target_names),  # type: ignore[attr-defined]
             "observation_dims": [d // history for d in term_dims],
             "observation_history_length": history,
-            "observation_dim": int(om.group_obs_dim["actor"][-1]),
+            "observation_dim": sum(term_dims),
             "policy_dt": env.step_dt,
             "physics_dt": env.physics_dt,
         }
