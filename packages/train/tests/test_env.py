@@ -75,3 +75,17 @@ def test_standing_robot_sinks_as_rft_predicts(make_env) -> None:  # noqa: ANN001
     np.testing.assert_allclose(np.mean(fz), weight, rtol=0.10)
     np.testing.assert_allclose(np.mean(depth), static, rtol=0.20)
     assert env.sand.feet.in_contact.all()
+
+
+@pytest.mark.parametrize("terrain", ["rough", "deep"])
+def test_rough_and_deep_terrains_step(make_env, terrain: str) -> None:  # noqa: ANN001
+    """3D-RFT on the sinusoidal and the 30 cm deep bed: builds, steps, floors sit at the configured depth."""
+    env = make_env(g1_granular_task("rft3d", terrain), num_envs=2)  # type: ignore[arg-type]
+    env.reset()
+    for _ in range(3):
+        obs, reward, *_ = env.step(torch.zeros(2, NUM_JOINTS))
+    assert torch.isfinite(obs["critic"]).all() and torch.isfinite(reward).all()
+    floor_z = env.sim.data.mocap_pos[:, env.sand.floor_mocap_id, 2].cpu().numpy()
+    if terrain == "deep":
+        np.testing.assert_allclose(floor_z, -0.30, atol=1e-6)
+    assert env.sand.task.terrain.kind == terrain
