@@ -1,8 +1,10 @@
 # SPDX-License-Identifier: Apache-2.0
 """Helpers for the pipeline tests: plain-python subprocesses and two toy stages that really write outputs.
 
-The real stages are not implemented yet, so skip/resume is exercised with a toy ``train_teacher`` (writes a
-checkpoint) and a toy ``distill`` (reads it, writes a student), registered in place of the real ones.
+The runner's skip/resume/force logic is exercised in seconds with a toy ``train_teacher`` (writes a checkpoint) and
+a toy ``distill`` (reads it, writes a student) registered in place of the real ones; the later stages are
+registered as not implemented, so these tests never run the real (minutes-long) stages. ``test_pipeline_smoke.py``
+and ``test_stage_rerun.py`` run the real ones.
 """
 
 from __future__ import annotations
@@ -18,7 +20,7 @@ from typing import Any
 
 import stage_registry
 from run_dir import atomic_write_json, read_json
-from stage_registry import StageFn, StageSpec
+from stage_registry import StageFn, StageSpec, not_implemented
 
 REPO_ROOT = Path(__file__).resolve().parents[1]
 """Checkout root."""
@@ -71,10 +73,10 @@ def toy_student(cfg: Any) -> dict[str, float]:
 
 
 def toy_registry(teacher: StageFn = toy_teacher, student: StageFn = toy_student) -> tuple[StageSpec, ...]:
-    """The real registry with train_teacher and distill replaced by toy stages."""
+    """The real registry with train_teacher and distill replaced by toy stages and the rest by stubs."""
     real = {s.name: s for s in stage_registry.STAGES}
     return (
         StageSpec("train_teacher", real["train_teacher"].issues, (), "toy teacher", fn=teacher),
         StageSpec("distill", real["distill"].issues, ("train_teacher",), "toy student", fn=student),
-        *stage_registry.STAGES[2:],
+        *(StageSpec(s.name, s.issues, s.needs, "stub", fn=not_implemented(s.name)) for s in stage_registry.STAGES[2:]),
     )

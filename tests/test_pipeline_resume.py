@@ -37,7 +37,7 @@ def run(compose: Compose, tmp_path: Path) -> Callable[..., dict[str, Any]]:
 
 
 def test_first_run_records_everything(run: Callable[..., dict[str, Any]], tmp_path: Path) -> None:
-    """Toy stages are done with outputs and metrics; the real ones are reported as not implemented."""
+    """Toy stages are done with outputs and metrics; the stubbed later stages are reported as not implemented."""
     summary = run()
     assert summary["exit_code"] == EXIT_OK
     statuses = _statuses(summary)

@@ -1,24 +1,68 @@
 # SPDX-License-Identifier: Apache-2.0
 """Stage ``analyze_logs``: analysis of MCAP robot recordings (tracking, torques, clearance, decoded eta) (issue 7).
 
-Run alone (time-boxed and resumable; works with plain ``python`` and ``PYTHONPATH=packages/*/src:workflows``)::
+Runs ``gmloco.deploy.logs.analyze`` (the ``gmloco-logs`` command) on ``analyze_logs.inputs`` (files or folders;
+default: the committed sample recordings) plus, with ``analyze_logs.include_run_recordings``, every ``*.mcap`` an
+earlier stage wrote under the run directory. Writes ``summary.md``, ``summary.csv``, ``tracking.csv``,
+``summary.json`` and ``figures/``; a recording that cannot be read is listed under "Files not analyzed".
 
-    python workflows/analyze_logs.py +exp=gm_loco run_dir=runs/gm_loco/<name> max_minutes=9
+Run alone (works with plain ``python`` and ``PYTHONPATH=packages/*/src:workflows``)::
 
-Contract for the implementation that replaces ``not_implemented`` below: ``run(cfg) -> dict[str, float]``
-reads ``cfg.analyze_logs`` (plus ``cfg.seed`` and the resolved ``cfg.device``), writes every file under
-``cfg.analyze_logs.out_dir`` (atomically: ``run_dir.atomic_write_*``), stops by ``cfg.analyze_logs.max_minutes`` by
-saving resumable state and raising ``StageIncompleteError``, and returns its metrics. The runner adds
-``metrics.json`` and the manifest entry.
+    python workflows/analyze_logs.py +exp=gm_loco run_dir=runs/gm_loco/<name> 'analyze_logs.inputs=[data/logs]'
+
+Contract: ``run(cfg)`` reads ``cfg.analyze_logs``, writes every file under ``cfg.analyze_logs.out_dir`` and returns
+counts and the mean velocity-tracking error; it takes seconds per recording, so it has no time box of its own.
 """
 
 from __future__ import annotations
 
-from stage_registry import not_implemented
+import math
+from pathlib import Path
+from typing import Any
 
-__all__ = ["main", "run"]
+from omegaconf import DictConfig
 
-run = not_implemented("analyze_logs")
+from run_dir import atomic_write_json
+
+__all__ = ["main", "recordings", "run"]
+
+
+def recordings(cfg: DictConfig) -> list[str | Path]:
+    """Return the configured inputs, then the ``*.mcap`` files under the run directory (outside this stage)."""
+    section = cfg.analyze_logs
+    inputs: list[str | Path] = [str(p) for p in section.inputs]
+    if section.include_run_recordings:
+        out = Path(section.out_dir).resolve()
+        found = sorted(p for p in Path(cfg.run_dir).rglob("*.mcap") if out not in p.resolve().parents)
+        inputs += found
+    return inputs
+
+
+def _metrics(content: dict[str, Any]) -> dict[str, float]:
+    """Counts of the analysis and the mean tracking RMSE over commanded-speed segments (NaN-free)."""
+    rmse = [float(t["rmse"]) for t in content["tracking"] if math.isfinite(float(t["rmse"]))]
+    metrics = {
+        "recordings": float(len(content["runs"])),
+        "failed_recordings": float(len(content["failures"])),
+        "figures": float(len(content["figures"])),
+        "tracking_segments": float(len(content["tracking"])),
+    }
+    if rmse:
+        metrics["tracking_rmse_mean"] = sum(rmse) / len(rmse)
+    return metrics
+
+
+def run(cfg: DictConfig) -> dict[str, float]:
+    """Analyze the recordings; fail when none could be read."""
+    from gmloco.deploy.logs.analysis.report import analyze
+
+    section = cfg.analyze_logs
+    inputs = recordings(cfg)
+    content = analyze(inputs, section.out_dir, figures=bool(section.figures), progress=False)
+    atomic_write_json(Path(section.out_dir) / "inputs.json", {"inputs": [str(p) for p in inputs]})
+    if not content["runs"]:
+        raise RuntimeError(f"no recording could be analyzed among {inputs}: {content['failures']}")
+    return _metrics(content)
 
 
 def main() -> None:

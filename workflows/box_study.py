@@ -22,7 +22,7 @@ def main() -> None:
     from gmloco.eval.mpm.bed import SandBedCfg
     from gmloco.eval.mpm.box_scene import MpmSolverCfg
 
-    p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    p = argparse.ArgumentParser(description=(__doc__ or "").splitlines()[0])
     p.add_argument("--out-dir", default="results/box_intrusion")
     p.add_argument("--num-trials", type=int, default=30)
     p.add_argument("--seed", type=int, default=0)

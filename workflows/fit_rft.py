@@ -21,7 +21,7 @@ def main() -> None:
     from gmloco.eval.mpm.box_scene import MpmSolverCfg
     from gmloco.eval.rft_fit import RftFitCfg, rft_fit_smoke_cfg, run
 
-    p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    p = argparse.ArgumentParser(description=(__doc__ or "").splitlines()[0])
     p.add_argument("--out-dir", default="results/rft_fit")
     p.add_argument("--material", default="dry_sand", help="gmloco.contact.MATERIAL_PRESETS name")
     p.add_argument("--voxel-size", type=float, default=0.02)

@@ -1,24 +1,68 @@
 # SPDX-License-Identifier: Apache-2.0
-"""Stage ``mismatch``: sim-vs-real mismatch discovery over MCAP recordings (issue 8).
+"""Stage ``mismatch``: sim-vs-real mismatch discovery on one MCAP recording (issue 8).
 
-Run alone (time-boxed and resumable; works with plain ``python`` and ``PYTHONPATH=packages/*/src:workflows``)::
+Runs the ``gmloco-mismatch`` analysis (``gmloco.deploy.mismatch``) on ``mismatch.real`` (default: a committed sample
+recording) with the simulated counterpart produced by replaying its commands in MuJoCo: contract checks,
+localisation, attribution over the effect library, fit, held-out before/after. Writes ``report.json``,
+``report.md``, ``config_patch.json`` and the plots. The smoke scale analyses the first seconds with a short horizon
+and a subset of effects, which checks the machinery, not the verdict.
 
-    python workflows/mismatch.py +exp=gm_loco run_dir=runs/gm_loco/<name> max_minutes=9
+Run alone (works with plain ``python`` and ``PYTHONPATH=packages/*/src:workflows``)::
 
-Contract for the implementation that replaces ``not_implemented`` below: ``run(cfg) -> dict[str, float]``
-reads ``cfg.mismatch`` (plus ``cfg.seed`` and the resolved ``cfg.device``), writes every file under
-``cfg.mismatch.out_dir`` (atomically: ``run_dir.atomic_write_*``), stops by ``cfg.mismatch.max_minutes`` by
-saving resumable state and raising ``StageIncompleteError``, and returns its metrics. The runner adds
-``metrics.json`` and the manifest entry.
+    python workflows/mismatch.py +exp=gm_loco run_dir=runs/gm_loco/<name> mismatch.real=data/logs/robot.mcap
+
+Contract: ``run(cfg)`` reads ``cfg.mismatch``, writes every file under ``cfg.mismatch.out_dir`` and returns the
+verdict and its numbers. A 6 s recording with the whole library takes about 2 min on 2 CPU cores; the analysis
+cannot stop midway, so ``max_minutes`` is not checked inside it.
 """
 
 from __future__ import annotations
 
-from stage_registry import not_implemented
+from pathlib import Path
+from typing import Any
+
+from omegaconf import DictConfig
 
 __all__ = ["main", "run"]
 
-run = not_implemented("mismatch")
+
+def _analysis_cfg(section: DictConfig) -> Any:
+    """Return the package's ``AnalysisCfg`` for the stage's section."""
+    from gmloco.deploy.mismatch.pipeline import AnalysisCfg
+    from gmloco.deploy.mismatch.replay import ReplayCfg
+
+    cfg = AnalysisCfg(replay=ReplayCfg(horizon=int(section.horizon)), mirror_check=bool(section.mirror_check))
+    cfg.attribution.effects = None if section.effects is None else tuple(str(e) for e in section.effects)
+    cfg.attribution.n_boot = int(section.n_boot)
+    return cfg
+
+
+def _metrics(report: dict[str, Any]) -> dict[str, Any]:
+    """The verdict, the winning effect and the report's headline numbers (an invalid input has fewer)."""
+    mismatch = report.get("mismatch", {})
+    metrics: dict[str, Any] = {"verdict": report["verdict"], "winner": report.get("winner") or "none"}
+    metrics["untested_effects"] = float(len(report.get("untested", [])))
+    for key in ("nominal_energy_ratio", "explained_fraction"):
+        if isinstance(mismatch.get(key), int | float):
+            metrics[key] = float(mismatch[key])
+    if isinstance(report.get("runtime_s"), int | float):
+        metrics["runtime_s"] = float(report["runtime_s"])
+    return metrics
+
+
+def run(cfg: DictConfig) -> dict[str, Any]:
+    """Analyse ``mismatch.real`` and write the report; return the verdict and counts."""
+    from gmloco.deploy.mismatch.io import read_recording
+    from gmloco.deploy.mismatch.pipeline import analyze
+    from gmloco.deploy.mismatch.report import write_report
+
+    section = cfg.mismatch
+    rec = read_recording(str(section.real))
+    if section.duration_s is not None:
+        rec = rec.slice(0, min(rec.n, round(float(section.duration_s) / rec.dt)))
+    result = analyze(rec, _analysis_cfg(section))
+    write_report(result, Path(section.out_dir), plots=bool(section.plots))
+    return _metrics(result.report) | {"recording_s": float(rec.n * rec.dt)}
 
 
 def main() -> None:

@@ -2,8 +2,9 @@
 """Structured-config schemas of the pipeline, registered in Hydra's ConfigStore.
 
 Each ``conf/<group>/*.yaml`` extends its schema through its defaults list (``- base_<group>``), so a typo in
-an override or a YAML file fails at composition with the key's name. The stage sections are placeholders that
-the packages replace with their own ``FooCfg`` dataclasses as the stages get implemented (issues 4, 6-9).
+an override or a YAML file fails at composition with the key's name. The stage sections mirror the packages'
+``FooCfg`` dataclasses (OmegaConf cannot hold their ``Literal`` fields); each ``workflows/<stage>.py`` converts
+its section into the package's dataclass. ``eval_mpm``'s section is still a placeholder (issue 9).
 """
 
 from __future__ import annotations
@@ -27,10 +28,15 @@ __all__ = [
     "MismatchCfg",
     "PathsCfg",
     "PipelineCfg",
+    "PolicyTrainingCfg",
+    "PpoSchedule",
+    "PpoSettingsCfg",
     "ScaleName",
     "StageCfg",
     "SweepCfg",
+    "TerrainName",
     "TrackingCfg",
+    "TrainAlgorithm",
     "TrainTeacherCfg",
     "WandbMode",
     "register_configs",
@@ -81,7 +87,9 @@ class PathsCfg:
     data_dir: str = _interp("${paths.root_dir}/data")
     """Inputs that are not code (recordings, material tables)."""
     hw_logs_dir: str = _interp("${paths.data_dir}/logs")
-    """MCAP robot recordings read by ``analyze_logs`` and ``mismatch``."""
+    """Your own MCAP robot recordings (add them to ``analyze_logs.inputs`` or set ``mismatch.real``)."""
+    sample_logs_dir: str = _interp("${paths.root_dir}/packages/deploy/data/sample_logs")
+    """Committed sample recordings (scripted controller in the project's simulator), the default inputs."""
 
 
 @dataclass
@@ -104,41 +112,130 @@ class StageCfg:
     """Folder the stage writes its outputs to (``metrics.json`` is added by the runner)."""
     max_minutes: float | None = _interp("${max_minutes}")
     """Time box of the stage [min]; it saves resumable state and stops when reached. None: no limit."""
+    resume: bool = True
+    """Continue from resumable state in ``out_dir``. Set by the runner: false when the stage is forced or its
+    config changed since its last record, so it starts fresh."""
+
+
+class TrainAlgorithm(str, Enum):
+    """What the train stage trains."""
+
+    ppo = "ppo"
+    """Vanilla PPO (``+exp=ppo_*``, the paper's contact-model ablation): ``gmloco.train.train``."""
+    vae_teacher = "vae_teacher"
+    """GM-Loco teacher: PPO with the VAE terrain encoder and eta decoder (``TeacherPPO``, ``+exp=gm_loco``)."""
+
+
+class TerrainName(str, Enum):
+    """Sand beds of ``gmloco.train.g1_granular_task``."""
+
+    flat = "flat"
+    rough = "rough"
+    deep = "deep"
+
+
+class PpoSchedule(str, Enum):
+    """Learning-rate schedule of rsl-rl's PPO."""
+
+    adaptive = "adaptive"
+    fixed = "fixed"
 
 
 @dataclass
-class TrainTeacherCfg(StageCfg):
-    """PPO teacher on mjlab with a granular contact model (issues 4, 6)."""
+class PpoSettingsCfg:
+    """PPO hyper-parameters (mirror of ``gmloco.train.teacher_student.PpoCfg``; GM-Loco values by default)."""
 
-    out_dir: str = _interp("${run_dir}/train_teacher")
-    contact_model: ContactModelName = ContactModelName.rft3d
-    """Granular contact model applied to the feet."""
+    learning_rate: float = 1.0e-3
+    """Adam learning rate (initial value under the adaptive schedule)."""
+    schedule: PpoSchedule = PpoSchedule.adaptive
+    """Learning-rate schedule; adaptive keeps the policy KL near ``desired_kl``."""
+    desired_kl: float = 0.01
+    """Target KL per update [nats] of the adaptive schedule."""
+    entropy_coef: float = 0.005
+    """Entropy bonus weight."""
+    gamma: float = 0.99
+    """Discount factor per policy step."""
+    lam: float = 0.95
+    """GAE lambda."""
+    clip_param: float = 0.2
+    """PPO ratio clip."""
+    num_learning_epochs: int = 5
+    """Passes over the rollout per update."""
+    num_mini_batches: int = 4
+    """Mini-batches per pass."""
+    max_grad_norm: float = 1.0
+    """Gradient-norm clip."""
+
+
+@dataclass
+class PolicyTrainingCfg(StageCfg):
+    """Fields shared by the two training stages (``gmloco.train.TrainRunCfg``)."""
+
     num_envs: int = 4096
     """Parallel environments (rsl_rl / mjlab name)."""
     max_iterations: int = 5000
-    """PPO iterations."""
+    """Iterations in total over all resumed calls."""
+    num_steps_per_env: int = 24
+    """Env steps per env and iteration."""
+    save_interval: int = 50
+    """Iterations between checkpoints (one is always written when a call ends)."""
+    ppo: PpoSettingsCfg = field(default_factory=PpoSettingsCfg)
+    """PPO hyper-parameters."""
 
 
 @dataclass
-class DistillCfg(StageCfg):
+class TrainTeacherCfg(PolicyTrainingCfg):
+    """Train stage: vanilla PPO or the GM-Loco VAE teacher on mjlab with a granular contact model (issues 4, 6)."""
+
+    out_dir: str = _interp("${run_dir}/train_teacher")
+    algorithm: TrainAlgorithm = TrainAlgorithm.vae_teacher
+    """Vanilla PPO (``+exp=ppo_*``) or the VAE teacher (``+exp=gm_loco``)."""
+    contact_model: ContactModelName = ContactModelName.rft3d
+    """Granular contact model applied to the feet."""
+    terrain: TerrainName = TerrainName.flat
+    """Sand bed: flat soft sand, sinusoidal rough surface, or a 30 cm deep loose bed."""
+    policy_history_length: int = 5
+    """Actor frames stacked into o_t (1 for the teacher-student: the history goes through the encoders)."""
+    hidden_dims: list[int] = field(default_factory=lambda: [512, 256, 128])
+    """Actor and critic MLP widths (GM-Loco: 512, 256, 128)."""
+    latent_dim: int = 16
+    """Terrain latent size z of the VAE teacher (ours; the paper does not give it)."""
+    kl_weight: float = 1.0e-3
+    """beta, weight of the teacher's KL term (ours)."""
+    encoder_hidden_dims: list[int] = field(default_factory=lambda: [256, 128, 64])
+    """Teacher terrain encoder widths (paper)."""
+    history_length: int = 50
+    """N, frames of the ``history`` group the teacher encoder reads (the student reads the same N)."""
+
+
+@dataclass
+class DistillCfg(PolicyTrainingCfg):
     """TCN student distilled from the teacher with DAgger + PPO (issue 6)."""
 
     out_dir: str = _interp("${run_dir}/distill")
     teacher_dir: str = _interp("${train_teacher.out_dir}")
-    """Folder holding the teacher checkpoint."""
-    num_envs: int = 4096
-    """Parallel environments."""
+    """Folder holding the teacher checkpoint (newest ``model_<it>.pt``)."""
     max_iterations: int = 2000
-    """Distillation iterations."""
+    curriculum_finish: int = 1000
+    """Iteration at which w_PPO and w_dist reach their end values (ours)."""
+    tcn_channels: list[int] = field(default_factory=lambda: [32, 32, 32])
+    """Output channels of the student's three 1-D convolutions (ours)."""
+    ppo: PpoSettingsCfg = field(
+        default_factory=lambda: PpoSettingsCfg(learning_rate=5.0e-4, schedule=PpoSchedule.fixed, entropy_coef=0.001)
+    )
 
 
 @dataclass
 class ExportCfg(StageCfg):
-    """ONNX export of the student with deploy metadata (issue 6)."""
+    """ONNX export of the student with deploy metadata and an onnxruntime check (issue 6)."""
 
     out_dir: str = _interp("${run_dir}/export")
     policy_dir: str = _interp("${distill.out_dir}")
-    """Folder holding the student checkpoint."""
+    """Folder holding the student checkpoint (newest ``model_<it>.pt``)."""
+    parity_atol: float = 1.0e-5
+    """Largest onnxruntime-vs-torch difference accepted, on random and on rollout inputs."""
+    check_steps: int = 25
+    """Env steps rolled out with the ONNX runner, compared with the torch student and the teacher."""
 
 
 @dataclass
@@ -158,20 +255,36 @@ class EvalMpmCfg(StageCfg):
 
 @dataclass
 class AnalyzeLogsCfg(StageCfg):
-    """MCAP robot-log analysis (issue 7)."""
+    """MCAP robot-log analysis, ``gmloco.deploy.logs.analyze`` (issue 7)."""
 
     out_dir: str = _interp("${run_dir}/analyze_logs")
-    logs_dir: str = _interp("${paths.hw_logs_dir}")
-    """Folder of ``*.mcap`` recordings."""
+    inputs: list[str] = field(default_factory=lambda: ["${paths.sample_logs_dir}"])
+    """MCAP files or folders of them (default: the committed sample recordings)."""
+    include_run_recordings: bool = True
+    """Also analyze every ``*.mcap`` that earlier stages wrote under the run directory."""
+    figures: bool = True
+    """Write the paper-style PNG figures."""
 
 
 @dataclass
 class MismatchCfg(StageCfg):
-    """Sim-vs-real mismatch discovery (issue 8)."""
+    """Sim-vs-real mismatch discovery, ``gmloco.deploy.mismatch`` (issue 8)."""
 
     out_dir: str = _interp("${run_dir}/mismatch")
-    logs_dir: str = _interp("${paths.hw_logs_dir}")
-    """Folder of real ``*.mcap`` recordings."""
+    real: str = _interp("${paths.sample_logs_dir}/g1_scripted_rigid_no_odometry.mcap")
+    """The "real" recording (MCAP, project schema); default: a committed sample recording."""
+    duration_s: float | None = None
+    """Analyze only the first ``duration_s`` seconds [s] (at least ~5 s); None: the whole recording."""
+    horizon: int = 30
+    """Shooting horizon of the replay [samples]."""
+    effects: list[str] | None = None
+    """Effect ids to screen (``gmloco.deploy.mismatch.EFFECT_IDS``); None: the whole library."""
+    n_boot: int = 400
+    """Block-bootstrap resamples of the attribution."""
+    mirror_check: bool = True
+    """Also test a left/right-swapped joint map."""
+    plots: bool = True
+    """Write the report's plots."""
 
 
 @dataclass

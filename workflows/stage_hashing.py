@@ -25,7 +25,7 @@ VOLATILE_KEYS = frozenset(
 )
 """Top-level keys that never change a stage's result (where it runs, how long, how it is tracked)."""
 
-VOLATILE_STAGE_KEYS = frozenset({"out_dir", "max_minutes"})
+VOLATILE_STAGE_KEYS = frozenset({"out_dir", "max_minutes", "resume"})
 """Keys of a stage section that never change its result."""
 
 

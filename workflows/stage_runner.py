@@ -185,9 +185,15 @@ class StageRunner:
             return "never run"
         return rec.status.value if rec.config_hash == self.hashes[name] else "done for another config"
 
+    def _resumable(self, name: str) -> bool:
+        """Whether the stage may continue from its saved state: not forced, and not recorded for another config."""
+        rec = self.manifest.stages.get(name)
+        return name not in self.forced and (rec is None or rec.config_hash == self.hashes[name])
+
     def _stage_cfg(self, name: str, remaining_s: float | None) -> DictConfig:
-        """Copy of the config with the device resolved and the stage's time box capped by the pipeline's."""
+        """Copy of the config with the stage's time box capped by the pipeline's and ``resume`` decided."""
         cfg = copy.deepcopy(self.cfg)
+        cfg[name].resume = self._resumable(name)
         own = cfg[name].max_minutes
         if remaining_s is not None:
             cap = remaining_s / 60.0

@@ -1,24 +1,48 @@
 # SPDX-License-Identifier: Apache-2.0
-"""Stage ``train_teacher``: PPO teacher with a VAE terrain encoder on mjlab with a granular contact model (issues 4, 6).
+"""Stage ``train_teacher``: the train stage: vanilla PPO or the GM-Loco VAE teacher on the granular G1 (issues 4, 6).
+
+``train_teacher.algorithm`` picks what is trained, both through the time-boxed, resumable ``gmloco.train.train``:
+
+* ``ppo`` (``+exp=ppo_rft3d|ppo_heuristic_rft|ppo_cone_multi|ppo_rigid``): vanilla PPO with that contact model;
+  writes ``model_<it>.pt``, TensorBoard events and ``policy.onnx`` (+ ``policy.json``, mjlab deploy metadata).
+* ``vae_teacher`` (``+exp=gm_loco``): ``TeacherPPO`` with the ``TeacherActor`` (VAE terrain encoder over the critic
+  group and the ``history`` group, eta decoder) and the asymmetric MLP critic; writes ``model_<it>.pt`` (the
+  ``distill`` stage reads the newest one) and TensorBoard events.
 
 Run alone (time-boxed and resumable; works with plain ``python`` and ``PYTHONPATH=packages/*/src:workflows``)::
 
     python workflows/train_teacher.py +exp=gm_loco run_dir=runs/gm_loco/<name> max_minutes=9
+    python workflows/train.py +exp=ppo_rft3d run_dir=runs/ppo_rft3d/<name> max_minutes=9
 
-Contract for the implementation that replaces ``not_implemented`` below: ``run(cfg) -> dict[str, float]``
-reads ``cfg.train_teacher`` (plus ``cfg.seed`` and the resolved ``cfg.device``), writes every file under
-``cfg.train_teacher.out_dir`` (atomically: ``run_dir.atomic_write_*``), stops by ``cfg.train_teacher.max_minutes`` by
-saving resumable state and raising ``StageIncompleteError``, and returns its metrics. The runner adds
-``metrics.json`` and the manifest entry.
+Contract: ``run(cfg)`` reads ``cfg.train_teacher`` (plus ``cfg.seed`` and the resolved ``cfg.device``), writes every
+file under ``cfg.train_teacher.out_dir`` (checkpoints atomically), stops by ``cfg.train_teacher.max_minutes``
+with a checkpoint and raises ``StageIncompleteError`` (rerun to continue from it), and returns ``train``'s metrics.
 """
 
 from __future__ import annotations
 
-from stage_registry import not_implemented
+from typing import Any
+
+from omegaconf import DictConfig
+
+from policy_training import run_training, task_cfg, teacher_cfg, vanilla_ppo_overrides
 
 __all__ = ["main", "run"]
 
-run = not_implemented("train_teacher")
+
+def run(cfg: DictConfig) -> dict[str, float | None]:
+    """Train (or resume) the stage's policy and return its metrics."""
+    section = cfg.train_teacher
+    run_cfg: dict[str, Any] = {"task": task_cfg(section), "hidden_dims": tuple(int(d) for d in section.hidden_dims)}
+    if section.algorithm.value == "ppo":
+        run_cfg |= {"rsl_rl_overrides": vanilla_ppo_overrides(section), "export_onnx": True}
+    else:
+        from gmloco.train.teacher_student import ObsGroupsCfg
+
+        overrides = teacher_cfg(section).to_rsl_rl(ObsGroupsCfg())
+        # The teacher is not deployed (the exported policy is the student), so no ONNX export here.
+        run_cfg |= {"rsl_rl_overrides": overrides, "history_length": int(section.history_length), "export_onnx": False}
+    return run_training(cfg, "train_teacher", **run_cfg)
 
 
 def main() -> None:

@@ -8,6 +8,7 @@ time-boxed run is continued by repeating the same call.
 
 from __future__ import annotations
 
+import copy
 import json
 import math
 import os
@@ -58,6 +59,14 @@ class TrainRunCfg:
     """Export ``policy.onnx`` (+ ``policy.json``) with deploy metadata when the call ends."""
     export_reserve_s: float = 30.0
     """Time kept free before the deadline for the final checkpoint and export [s]."""
+    rsl_rl_overrides: dict[str, Any] = field(default_factory=dict)
+    """Top-level entries that replace those of the PPO runner cfg, e.g. ``TeacherCfg().to_rsl_rl(ObsGroupsCfg())``
+    (VAE teacher) or ``DistillCfg(...).to_rsl_rl(...)`` (student); empty: vanilla PPO."""
+    history_length: int = 0
+    """N of the env's ``history`` observation group ``[num_envs, N, 96]`` (teacher encoder, student); 0: none."""
+    init_checkpoint: str | None = None
+    """Checkpoint loaded (through the algorithm's ``load``) when ``run_dir`` has none yet, e.g. the teacher's
+    ``model_<it>.pt`` for distillation; None: start from scratch."""
 
 
 def _check_resume_cfg(run_dir: Path, cfg: TrainRunCfg) -> None:
@@ -81,7 +90,7 @@ def _make_env(cfg: TrainRunCfg) -> Any:
 
     from gmloco.train.tasks.g1_granular import make_g1_granular_env_cfg
 
-    env_cfg = make_g1_granular_env_cfg(cfg.task, cfg.num_envs)
+    env_cfg = make_g1_granular_env_cfg(cfg.task, cfg.num_envs, cfg.history_length)
     env_cfg.seed = cfg.seed
     return RslRlVecEnvWrapper(ManagerBasedRlEnv(cfg=env_cfg, device=cfg.device))
 
@@ -94,7 +103,7 @@ def _make_runner(cfg: TrainRunCfg, env: Any, run_dir: Path) -> Any:
     agent = make_g1_granular_ppo_cfg(experiment_name=run_dir.name, hidden_dims=cfg.hidden_dims)
     agent.seed, agent.save_interval, agent.logger = cfg.seed, cfg.save_interval, cfg.logger
     agent.num_steps_per_env, agent.max_iterations = cfg.num_steps_per_env, cfg.max_iterations
-    runner = GmlocoOnPolicyRunner(env, asdict(agent), str(run_dir), cfg.device)
+    runner = GmlocoOnPolicyRunner(env, asdict(agent) | copy.deepcopy(cfg.rsl_rl_overrides), str(run_dir), cfg.device)
     runner.add_git_repo_to_log(__file__)
     return runner
 
@@ -126,6 +135,8 @@ def train(cfg: TrainRunCfg) -> dict[str, float]:
     checkpoint = latest_checkpoint(run_dir) if cfg.resume else None
     if checkpoint is not None:
         runner.load(str(checkpoint))
+    elif cfg.init_checkpoint is not None:
+        runner.load(str(Path(cfg.init_checkpoint).resolve()))
     resumed_from = runner.current_learning_iteration
     remaining = cfg.max_iterations - resumed_from
     if remaining > 0:

@@ -117,12 +117,18 @@ def _terminations(task: GranularTaskCfg) -> dict[str, TerminationTermCfg]:
     }
 
 
-def make_g1_granular_env_cfg(task: GranularTaskCfg, num_envs: int = 4096) -> ManagerBasedRlEnvCfg:
-    """Build the mjlab env config of ``num_envs`` envs: 50 Hz policy (decimation 4) over 200 Hz physics."""
+def make_g1_granular_env_cfg(
+    task: GranularTaskCfg, num_envs: int = 4096, history_length: int = 0
+) -> ManagerBasedRlEnvCfg:
+    """Build the mjlab env config of ``num_envs`` envs: 50 Hz policy (decimation 4) over 200 Hz physics.
+
+    ``history_length`` > 0 adds the ``history`` observation group ``[num_envs, N, 96]`` that the VAE teacher's
+    encoder and the TCN student read (see :func:`make_observations_cfg`).
+    """
     rewards = make_rewards_cfg(task)
     return ManagerBasedRlEnvCfg(
         scene=_scene(task, num_envs),
-        observations=make_observations_cfg(task),
+        observations=make_observations_cfg(task, history_length),
         actions={
             "joint_pos": JointPositionActionCfg(
                 entity_name="robot", actuator_names=(".*",), scale=task.action_scale, use_default_offset=True

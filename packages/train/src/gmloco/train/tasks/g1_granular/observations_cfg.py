@@ -1,5 +1,5 @@
 # SPDX-License-Identifier: Apache-2.0
-"""Actor (policy) and critic (privileged) observation groups of the granular G1 task."""
+"""Actor (policy), critic (privileged) and optional history observation groups of the granular G1 task."""
 
 from __future__ import annotations
 
@@ -10,7 +10,7 @@ from mjlab.utils.noise import UniformNoiseCfg
 from gmloco.train import mdp
 from gmloco.train.config import GranularTaskCfg
 
-__all__ = ["ACTOR_TERMS", "CRITIC_EXTRA_TERMS", "make_observations_cfg"]
+__all__ = ["ACTOR_TERMS", "CRITIC_EXTRA_TERMS", "HISTORY_GROUP", "make_observations_cfg"]
 
 ACTOR_TERMS = ("base_ang_vel", "projected_gravity", "command", "joint_pos", "joint_vel", "actions")
 """Actor observation terms, in order (29-DoF G1: 3 + 3 + 3 + 29 + 29 + 29 = 96 per frame)."""
@@ -23,6 +23,8 @@ CRITIC_EXTRA_TERMS = (
     "eta",
 )
 """Privileged terms appended to the (noise-free) actor terms in the critic group."""
+HISTORY_GROUP = "history"
+"""Group of the last N actor frames, ``[num_envs, N, 96]`` (oldest first; the teacher encoder and student read it)."""
 
 
 def _noise(half_width: float, scale: float) -> UniformNoiseCfg | None:
@@ -60,11 +62,26 @@ def _critic_terms() -> dict[str, ObservationTermCfg]:
     }
 
 
-def make_observations_cfg(task: GranularTaskCfg) -> dict[str, ObservationGroupCfg]:
-    """Return the ``actor`` and ``critic`` groups (rsl-rl / mjlab group names)."""
+def make_observations_cfg(task: GranularTaskCfg, history_length: int = 0) -> dict[str, ObservationGroupCfg]:
+    """Return the ``actor`` and ``critic`` groups (rsl-rl / mjlab group names), plus ``history`` if asked.
+
+    Args:
+        task: The task config (noise, play mode, stacked actor frames).
+        history_length: N > 0 adds the ``history`` group: the six actor terms over the last N policy steps,
+            ``[num_envs, N, 96]`` (mjlab ``flatten_history_dim=False``), with the actor's noise. 0 leaves it out,
+            so vanilla PPO does not store N frames per env and step in its rollout buffer.
+    """
     history = task.policy_history_length if task.policy_history_length > 1 else None
     noise = 0.0 if task.play else task.obs_noise_scale
-    return {
+    groups = {
         "actor": ObservationGroupCfg(terms=_actor_terms(noise), enable_corruption=noise > 0.0, history_length=history),
         "critic": ObservationGroupCfg(terms=_critic_terms(), enable_corruption=False),
     }
+    if history_length > 0:
+        groups[HISTORY_GROUP] = ObservationGroupCfg(
+            terms=_actor_terms(noise),
+            enable_corruption=noise > 0.0,
+            history_length=history_length,
+            flatten_history_dim=False,
+        )
+    return groups

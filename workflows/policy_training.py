@@ -1,0 +1,162 @@
+# SPDX-License-Identifier: Apache-2.0
+"""Bridge from the training stages' Hydra sections to ``gmloco.train`` (no Hydra here beyond reading a DictConfig).
+
+``train_teacher`` and ``distill`` both run :func:`gmloco.train.train` (time-boxed, resumable, atomic checkpoints);
+they differ only in the rsl-rl entries merged over the PPO runner cfg (``TrainRunCfg.rsl_rl_overrides``), in the
+env's ``history`` group and, for distillation, in the teacher checkpoint loaded first. ``export`` rebuilds the
+same student from these helpers.
+"""
+
+from __future__ import annotations
+
+import math
+import re
+from dataclasses import replace
+from pathlib import Path
+from typing import Any
+
+from omegaconf import DictConfig, OmegaConf
+
+from stage_registry import StageIncompleteError
+
+__all__ = [
+    "distill_overrides",
+    "newest_checkpoint",
+    "ppo_cfg",
+    "run_training",
+    "task_cfg",
+    "teacher_cfg",
+    "torch_device",
+    "vanilla_ppo_overrides",
+]
+
+_CHECKPOINT = re.compile(r"^model_(\d+)\.pt$")
+"""Checkpoint names written by ``gmloco.train``'s runner."""
+_RUN_STATE = ("train_cfg.json", "metrics.json")
+"""Files besides checkpoints that tie a training folder to one config."""
+
+
+def torch_device(device: str) -> str:
+    """Map the pipeline's resolved device (``cpu``, ``cuda``, ``cuda:N``) to a torch / Warp device string."""
+    return "cuda:0" if device == "cuda" else device
+
+
+def newest_checkpoint(folder: str | Path) -> Path:
+    """Return the ``model_<it>.pt`` with the highest iteration in ``folder``.
+
+    Raises:
+        FileNotFoundError: If there is none.
+    """
+    found = [(int(m.group(1)), p) for p in Path(folder).glob("model_*.pt") if (m := _CHECKPOINT.match(p.name))]
+    if not found:
+        raise FileNotFoundError(f"no model_<iteration>.pt checkpoint in {folder}")
+    return max(found)[1]
+
+
+def task_cfg(section: DictConfig) -> Any:
+    """Return the ``GranularTaskCfg`` of a train section: contact model x terrain, stacked actor frames."""
+    from gmloco.train import g1_granular_task
+
+    task = g1_granular_task(str(section.contact_model.value), str(section.terrain.value))  # type: ignore[arg-type]
+    return replace(task, policy_history_length=int(section.policy_history_length))
+
+
+def ppo_cfg(section: DictConfig) -> Any:
+    """Return ``teacher_student.PpoCfg`` from a section's ``ppo`` node."""
+    from gmloco.train.teacher_student import PpoCfg
+
+    values = OmegaConf.to_container(section.ppo, resolve=True, enum_to_str=True)
+    assert isinstance(values, dict)
+    return PpoCfg(**{str(k): v for k, v in values.items()})
+
+
+def vanilla_ppo_overrides(section: DictConfig) -> dict[str, Any]:
+    """Return the ``algorithm`` entry of GM-Loco's PPO runner cfg with the section's PPO settings."""
+    from dataclasses import asdict
+
+    from gmloco.train import make_g1_granular_ppo_cfg
+
+    algorithm = asdict(make_g1_granular_ppo_cfg().algorithm)
+    settings = OmegaConf.to_container(section.ppo, resolve=True, enum_to_str=True)
+    assert isinstance(settings, dict)
+    return {"algorithm": algorithm | {str(k): v for k, v in settings.items()}}
+
+
+def teacher_cfg(section: DictConfig) -> Any:
+    """Return the ``TeacherCfg`` of the ``train_teacher`` section (VAE teacher)."""
+    from gmloco.train.teacher_student import TeacherCfg
+
+    dims = tuple(int(d) for d in section.hidden_dims)
+    return TeacherCfg(
+        actor_hidden_dims=dims,
+        critic_hidden_dims=dims,
+        encoder_hidden_dims=tuple(int(d) for d in section.encoder_hidden_dims),
+        latent_dim=int(section.latent_dim),
+        kl_weight=float(section.kl_weight),
+        ppo=ppo_cfg(section),
+    )
+
+
+def distill_overrides(cfg: DictConfig) -> dict[str, Any]:
+    """Return the student's rsl-rl entries (actor, critic, frozen teacher, StudentPPO, obs groups).
+
+    ``DistillCfg.to_rsl_rl`` also names ``StudentRunner`` and a teacher path; both are dropped: the time-boxed runner
+    of ``gmloco.train.train`` runs StudentPPO, and ``TrainRunCfg.init_checkpoint`` loads the teacher through
+    ``StudentPPO.load`` (which calls ``load_teacher``), as ``StudentRunner`` would.
+    """
+    from gmloco.train.teacher_student import DistillCfg, ObsGroupsCfg, StudentCfg
+
+    teacher_section, section = cfg.train_teacher, cfg.distill
+    teacher = teacher_cfg(teacher_section)
+    student = StudentCfg(
+        actor_hidden_dims=teacher.actor_hidden_dims,
+        history_length=int(teacher_section.history_length),
+        tcn_channels=tuple(int(c) for c in section.tcn_channels),  # type: ignore[arg-type]
+    )
+    distill = DistillCfg(curriculum_finish=int(section.curriculum_finish), ppo=ppo_cfg(section))
+    entries = distill.to_rsl_rl(teacher, student, ObsGroupsCfg())
+    for key in ("class_name", "teacher_checkpoint"):
+        entries.pop(key)
+    return entries
+
+
+def _start_fresh(run_dir: Path) -> None:
+    """Delete the checkpoints and run files of an earlier config (the stage was forced or its config changed)."""
+    for p in [*run_dir.glob("model_*.pt"), *(run_dir / name for name in _RUN_STATE)]:
+        p.unlink(missing_ok=True)
+
+
+def run_training(cfg: DictConfig, name: str, **run_cfg: Any) -> dict[str, float | None]:
+    """Run ``gmloco.train.train`` for stage ``name``; raise ``StageIncompleteError`` when its time box stopped it.
+
+    Args:
+        cfg: The pipeline config (the stage's section is ``cfg[name]``).
+        name: ``train_teacher`` or ``distill``.
+        **run_cfg: ``TrainRunCfg`` fields that depend on the stage (task, overrides, history, ...).
+
+    Returns:
+        ``train``'s metrics, with non-finite values as None.
+    """
+    from gmloco.train import TrainRunCfg, train
+
+    section = cfg[name]
+    out = Path(section.out_dir)
+    if not section.resume:
+        _start_fresh(out)
+    metrics = train(
+        TrainRunCfg(
+            num_envs=int(section.num_envs),
+            max_iterations=int(section.max_iterations),
+            max_minutes=None if section.max_minutes is None else float(section.max_minutes),
+            seed=int(cfg.seed),
+            device=torch_device(str(cfg.device)),
+            run_dir=str(out),
+            save_interval=int(section.save_interval),
+            num_steps_per_env=int(section.num_steps_per_env),
+            **run_cfg,
+        )
+    )
+    if metrics.get("stopped_by_deadline"):
+        it, total = int(metrics["iteration"]), int(section.max_iterations)
+        raise StageIncompleteError(f"time box reached at iteration {it} of {total}; checkpoint model_{it}.pt saved")
+    return {k: (float(v) if math.isfinite(v) else None) for k, v in metrics.items()}
