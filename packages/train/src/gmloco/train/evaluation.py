@@ -5,6 +5,9 @@ Every env is one cell (material, commanded forward speed, repeat). An env fails 
 than 0.2 m above the sand or |roll| or |pitch| exceeds pi/4 before ``duration_s`` (GM-Loco metrics); the
 first episode of each env counts. Tracking errors average over the steps an env is alive:
 ``vel_error`` = |v_xy - v_cmd| [m/s] in the yaw frame, ``yaw_rate_error`` = |w_z - w_cmd| [rad/s].
+
+With ``EvalCfg.record_dir`` set, the first env of every (material, speed) cell is also recorded in the project's
+MCAP log schema (:mod:`gmloco.train.recording`), one file per cell, until it fails or the episode ends.
 """
 
 from __future__ import annotations
@@ -55,6 +58,13 @@ class EvalCfg:
     """Env seed."""
     out_path: str | None = None
     """If set, write the metrics as JSON here."""
+    record_dir: str | None = None
+    """If set, record env 0 of each (material, speed) cell to ``<record_dir>/g1_<label>_<material>_v<speed>.mcap``
+    (:mod:`gmloco.train.recording`; existing files are not overwritten)."""
+    record_label: str | None = None
+    """Policy name in the recordings' ``controller = "policy:<label>"``; None: the ONNX ``run_path`` metadata."""
+    record_notes: str = ""
+    """Free text for the recordings' run metadata (e.g. how far the policy is validated)."""
 
 
 def _read_metadata(path: str) -> dict[str, str]:
@@ -110,7 +120,50 @@ def _pin_cells(env: Any, cells: list[tuple[str, float]]) -> torch.Tensor:
     return as_t([[s, 0.0, 0.0] for _, s in cells])
 
 
-def _rollout(env: Any, session: Any, commands: torch.Tensor, steps: int) -> dict[str, np.ndarray]:
+def _make_recorders(cfg: EvalCfg, env: Any, meta: dict[str, str], cells: list[tuple[str, float]]) -> list[Any]:
+    """One :class:`~gmloco.train.recording.EnvRecorder` per (material, speed) cell, on the cell's first env."""
+    from gmloco.train.recording import (
+        EnvRecorder,
+        RecordingCfg,
+        policy_label,
+        policy_run_metadata,
+        recording_file_name,
+    )
+
+    assert cfg.record_dir is not None
+    label = cfg.record_label or policy_label(cfg.policy_path, meta)
+    model = cfg.contact_model or meta.get("contact_model", "rft3d")
+    recorders = []
+    for m, s in dict.fromkeys(cells):
+        k = cells.index((m, s))
+        metadata = policy_run_metadata(
+            policy_path=cfg.policy_path,
+            onnx_meta=meta,
+            material=m,
+            contact_model=model,
+            terrain=cfg.terrain,
+            control_rate_hz=1.0 / env.step_dt,
+            label=label,
+            notes=cfg.record_notes,
+            extra={
+                "command": {"lin_vel_x": s, "lin_vel_y": 0.0, "ang_vel_z": 0.0},
+                "duration_s": cfg.duration_s,
+                "env_index": k,
+                "num_envs": env.num_envs,
+                "seed": cfg.seed,
+                "physics_dt": env.physics_dt,
+                "failure": {"min_base_height": cfg.min_base_height, "max_tilt": cfg.max_tilt},
+                "floor": {"enabled": cfg.floor.enabled, "depth_range": list(cfg.floor.depth_range)},
+            },
+        )
+        path = Path(cfg.record_dir) / recording_file_name(label, m, s)
+        recorders.append(EnvRecorder(env, path, metadata, RecordingCfg(env_index=k)))
+    return recorders
+
+
+def _rollout(
+    env: Any, session: Any, commands: torch.Tensor, steps: int, recorders: list[Any] | None = None
+) -> dict[str, np.ndarray]:
     """Run the policy; return per-env alive steps, summed velocity and yaw-rate errors, failure flags."""
     from mjlab.utils.lab_api.math import quat_apply_inverse, yaw_quat
 
@@ -128,7 +181,11 @@ def _rollout(env: Any, session: Any, commands: torch.Tensor, steps: int) -> dict
         actor_obs = obs["actor"].cpu().numpy().astype(np.float32)
         # mjlab exports a batch-1 graph (no dynamic axes): one call per env.
         action = np.concatenate([session.run(None, {name: actor_obs[i : i + 1]})[0] for i in range(n)])
+        for rec in recorders or ():
+            rec.before_step(actor_obs, action)
         obs, _, terminated, _, _ = env.step(torch.as_tensor(action, device=env.device))
+        for rec in recorders or ():
+            rec.after_step(terminated)
         data = robot.data
         v_yaw = quat_apply_inverse(yaw_quat(data.root_link_quat_w), data.root_link_lin_vel_w)
         alive &= ~terminated
@@ -162,11 +219,19 @@ def evaluate_policy(cfg: EvalCfg) -> dict[str, float]:
     meta = _read_metadata(cfg.policy_path)
     cells = _cells(cfg)
     env = _build_env(cfg, meta, len(cells))
+    recorders: list[Any] = []
     try:
         commands = _pin_cells(env, cells)
         session = ort.InferenceSession(cfg.policy_path, providers=["CPUExecutionProvider"])
-        raw = _rollout(env, session, commands, round(cfg.duration_s / env.step_dt))
+        if cfg.record_dir is not None:
+            recorders = _make_recorders(cfg, env, meta, cells)
+        raw = _rollout(env, session, commands, round(cfg.duration_s / env.step_dt), recorders)
+        for rec in recorders:
+            rec.close("completed")
     finally:
+        for rec in recorders:
+            if not rec.closed:
+                rec.close("exception during evaluation")
         env.close()
     metrics = _summarize(cells, raw)
     if cfg.out_path is not None:
