@@ -10,11 +10,13 @@ import warp as wp
 __all__ = [
     "TerrainData",
     "eval_foot_wrench",
+    "eval_foot_wrench_tiled",
     "eval_scatter_values",
     "foot_point_kinematics",
     "media_scaling",
     "point_material",
     "terrain_height",
+    "tile_block_dim",
 ]
 
 HEIGHT_FLAT = wp.constant(0)
@@ -145,6 +147,78 @@ def eval_foot_wrench(model: Any, inputs: tuple, wrench_out: wp.array2d) -> None:
         dim=(model.num_worlds, model.num_feet),
         inputs=[model.points_b, foot_pos, foot_mat, foot_com, model.point_force],
         outputs=[wrench_out, model.nan_count],
+        device=model.device,
+    )
+
+
+def tile_block_dim(num_points: int) -> int:
+    """Threads per foot block of the tiled kernels: P rounded up to whole warps, at most 256 (CPU: resolves to 1)."""
+    return min(256, 32 * ((num_points + 31) // 32))
+
+
+@wp.func
+def foot_inputs_finite(pos: wp.vec3, rot: wp.mat33, lin_vel: wp.vec3, ang_vel: wp.vec3) -> bool:
+    """Return whether a foot's pose and velocities are all finite (else its elements get zero force)."""
+    return wp.isfinite(pos) and wp.isfinite(rot) and wp.isfinite(lin_vel) and wp.isfinite(ang_vel)
+
+
+@wp.func
+def foot_wrench_block_sum(
+    partial: wp.spatial_vector, pos: wp.vec3, rot: wp.mat33, com: wp.vec3, lane: int, nan_count_out: wp.array[int]
+) -> wp.spatial_vector:
+    """Sum the lanes' partial (force, torque about the CoM) over the block; zero for a non-finite foot pose.
+
+    Every lane must call this (tile collective). The lanes' partials are summed by ``wp.tile_sum`` in a fixed
+    tree order (deterministic; on CPU the block is one lane, so the order is the plain p = 0..P-1 loop of
+    :func:`foot_wrench_kernel`). A non-finite CoM alone counts once in ``nan_count_out`` (pose and velocity
+    are counted per element).
+    """
+    total = wp.tile_extract(wp.tile_sum(wp.tile(partial, preserve_type=True)), 0)
+    if not (wp.isfinite(pos) and wp.isfinite(rot) and wp.isfinite(com)):
+        if lane == 0 and wp.isfinite(pos) and wp.isfinite(rot):
+            wp.atomic_add(nan_count_out, 0, 1)
+        return wp.spatial_vector(0.0, 0.0, 0.0, 0.0, 0.0, 0.0)
+    return total
+
+
+@wp.kernel
+def foot_wrench_tiled_kernel(
+    # Model:
+    points_b: wp.array[wp.vec3],
+    # Data in:
+    foot_pos_in: wp.array2d[wp.vec3],
+    foot_mat_in: wp.array2d[wp.mat33],
+    foot_com_in: wp.array2d[wp.vec3],
+    point_force_in: wp.array3d[wp.vec3],
+    # Data out:
+    wrench_out: wp.array2d[wp.spatial_vector],
+    nan_count_out: wp.array[int],
+) -> None:
+    """Per-foot sum as :func:`foot_wrench_kernel`, one block per foot: lanes stride over the points, then a tile sum."""
+    worldid, footid, lane = wp.tid()
+    pos = foot_pos_in[worldid, footid]
+    rot = foot_mat_in[worldid, footid]
+    com = foot_com_in[worldid, footid]
+    force = wp.vec3(0.0)
+    torque = wp.vec3(0.0)
+    for p in range(lane, points_b.shape[0], wp.block_dim()):
+        f = point_force_in[worldid, footid, p]
+        force += f
+        torque += wp.cross(pos + rot * points_b[p] - com, f)
+    wrench = foot_wrench_block_sum(wp.spatial_vector(force, torque), pos, rot, com, lane, nan_count_out)
+    if lane == 0:
+        wrench_out[worldid, footid] = wrench
+
+
+def eval_foot_wrench_tiled(model: Any, inputs: tuple, wrench_out: wp.array) -> None:
+    """Launch :func:`foot_wrench_tiled_kernel` over [num_worlds, num_feet] blocks of :func:`tile_block_dim` lanes."""
+    foot_pos, foot_mat, _, _, foot_com = inputs
+    wp.launch_tiled(
+        foot_wrench_tiled_kernel,
+        dim=(model.num_worlds, model.num_feet),
+        inputs=[model.points_b, foot_pos, foot_mat, foot_com, model.point_force],
+        outputs=[wrench_out, model.nan_count],
+        block_dim=tile_block_dim(model.num_points),
         device=model.device,
     )
 

@@ -10,8 +10,18 @@ import numpy as np
 import warp as wp
 
 from gmloco.contact.colliders import ColliderPoints
-from gmloco.contact.kernels_geometry import TerrainData, eval_foot_wrench, eval_scatter_values
-from gmloco.contact.kernels_state import AT_REST_CODES, eval_reset_state, eval_state_update
+from gmloco.contact.kernels_geometry import (
+    TerrainData,
+    eval_foot_wrench,
+    eval_foot_wrench_tiled,
+    eval_scatter_values,
+)
+from gmloco.contact.kernels_state import (
+    AT_REST_CODES,
+    eval_reset_state,
+    eval_state_update,
+    eval_state_update_from_kinematics,
+)
 from gmloco.contact.materials import MATERIAL_PRESETS, eta, validate_material_arrays
 from gmloco.contact.terrain import HEIGHT_KINDS, TerrainCfg
 
@@ -54,14 +64,23 @@ class ContactModel:
     Attributes:
         point_depth: Element depth below the local free surface [m], wp.array3d[float] [W, F, P].
         point_force: Element force of the medium on the foot [N], wp.array3d[wp.vec3] [W, F, P].
+        point_vel: Element velocity [m/s], wp.array3d[wp.vec3] [W, F, P]. point_depth / point_force / point_vel
+            are written by compute() (the last call's inputs); update_state() does not rewrite them.
+        force_prev: Previous substep's element force [N], [W, F, P]: kept only in ``at_rest="ema"``, the only
+            mode that reads it (the fast update_state skips it in the other modes).
         nan_count: Count of non-finite element inputs seen by compute() (one per element per call), [1].
         eta: Normalized stiffness xi / xi_max of each world's material (paper definition) [-], [W].
         eta_log: Log-scaled normalized stiffness (materials.eta scale="log") [-], [W].
     """
 
     is_rigid: bool = False
+    fused: bool = True
+    """Fast kernels (default): tiled per-foot sums, the model's fused points + wrench pass where it has one, and
+    update_state() without a force pass. False: the previous per-point pass, one-thread-per-foot sum and
+    recomputing update_state (kept as the parity oracle and for benchmarks; same results to float32 round-off)."""
     _vertical_only: int = 0
     _eval_points: Callable[[Any, tuple, wp.array], None]
+    _eval_fused: Callable[[Any, tuple, wp.array], None] | None = None
 
     def __init__(
         self,
@@ -181,10 +200,14 @@ class ContactModel:
             wrench_out: Output, wp.array2d[wp.spatial_vector] [W, F], MuJoCo ``xfrc_applied`` layout.
         """
         inputs = (foot_pos_w, foot_mat_w, foot_lin_vel_w, foot_ang_vel_w, foot_com_w)
+        if self.fused and self._eval_fused is not None:
+            # 1+2. one block per foot: element forces, depths, velocities and the block's tile sum, one launch
+            self._eval_fused(self, inputs, wrench_out)
+            return
         # 1. element forces, depths and velocities from the kinematics and the (read-only) state
         self._eval_points(self, inputs, self.nan_count)
-        # 2. per-foot sum of forces and of moments about the CoM, fixed order
-        eval_foot_wrench(self, inputs, wrench_out)
+        # 2. per-foot sum of forces and of moments about the CoM, fixed order (tiled: one block per foot)
+        (eval_foot_wrench_tiled if self.fused else eval_foot_wrench)(self, inputs, wrench_out)
 
     def update_state(
         self,
@@ -198,12 +221,25 @@ class ContactModel:
 
         After ``mj_step`` MuJoCo's ``xpos``/``xmat``/``cvel`` still hold the pre-integration kinematics that the
         passive callback saw, so reading them after the step gives exactly those inputs.
+
+        Contract: the new state depends only on these inputs and the current state, never on what compute()
+        left in ``point_*`` (compute() may run any number of times per substep, e.g. again in ``sim.forward()``,
+        or not at all). The update needs each element's depth and velocity (z_max, reversal counter, previous
+        velocity), which it recomputes from the inputs in one launch with the kinematics functions compute()
+        uses (cheaper than storing and re-reading them, and immune to a later compute() with other inputs); no
+        element force is evaluated. ``at_rest="ema"`` (and ``fused=False``) keeps the previous path, which
+        re-evaluates the element forces because the EMA's ``force_prev`` is the filtered force.
         """
         inputs = (foot_pos_w, foot_mat_w, foot_lin_vel_w, foot_ang_vel_w, foot_com_w)
+        ema_rate = getattr(self.cfg, "ema_rate", 0.0)
+        if self.fused and self.at_rest_code != AT_REST_CODES["ema"]:
+            # z_max, EMA rigidity, previous velocity from recomputed element depth and velocity, one launch
+            eval_state_update_from_kinematics(self, inputs, ema_rate, self._vertical_only)
+            return
         # 1. recompute the element forces of this substep (not counted twice in nan_count)
         self._eval_points(self, inputs, self._scratch_count)
         # 2. z_max, EMA rigidity, previous force and velocity
-        eval_state_update(self, getattr(self.cfg, "ema_rate", 0.0), self._vertical_only)
+        eval_state_update(self, ema_rate, self._vertical_only)
 
     def reset(self, env_ids: Any = None) -> None:
         """Clear the state of the given worlds (all when None)."""

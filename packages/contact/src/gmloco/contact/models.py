@@ -22,7 +22,7 @@ from gmloco.contact.config import (
 )
 from gmloco.contact.kernels_cone import eval_cone_point_forces
 from gmloco.contact.kernels_rft2d import eval_heuristic_point_forces
-from gmloco.contact.kernels_rft3d import eval_rft3d_point_forces
+from gmloco.contact.kernels_rft3d import RFT3DCoeffs, eval_rft3d_foot_wrench, eval_rft3d_point_forces
 from gmloco.contact.kernels_state import eval_zero_wrench
 from gmloco.contact.model_base import ContactModel
 from gmloco.contact.terrain import TerrainCfg
@@ -42,13 +42,17 @@ class ContactRFT3D(ContactModel):
     """3D-RFT (PNAS 2023) on every collider element."""
 
     _eval_points = staticmethod(eval_rft3d_point_forces)
+    _eval_fused = staticmethod(eval_rft3d_foot_wrench)
 
     def __init__(
         self, cfg: ContactRFT3DCfg, num_worlds: int, num_feet: int, device: str, terrain: TerrainCfg | None = None
     ) -> None:
         """Build from ``cfg``; see :class:`ContactModel`."""
         super().__init__(cfg, num_worlds, num_feet, device, terrain, box_collider(cfg.collider))
-        self.coeffs = wp.array(resolve_rft3d_coeffs(cfg.coeffs), dtype=float, device=device)
+        coeffs = np.asarray(resolve_rft3d_coeffs(cfg.coeffs), dtype=np.float32)
+        self.coeffs = wp.array(coeffs, dtype=float, device=device)
+        self.coeffs_by_value = RFT3DCoeffs(coeffs)
+        """The same 20 x 3 coefficients as a by-value kernel parameter (fused path)."""
 
 
 class ContactHeuristicRFT(ContactModel):
