@@ -14,7 +14,7 @@ from omegaconf import DictConfig
 from pipeline_run import EXIT_FAILED, EXIT_INCOMPLETE, EXIT_OK, run_pipeline
 from run_dir import read_json
 from stage_registry import StageIncompleteError, not_implemented
-from tests.pipeline_helpers import CALLS, toy_registry
+from tests.pipeline_helpers import CALLS, toy_registry, toy_teacher
 
 Compose = Callable[..., DictConfig]
 
@@ -153,3 +153,23 @@ def test_stage_selection(run: Callable[..., dict[str, Any]]) -> None:
     assert s["train_teacher"] == "done" and s["distill"] == "disabled"
     s = _statuses(run("stages=[distill]"))
     assert (s["train_teacher"], s["distill"]) == ("disabled", "done")
+
+
+def test_stage_is_told_whether_to_resume(run: Callable[..., dict[str, Any]]) -> None:
+    """``<stage>.resume``: true on a first run and after an incomplete one; false when forced or the config changed."""
+    seen: list[bool] = []
+    stop = [True]
+
+    def teacher(cfg: Any) -> dict[str, float]:
+        seen.append(bool(cfg.train_teacher.resume))
+        if stop[0]:
+            raise StageIncompleteError("time box")
+        return toy_teacher(cfg)
+
+    registry = toy_registry(teacher=teacher)
+    run(registry=registry)  # first attempt stops at its time box
+    stop[0] = False
+    run(registry=registry)  # same config: continue
+    run("force=[train_teacher]", registry=registry)  # forced: start fresh
+    run("train_teacher.num_envs=8", registry=registry)  # another config: start fresh
+    assert seen == [True, True, False, False]

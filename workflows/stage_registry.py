@@ -1,7 +1,8 @@
 # SPDX-License-Identifier: Apache-2.0
 """The pipeline's stages, in order, with the issue that implements each one.
 
-To implement a stage, replace ``run = not_implemented("<stage>")`` in ``workflows/<stage>.py`` with a real
+To implement a stage (today only ``eval_mpm`` is missing), replace ``run = not_implemented("<stage>")`` in
+``workflows/<stage>.py`` with a real
 ``def run(cfg: DictConfig) -> dict[str, float]`` that writes its files under ``cfg.<stage>.out_dir`` and
 returns its metrics. Nothing here needs to change unless the stage's inputs (``needs``) change.
 """
@@ -48,7 +49,7 @@ class StageSpec:
 
 
 STAGES: tuple[StageSpec, ...] = (
-    StageSpec("train_teacher", (4, 6), (), "PPO teacher with VAE terrain encoder on mjlab + granular contact"),
+    StageSpec("train_teacher", (4, 6), (), "PPO (ppo_*) or VAE teacher (gm_loco) on mjlab + granular contact"),
     StageSpec("distill", (6,), ("train_teacher",), "TCN student, DAgger + PPO distillation"),
     StageSpec("export", (6,), ("distill",), "ONNX student with deploy metadata + CPU runner check"),
     StageSpec("eval_mpm", (9,), ("export",), "G1 on Newton implicit-MPM sand, paper metrics"),
