@@ -7,6 +7,13 @@ times ``model.compute`` (the stateless part that runs inside the passive callbac
 ``model.update_state``, each captured in a CUDA graph of ``--reps`` launches. The reference is one physics
 substep of mjlab's stock G1 (``env.sim.step()``, rigid contact) at the same world count, built in the same
 process.
+
+``--paths fused,reference`` (default) times both kernel paths of each model: ``fused`` (``model.fused = True``,
+the default: 3D-RFT points + per-foot tile sum in one launch, tiled sums for the other models, update_state
+without a force pass) under the plain key (``rft3d/150pt``) and ``reference`` (``model.fused = False``: the
+previous per-point pass, one-thread-per-foot loop and recomputing update_state) under ``<key>/reference``.
+Each fused record also carries ``wrench_max_rel_diff_vs_reference``: max |W_fused - W_ref| / max |W_ref| on
+the benchmark state after one compute (float32 round-off expected, ~1e-6).
 """
 
 from __future__ import annotations
@@ -28,6 +35,7 @@ def _parse() -> argparse.Namespace:
     p.add_argument("--reps", type=int, default=200)
     p.add_argument("--device", default="cuda:0")
     p.add_argument("--skip-sim", action="store_true", help="do not build the G1 env for the step reference")
+    p.add_argument("--paths", default="fused,reference", help="comma list of kernel paths: fused, reference")
     p.add_argument("--out", type=Path, default=Path("bench_contact.json"))
     return p.parse_args()
 
@@ -87,8 +95,25 @@ def _foot_state(num_worlds: int, device: str, seed: int = 0) -> tuple[Any, ...]:
     )
 
 
-def bench_models(num_worlds: int, reps: int, device: str) -> dict[str, dict[str, float]]:
-    """Seconds per launch of each model's compute / update_state for 25 and 150 points per foot."""
+def _wrench_rel_diff(cfg: Any, num_worlds: int, device: str, material: Any) -> float:
+    """Max |W_fused - W_reference| / max |W_reference| of one compute() on the benchmark state."""
+    from gmloco.contact import make_contact_model
+
+    out = []
+    for fused in (True, False):
+        model = make_contact_model(cfg, num_worlds, 2, device)
+        model.fused = fused
+        w = np.ones(num_worlds)
+        model.set_materials(w * material.rho_c, w * material.mu_int, w * material.mu_surf)
+        state = _foot_state(num_worlds, device)
+        model.update_state(*state[:5])  # z_max at the current depth: the same branch mix as the timed loop
+        model.compute(*state)
+        out.append(state[5].numpy().astype(np.float64))
+    return float(np.abs(out[0] - out[1]).max() / max(np.abs(out[1]).max(), 1e-30))
+
+
+def bench_models(num_worlds: int, reps: int, device: str, paths: list[str]) -> dict[str, dict[str, float]]:
+    """Seconds per launch of each model's compute / update_state for 25 and 150 points per foot, per path."""
     from gmloco.contact import (
         MATERIAL_PRESETS,
         ColliderBoxCfg,
@@ -112,16 +137,20 @@ def bench_models(num_worlds: int, reps: int, device: str) -> dict[str, dict[str,
         for name, cfg in cfgs.items():
             if name == "cone_single" and faces == "box":
                 continue  # one point per foot whatever the collider
-            model = make_contact_model(cfg, num_worlds, 2, device)
-            w = np.ones(num_worlds)
-            model.set_materials(w * sand.rho_c, w * sand.mu_int, w * sand.mu_surf)
-            state = _foot_state(num_worlds, device)
-            key = f"{name}/{points if name != 'cone_single' else 1}pt"
-            rec = {"compute_s": _time_graph(lambda m=model, s=state: m.compute(*s), reps, device)}
-            if getattr(model, "is_stateful", False):
-                rec["update_state_s"] = _time_graph(lambda m=model, s=state: m.update_state(*s[:5]), reps, device)
-            out[key] = rec
-            print(key, rec, flush=True)
+            for path in paths:
+                model = make_contact_model(cfg, num_worlds, 2, device)
+                model.fused = path == "fused"
+                w = np.ones(num_worlds)
+                model.set_materials(w * sand.rho_c, w * sand.mu_int, w * sand.mu_surf)
+                state = _foot_state(num_worlds, device)
+                key = f"{name}/{points if name != 'cone_single' else 1}pt" + ("" if path == "fused" else f"/{path}")
+                rec = {"compute_s": _time_graph(lambda m=model, s=state: m.compute(*s), reps, device)}
+                if getattr(model, "is_stateful", False):
+                    rec["update_state_s"] = _time_graph(lambda m=model, s=state: m.update_state(*s[:5]), reps, device)
+                if path == "fused" and "reference" in paths:
+                    rec["wrench_max_rel_diff_vs_reference"] = _wrench_rel_diff(cfg, num_worlds, device, sand)
+                out[key] = rec
+                print(key, rec, flush=True)
     return out
 
 
@@ -162,7 +191,8 @@ def main() -> None:
         "num_worlds": args.num_worlds,
         "reps": args.reps,
     }
-    res["models"] = bench_models(args.num_worlds, args.reps, args.device)
+    res["paths"] = args.paths.split(",")
+    res["models"] = bench_models(args.num_worlds, args.reps, args.device, res["paths"])
     if not args.skip_sim:
         res.update(bench_step(args.num_worlds, args.device))
         step = res["g1_substep_s"]
