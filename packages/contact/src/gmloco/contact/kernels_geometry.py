@@ -139,7 +139,7 @@ def foot_wrench_kernel(
     wrench_out[worldid, footid] = wp.spatial_vector(force, torque)
 
 
-def eval_foot_wrench(model: Any, inputs: tuple, wrench_out: wp.array2d) -> None:
+def eval_foot_wrench(model: Any, inputs: tuple, wrench_out: wp.array) -> None:
     """Launch :func:`foot_wrench_kernel` over [num_worlds, num_feet]."""
     foot_pos, foot_mat, _, _, foot_com = inputs
     wp.launch(

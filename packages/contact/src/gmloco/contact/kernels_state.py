@@ -223,6 +223,6 @@ def zero_wrench_kernel(
     wrench_out[w, f] = wp.spatial_vector(0.0, 0.0, 0.0, 0.0, 0.0, 0.0)
 
 
-def eval_zero_wrench(model: Any, wrench_out: wp.array2d) -> None:
+def eval_zero_wrench(model: Any, wrench_out: wp.array) -> None:
     """Launch :func:`zero_wrench_kernel` over [num_worlds, num_feet]."""
     wp.launch(zero_wrench_kernel, dim=(model.num_worlds, model.num_feet), outputs=[wrench_out], device=model.device)

@@ -182,12 +182,12 @@ class ContactModel:
 
     def compute(
         self,
-        foot_pos_w: wp.array2d,
-        foot_mat_w: wp.array2d,
-        foot_lin_vel_w: wp.array2d,
-        foot_ang_vel_w: wp.array2d,
-        foot_com_w: wp.array2d,
-        wrench_out: wp.array2d,
+        foot_pos_w: wp.array,
+        foot_mat_w: wp.array,
+        foot_lin_vel_w: wp.array,
+        foot_ang_vel_w: wp.array,
+        foot_com_w: wp.array,
+        wrench_out: wp.array,
     ) -> None:
         """Write each foot's wrench (force, torque about its CoM; world frame) without touching model state.
 
@@ -211,11 +211,11 @@ class ContactModel:
 
     def update_state(
         self,
-        foot_pos_w: wp.array2d,
-        foot_mat_w: wp.array2d,
-        foot_lin_vel_w: wp.array2d,
-        foot_ang_vel_w: wp.array2d,
-        foot_com_w: wp.array2d,
+        foot_pos_w: wp.array,
+        foot_mat_w: wp.array,
+        foot_lin_vel_w: wp.array,
+        foot_ang_vel_w: wp.array,
+        foot_com_w: wp.array,
     ) -> None:
         """Advance the memory once per physics substep, with the kinematics compute() used in that substep.
 

@@ -145,12 +145,12 @@ class ContactRigid(ContactModel):
 
     def compute(
         self,
-        foot_pos_w: wp.array2d,
-        foot_mat_w: wp.array2d,
-        foot_lin_vel_w: wp.array2d,
-        foot_ang_vel_w: wp.array2d,
-        foot_com_w: wp.array2d,
-        wrench_out: wp.array2d,
+        foot_pos_w: wp.array,
+        foot_mat_w: wp.array,
+        foot_lin_vel_w: wp.array,
+        foot_ang_vel_w: wp.array,
+        foot_com_w: wp.array,
+        wrench_out: wp.array,
     ) -> None:
         """Write zero wrenches."""
         eval_zero_wrench(self, wrench_out)

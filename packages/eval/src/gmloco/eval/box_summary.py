@@ -59,7 +59,7 @@ def score_model(
 def _best(scores: dict[str, dict], metric: str) -> str | None:
     """Return the model with the lowest value of ``metric`` (None if no model has it)."""
     have = {m: s[metric] for m, s in scores.items() if metric in s}
-    return min(have, key=have.get) if have else None
+    return min(have, key=lambda m: have[m]) if have else None
 
 
 def summarize_study(records: StudyRecords, cfg: Any, models: list[str]) -> dict[str, Any]:

@@ -154,7 +154,7 @@ def simulate_rom_box(
     dev = cfg.device
     arrs = {k: wp.zeros((n, 1), dtype=t, device=dev) for k, t in
             (("pos", wp.vec3), ("mat", wp.mat33), ("lin", wp.vec3), ("ang", wp.vec3), ("com", wp.vec3))}  # fmt: skip
-    wrench = wp.zeros((n, 1), dtype=wp.spatial_vector, device=dev)
+    wrench = wp.zeros((n, 1), dtype=wp.spatial_vectorf, device=dev)  # = wp.spatial_vector, typed as a dtype class
     steps_per_log = max(1, round(cfg.log_dt / cfg.dt))
     num_logs = round(box.duration / cfg.log_dt)
     out_pos, out_quat, out_grf = np.zeros((n, num_logs, 3)), np.zeros((n, num_logs, 4)), np.zeros((n, num_logs, 3))

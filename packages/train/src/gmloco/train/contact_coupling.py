@@ -85,7 +85,7 @@ class ContactCoupling:
         """Foot angular velocity [rad/s], world frame, shape [W, F]."""
         self.foot_com_w = wp.zeros(shape, dtype=wp.vec3, device=device)
         """Foot body CoM position [m], world frame, shape [W, F]."""
-        self.wrench = wp.zeros(shape, dtype=wp.spatial_vector, device=device)  # type: ignore[arg-type]
+        self.wrench = wp.zeros(shape, dtype=wp.spatial_vectorf, device=device)  # = wp.spatial_vector, typed as a class
         """Granular wrench (force [N], torque about CoM [N m]), world frame, shape [W, F]."""
         self.wrench_torch = wp.to_torch(self.wrench).view(*shape, 6)
         """Zero-copy torch view of :attr:`wrench`, shape [W, F, 6]."""

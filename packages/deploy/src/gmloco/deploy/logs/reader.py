@@ -177,7 +177,7 @@ def _check_units(path: Path, meta: RunMetadata) -> None:
         raise UnitsError(f"{path}: units differ from the schema ({lines}). Convert to SI units before logging.")
 
 
-def _group(scan: Any, meta_record: dict[str, str]) -> tuple[dict[str, list], dict[int, Any]]:
+def _group(scan: Any, meta_record: dict[str, str]) -> tuple[dict[str, list], dict[str, Any]]:
     """Group messages by topic, recovering lost channel records from the metadata channel map."""
     channels = dict(scan.channels)
     cmap = json.loads(meta_record.get("channel_map", "{}"))

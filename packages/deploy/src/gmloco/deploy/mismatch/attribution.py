@@ -132,10 +132,14 @@ def _lm(pb: Problem, hyp: Hypothesis, cfg: AttributionCfg) -> tuple[np.ndarray, 
     spec, m = hyp.spec, pb.train
     lo, hi = spec.bounds()
     steps = spec.flat("fd_step")
+    if hyp.theta_lin is None:
+        raise ValueError(f"effect {spec.id!r}: screen() must set theta_lin before the nonlinear fit")
+    if cfg.max_iter < 1:
+        raise ValueError(f"AttributionCfg.max_iter must be >= 1 (the fit returns a Jacobian), got {cfg.max_iter}")
     theta = hyp.theta_lin.copy()
     r = pb.resid(_sim_params(spec, theta), m).ravel()
     lam = 1e-3
-    J = None
+    J = np.empty((r.size, spec.size))
     for _ in range(cfg.max_iter):
         J = np.empty((r.size, spec.size))
         for i in range(spec.size):

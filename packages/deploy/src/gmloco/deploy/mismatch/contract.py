@@ -68,11 +68,12 @@ def joint_ranges() -> dict[str, tuple[float, float]]:
     from gmloco.deploy.mismatch.g1model import g1_mjcf_path
 
     root = ET.parse(g1_mjcf_path()).getroot()
-    out = {}
+    out: dict[str, tuple[float, float]] = {}
     for j in root.iter("joint"):
-        if j.get("range") and j.get("name"):
-            lo, hi = (float(x) for x in j.get("range").split())
-            out[j.get("name")] = (lo, hi)
+        name, rng = j.get("name"), j.get("range")
+        if rng and name:
+            lo, hi = (float(x) for x in rng.split())
+            out[name] = (lo, hi)
     return out
 
 

@@ -43,15 +43,13 @@ def read_recording(path: str | Path, rate_hz: float | None = None) -> Recording:
     get = lambda name, hold=False: _resample(*log.signal(name), t, hold)  # noqa: E731
     quat = get("imu.quaternion")
     quat /= np.linalg.norm(quat, axis=1, keepdims=True)
-    kw = {}
+    base_pos = base_quat = base_linvel = base_angvel = None
     if log.has("odom.position"):
         oq = get("odom.orientation")
-        kw = dict(
-            base_pos=get("odom.position"),
-            base_quat=oq / np.linalg.norm(oq, axis=1, keepdims=True),
-            base_linvel=get("odom.linear_velocity"),
-            base_angvel=get("odom.angular_velocity"),
-        )
+        base_pos = get("odom.position")
+        base_quat = oq / np.linalg.norm(oq, axis=1, keepdims=True)
+        base_linvel = get("odom.linear_velocity")
+        base_angvel = get("odom.angular_velocity")
     tau = get("lowstate.tau_est") if log.has("lowstate.tau_est") else np.zeros_like(_resample(ts, q, t, False))
     return Recording(
         t=t - t[0],
@@ -68,7 +66,10 @@ def read_recording(path: str | Path, rate_hz: float | None = None) -> Recording:
         imu_acc=get("imu.accelerometer"),
         valid=near <= 1.5 / rate,
         meta={"path": str(path), "controller": log.metadata.controller, "material": log.metadata.material},
-        **kw,
+        base_pos=base_pos,
+        base_quat=base_quat,
+        base_linvel=base_linvel,
+        base_angvel=base_angvel,
     )
 
 
@@ -79,6 +80,7 @@ def write_recording(rec: Recording, path: str | Path, controller: str = "unknown
 
     meta = RunMetadata(controller=controller, source="real", contact_model="hardware", lowstate_rate_hz=1.0 / rec.dt)
     valid = rec.valid_mask()
+    odom = rec.odometry()
     with G1LogWriter(path, meta, LogWriterCfg(overwrite=overwrite)) as w:
         for k in range(rec.n):
             if not valid[k]:
@@ -86,6 +88,7 @@ def write_recording(rec: Recording, path: str | Path, controller: str = "unknown
             t = float(rec.t[k])
             w.write_lowstate(t, rec.q[k], rec.dq[k], rec.tau_est[k], rec.imu_quat[k], rec.imu_gyro[k], rec.imu_acc[k])
             w.write_lowcmd(t, rec.q_cmd[k], rec.dq_cmd[k], rec.kp[k], rec.kd[k], rec.tau_ff[k])
-            if rec.has_odometry:
-                w.write_odometry(t, rec.base_pos[k], rec.base_quat[k], rec.base_linvel[k], rec.base_angvel[k])
+            if odom is not None:
+                base_pos, base_quat, base_linvel, base_angvel = odom
+                w.write_odometry(t, base_pos[k], base_quat[k], base_linvel[k], base_angvel[k])
     return Path(path)

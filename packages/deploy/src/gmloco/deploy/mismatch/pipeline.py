@@ -137,8 +137,9 @@ def analyze(
     names = channel_names(rec.joint_names)
     loc = localize(r0, names, phases_all[idx], rec.t[idx], n_eff / r0[pb.train].size)
     winner = next((h for h in ranked if h.spec.id == decision["winner"]), None)
-    params = {winner.spec.id: winner.theta} if winner is not None else {}
-    fitted = pb.simulate(params) if winner is not None else y0
+    # confirm() sets theta on every ranked hypothesis, so a winner always has a fit.
+    params = {winner.spec.id: winner.theta} if winner is not None and winner.theta is not None else {}
+    fitted = pb.simulate(params) if params else y0
     from gmloco.deploy.mismatch.report import build_report
 
     report = build_report(rec, pb, hyps, ranked, decision, loc, issues, r0, fitted, n_eff, time.time() - t0)

@@ -75,6 +75,12 @@ class Recording:
         """Whether base pose and velocity are logged."""
         return all(x is not None for x in (self.base_pos, self.base_quat, self.base_linvel, self.base_angvel))
 
+    def odometry(self) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray] | None:
+        """Return ``(base_pos, base_quat, base_linvel, base_angvel)`` when all are logged, else ``None``."""
+        if self.base_pos is None or self.base_quat is None or self.base_linvel is None or self.base_angvel is None:
+            return None
+        return self.base_pos, self.base_quat, self.base_linvel, self.base_angvel
+
     def valid_mask(self) -> np.ndarray:
         """Return the per-sample validity mask, shape [N]."""
         return np.ones(self.n, bool) if self.valid is None else self.valid.astype(bool)

@@ -153,14 +153,16 @@ class Replayer:
         """Run the base estimator (or wrap odometry) at ``starts``."""
         r = self.rec
         q_true = r.q[starts] - h.offset
-        if r.has_odometry:
+        odom = r.odometry()
+        if odom is not None:
+            base_pos, base_quat, base_linvel, base_angvel = odom
             return odometry_base(
                 self.model,
                 q_true,
-                r.base_pos[starts],
-                r.base_quat[starts],
-                r.base_linvel[starts],
-                r.base_angvel[starts],
+                base_pos[starts],
+                base_quat[starts],
+                base_linvel[starts],
+                base_angvel[starts],
             )
         qm = quat_from_roll_pitch(float(h.mis[0]), float(h.mis[1]))
         quat = quat_mul(r.imu_quat[starts], quat_conj(qm))

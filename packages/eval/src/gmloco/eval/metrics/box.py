@@ -4,6 +4,7 @@
 from __future__ import annotations
 
 import numpy as np
+import numpy.typing as npt
 
 __all__ = [
     "SINKAGE_FLOOR",
@@ -69,7 +70,7 @@ def metric_lateral_force(grf: np.ndarray, velocity_xy: tuple[float, float]) -> f
     return float(np.mean(np.asarray(grf)[:, :2] @ lateral))
 
 
-def metric_relative_error(value: np.ndarray, reference: np.ndarray, floor: float) -> np.ndarray:
+def metric_relative_error(value: npt.ArrayLike, reference: npt.ArrayLike, floor: float) -> np.ndarray:
     """Return |value - reference| / max(|reference|, floor) element-wise [-]."""
     value, reference = np.asarray(value, dtype=np.float64), np.asarray(reference, dtype=np.float64)
     return np.abs(value - reference) / np.maximum(np.abs(reference), floor)

@@ -31,15 +31,25 @@ __all__ = ["GranularMaterial", "MpmMaterialCfg", "apply_mpm_material", "mpm_mate
 
 
 class GranularMaterial(Protocol):
-    """What the mapping reads from a material (``gmloco.contact.MaterialCfg`` satisfies it)."""
+    """What the mapping reads from a material (``gmloco.contact.MaterialCfg`` satisfies it).
+
+    Read-only members, so frozen dataclasses such as ``MaterialCfg`` match the protocol.
+    """
 
     @property
     def rho_c(self) -> float:
         """Critical density [kg/m^3]."""
         ...
 
-    mu_int: float
-    mu_surf: float
+    @property
+    def mu_int(self) -> float:
+        """Internal friction coefficient [-]."""
+        ...
+
+    @property
+    def mu_surf(self) -> float:
+        """Intruder-medium surface friction coefficient [-]."""
+        ...
 
 
 @dataclass(frozen=True)

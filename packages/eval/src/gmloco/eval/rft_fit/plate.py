@@ -147,18 +147,23 @@ def run_plate_intrusion(
         mpm.setup_collider(model=rigid_model, body_mass=wp.full(rigid_model.body_count, PLATE_MASS, dtype=float))
         state = model.state()
         rigid_state = rigid_model.state()
-        state.body_q, state.body_qd = rigid_state.body_q, rigid_state.body_qd
-        wrench = wp.zeros(rigid_model.body_count, dtype=wp.spatial_vector)
+        body_q, body_qd, body_com = rigid_state.body_q, rigid_state.body_qd, rigid_model.body_com
+        if body_q is None or body_qd is None or body_com is None:
+            raise RuntimeError("the collider model has no body arrays")  # Newton allocates them: it holds the plate
+        state.body_q, state.body_qd = body_q, body_qd
+        # wp.spatial_vectorf is wp.spatial_vector; Warp's stubs type only the former as a dtype class
+        wrench = wp.zeros(rigid_model.body_count, dtype=wp.spatial_vectorf)
         num_frames = math.ceil(duration / s.frame_dt)
         depth, force = np.zeros(num_frames), np.zeros((num_frames, 3))
-        qd = wp.array([[*v.tolist(), 0.0, 0.0, 0.0]], dtype=wp.spatial_vector)
+        qd = wp.array([[*v.tolist(), 0.0, 0.0, 0.0]], dtype=wp.spatial_vectorf)
         for k in range(num_frames):
             p = start + v * k * s.frame_dt
-            state.body_q.assign([wp.transform(wp.vec3(*p.tolist()), wp.quat(*q))])
-            wp.copy(state.body_qd, qd)
-            mpm.step(state, state, None, None, s.frame_dt)
-            eval_body_sand_wrench(mpm.collider_body_index, rigid_model.body_com, s.frame_dt,
-                                  mpm.collect_collider_impulses(state), state.body_q, wrench)  # fmt: skip
+            body_q.assign([wp.transform(wp.vec3(*p.tolist()), wp.quat(*q))])
+            wp.copy(body_qd, qd)
+            # Newton annotates control/contacts as required, but SolverImplicitMPM.step documents both as unused
+            mpm.step(state, state, None, None, s.frame_dt)  # pyright: ignore[reportArgumentType]
+            eval_body_sand_wrench(mpm.collider_body_index, body_com, s.frame_dt,
+                                  mpm.collect_collider_impulses(state), body_q, wrench)  # fmt: skip
             force[k] = wrench.numpy()[body][:3]
             depth[k] = -(p + 0.5 * v * s.frame_dt)[2]  # centroid depth at mid-step
     travelled = cfg.speed * s.frame_dt * np.arange(1, num_frames + 1)
@@ -171,5 +176,6 @@ def _quat_xyzw(rot: np.ndarray) -> tuple[float, float, float, float]:
     """Unit quaternion (x, y, z, w) of a rotation matrix."""
     import warp as wp
 
-    qq = wp.quat_from_matrix(wp.mat33(*rot.ravel().tolist()))
+    # Warp's stubs do not relate the concrete ``mat33`` class to the ``Matrix[Float, 3, 3]`` overload
+    qq = wp.quat_from_matrix(wp.mat33(*rot.ravel().tolist()))  # pyright: ignore[reportCallIssue, reportArgumentType]
     return (float(qq[0]), float(qq[1]), float(qq[2]), float(qq[3]))

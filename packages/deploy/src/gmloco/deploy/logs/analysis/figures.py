@@ -9,11 +9,13 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 if TYPE_CHECKING:
+    from matplotlib.typing import RcKeyType
+
     from gmloco.deploy.logs.analysis.run_analysis import RunAnalysis
 
 __all__ = ["fig_ankle_torque", "fig_clearance", "fig_eta", "fig_gait", "fig_velocity_tracking", "write_figures"]
 
-_STYLE = {"font.size": 8, "axes.spines.top": False, "axes.spines.right": False, "figure.dpi": 150}
+_STYLE: dict[RcKeyType, Any] = {"font.size": 8, "axes.spines.top": False, "axes.spines.right": False, "figure.dpi": 150}
 
 
 def _plt() -> Any:

@@ -4,6 +4,7 @@
 from __future__ import annotations
 
 from collections import defaultdict
+from typing import Any
 
 import numpy as np
 
@@ -50,7 +51,7 @@ def score(rows: list[dict]) -> dict:
             d["oracle_frac"].append((en["nominal"] - en["fitted"]) / (en["nominal"] - en["oracle"]))
     out = {}
     for k, d in per.items():
-        o = {"n": max((len(v) for v in d.values()), default=0)}
+        o: dict[str, Any] = {"n": max((len(v) for v in d.values()), default=0)}
         for m, v in d.items():
             if m == "errors":
                 o["errors"] = v
