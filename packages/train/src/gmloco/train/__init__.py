@@ -5,23 +5,54 @@ Entry points:
     * :func:`train` with :class:`TrainRunCfg`: time-boxed, resumable PPO with ONNX export.
     * :func:`evaluate_policy` with :class:`EvalCfg`: roll out an exported ONNX policy in the granular simulator.
     * :func:`make_g1_granular_env_cfg` / :func:`g1_granular_task`: the mjlab env config factories.
+
+The exports are resolved lazily (PEP 562): ``import gmloco.train.teacher_student`` or ``gmloco.train.config``
+does not pay for importing the mjlab env stack (15-25 s on CPU); ``from gmloco.train import train`` imports
+the defining module on first access.
 """
 
-from gmloco.train.config import (
-    ContactModelName,
-    GranularTaskCfg,
-    MaterialRangeCfg,
-    RobotDrCfg,
-    SandFloorCfg,
-    SandTerrainCfg,
-    TerrainName,
-    deep_sand_terrain,
-    flat_sand_terrain,
-    rough_sand_terrain,
-)
-from gmloco.train.evaluation import EvalCfg, evaluate_policy
-from gmloco.train.tasks.g1_granular import g1_granular_task, make_g1_granular_env_cfg, make_g1_granular_ppo_cfg
-from gmloco.train.training import TrainRunCfg, train
+from __future__ import annotations
+
+import importlib
+from typing import TYPE_CHECKING, Any
+
+if TYPE_CHECKING:
+    from gmloco.train.config import (
+        ContactModelName,
+        GranularTaskCfg,
+        MaterialRangeCfg,
+        RobotDrCfg,
+        SandFloorCfg,
+        SandTerrainCfg,
+        TerrainName,
+        deep_sand_terrain,
+        flat_sand_terrain,
+        rough_sand_terrain,
+    )
+    from gmloco.train.evaluation import EvalCfg, evaluate_policy
+    from gmloco.train.tasks.g1_granular import g1_granular_task, make_g1_granular_env_cfg, make_g1_granular_ppo_cfg
+    from gmloco.train.training import TrainRunCfg, train
+
+_EXPORTS: dict[str, str] = {
+    "ContactModelName": "gmloco.train.config",
+    "GranularTaskCfg": "gmloco.train.config",
+    "MaterialRangeCfg": "gmloco.train.config",
+    "RobotDrCfg": "gmloco.train.config",
+    "SandFloorCfg": "gmloco.train.config",
+    "SandTerrainCfg": "gmloco.train.config",
+    "TerrainName": "gmloco.train.config",
+    "deep_sand_terrain": "gmloco.train.config",
+    "flat_sand_terrain": "gmloco.train.config",
+    "rough_sand_terrain": "gmloco.train.config",
+    "EvalCfg": "gmloco.train.evaluation",
+    "evaluate_policy": "gmloco.train.evaluation",
+    "g1_granular_task": "gmloco.train.tasks.g1_granular",
+    "make_g1_granular_env_cfg": "gmloco.train.tasks.g1_granular",
+    "make_g1_granular_ppo_cfg": "gmloco.train.tasks.g1_granular",
+    "TrainRunCfg": "gmloco.train.training",
+    "train": "gmloco.train.training",
+}
+"""Public name -> the module that defines it."""
 
 __all__ = [
     "ContactModelName",
@@ -42,3 +73,19 @@ __all__ = [
     "rough_sand_terrain",
     "train",
 ]
+
+
+def __getattr__(name: str) -> Any:
+    """Import the module defining the public ``name`` on first access and cache the value in this module."""
+    module = _EXPORTS.get(name)
+    if module is None:
+        # AttributeError lets ``from gmloco.train import mdp`` fall back to importing the submodule
+        raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
+    value = getattr(importlib.import_module(module), name)
+    globals()[name] = value
+    return value
+
+
+def __dir__() -> list[str]:
+    """List the module's attributes, including the not-yet-imported public names."""
+    return sorted({*globals(), *__all__})
