@@ -73,3 +73,11 @@ def test_stage_runs_alone_with_plain_python(tmp_path: Path) -> None:
     assert statuses.pop("export") == "blocked"
     assert set(statuses.values()) == {"disabled"}
     assert (tmp_path / "export.log").exists()  # Hydra's job log carries the stage's name
+
+
+def test_train_entry_prints_the_ablation_config() -> None:
+    """``python workflows/train.py +exp=ppo_rigid --cfg job``: the train stage alone, vanilla PPO on rigid ground."""
+    res = run_cli(["workflows/train.py", "+exp=ppo_rigid", "--cfg", "job"])
+    assert res.returncode == 0, res.stderr
+    for line in ("algorithm: ppo", "contact_model: rigid", "- train_teacher"):
+        assert line in res.stdout

@@ -204,6 +204,10 @@ def hydra_entry(task: Callable[[DictConfig], int], *, config_name: str = "full_p
                 extra.append(SMOKE_OVERRIDE)
         except ConfigInputError as e:
             _fail(e)
-    sys.argv = [sys.argv[0], *argv, *extra]
+    # Overrides first, options (--cfg job, --multirun, ...) last: argparse takes the positional overrides in one run.
+    options = list(argv)
+    for o in args.overrides:
+        options.remove(o)
+    sys.argv = [sys.argv[0], *args.overrides, *extra, *options]
     main = hydra.main(config_path=str(CONF_DIR), config_name=config_name, version_base="1.3")(_guarded(task))
     main()
