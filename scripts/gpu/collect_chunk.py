@@ -99,7 +99,8 @@ def main() -> None:
         {
             "commit": args.commit,
             "device": summary.get("device"),
-            "command": "python3 scripts/gpu/train_chunk.py " + " ".join(f"--{k} {v}" for k, v in summary["args"].items()),
+            "command": "python3 scripts/gpu/train_chunk.py "
+            + " ".join(f"--{k} {v}" for k, v in summary["args"].items()),
             "resumed_from_iteration": metrics.get("resumed_from_iteration"),
             "iteration": metrics.get("iteration"),
             "gpu_minutes": args.gpu_minutes,
