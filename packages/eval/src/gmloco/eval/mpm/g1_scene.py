@@ -30,7 +30,15 @@ from gmloco.eval.mpm.bed import SandBedCfg, add_bed_container, emit_sand_bed
 from gmloco.eval.mpm.box_scene import MpmSolverCfg
 from gmloco.eval.mpm.materials import GranularMaterial, MpmMaterialCfg, apply_mpm_material, mpm_material
 
-__all__ = ["G1MpmScene", "G1MpmSceneCfg", "MjlabOnnxPolicy", "PolicySpec", "SoleCfg", "g1_mjcf_path"]
+__all__ = [
+    "G1MpmScene",
+    "G1MpmSceneCfg",
+    "MjlabOnnxPolicy",
+    "PolicySpec",
+    "SoleCfg",
+    "StudentOnnxPolicy",
+    "g1_mjcf_path",
+]
 
 FOOT_BODIES = ("left_ankle_roll_link", "right_ankle_roll_link")
 
@@ -140,6 +148,45 @@ class MjlabOnnxPolicy:
         return np.asarray(self.session.run(None, {self.input_name: obs})[0])[0]
 
 
+class StudentOnnxPolicy:
+    """A gmloco student export (``obs`` + ``history``) run by ``OnnxPolicyRunner``; o_t built from the metadata."""
+
+    def __init__(self, path: str | Path) -> None:
+        """Load the runner; check that the observation terms are ones the scene provides."""
+        from gmloco.deploy.export import OnnxPolicyRunner
+
+        self.runner = OnnxPolicyRunner(path)
+        meta = self.runner.metadata
+        known = {"base_ang_vel", "projected_gravity", "command", "joint_pos", "joint_vel", "actions"}
+        if not set(meta.observation_names) <= known:
+            raise ValueError(f"unsupported observation terms {sorted(set(meta.observation_names) - known)}")
+        self.meta = meta
+        self.spec = PolicySpec(
+            joint_names=list(meta.joint_names),
+            kp=np.asarray(meta.joint_stiffness, dtype=np.float64),
+            kd=np.asarray(meta.joint_damping, dtype=np.float64),
+            default_joint_pos=np.asarray(meta.default_joint_pos, dtype=np.float64),
+            action_scale=np.asarray(meta.action_scale, dtype=np.float64),
+            policy_dt=float(meta.policy_dt),
+        )
+
+    def reset(self) -> None:
+        """Forget the history."""
+        self.runner.reset()
+
+    def act(self, terms: dict[str, np.ndarray]) -> np.ndarray:
+        """Clip, scale and concatenate the terms into o_t; return the action [num_actions]."""
+        parts = []
+        for name, clip, scale in zip(
+            self.meta.observation_names, self.meta.observation_clip, self.meta.observation_scale, strict=True
+        ):
+            x = np.asarray(terms[name], dtype=np.float64)
+            if clip is not None:
+                x = np.clip(x, clip[0], clip[1])
+            parts.append(x * np.asarray(scale, dtype=np.float64))
+        return np.asarray(self.runner.step(np.concatenate(parts).astype(np.float32)))
+
+
 class G1MpmScene:
     """G1 standing / walking on a coupled MPM sand bed (Example-shaped: ``step``, ``run``, ``test_final``).
 
@@ -154,7 +201,7 @@ class G1MpmScene:
         self,
         cfg: G1MpmSceneCfg,
         material: GranularMaterial | MpmMaterialCfg,
-        policy: MjlabOnnxPolicy | PolicySpec,
+        policy: MjlabOnnxPolicy | StudentOnnxPolicy | PolicySpec,
     ) -> None:
         """Build robot + sand models, both solvers and the coupling buffers."""
         import newton
@@ -162,8 +209,8 @@ class G1MpmScene:
 
         self.cfg = cfg
         self.mat = material if isinstance(material, MpmMaterialCfg) else mpm_material(material)
-        self.policy = policy if isinstance(policy, MjlabOnnxPolicy) else None
-        self.spec = policy.spec if isinstance(policy, MjlabOnnxPolicy) else policy
+        self.policy = None if isinstance(policy, PolicySpec) else policy
+        self.spec = policy if isinstance(policy, PolicySpec) else policy.spec
         self.device = wp.get_device(cfg.device)
         s = cfg.solver
         self.frame_dt, self.sim_dt = s.frame_dt, s.frame_dt / s.rigid_substeps
