@@ -16,7 +16,7 @@ import numpy as np
 
 from gmloco.deploy.mismatch.replay import CHANNEL_GROUPS, Replayer
 
-__all__ = ["FloorCfg", "Problem", "effective_samples"]
+__all__ = ["FloorCfg", "Problem", "effective_samples", "group_balance"]
 
 
 @dataclass
@@ -33,6 +33,9 @@ class FloorCfg:
     """Floors when base odometry is logged."""
     exclude_arms: bool = False
     """Drop arm joints from the residual (arms often run a different controller)."""
+    group_balance: bool = True
+    """Give each signal group (q, dq, tau_est, gyro, acc) the same total weight, so the 3-column IMU groups are
+    not outvoted by the 29-column joint groups. The weights keep the total null energy (one per active column)."""
 
 
 def _meas_noise(x: np.ndarray) -> np.ndarray:
@@ -40,6 +43,25 @@ def _meas_noise(x: np.ndarray) -> np.ndarray:
     d2 = x[2:] - 2 * x[1:-1] + x[:-2]
     mad = np.median(np.abs(d2 - np.median(d2, axis=0)), axis=0)
     return 1.4826 * mad / np.sqrt(6.0)
+
+
+def group_balance(active: np.ndarray) -> np.ndarray:
+    """Per-column factors that give every signal group with active columns the same total weight.
+
+    With ``N`` active columns in ``G`` active groups, a group with ``n_g`` active columns gets the factor
+    ``sqrt(N / (G n_g))`` on its residuals, so its expected null energy is ``N / G`` and the total stays ``N``.
+    """
+    out = np.zeros(active.shape, float)
+    on = active > 0
+    sizes, off = [], 0
+    for _, width in CHANNEL_GROUPS:
+        sizes.append((off, width, int(on[off : off + width].sum())))
+        off += width
+    n_tot, n_grp = sum(n for *_, n in sizes), sum(1 for *_, n in sizes if n > 0)
+    for o, width, n in sizes:
+        if n > 0:
+            out[o : o + width] = np.sqrt(n_tot / (n_grp * n))
+    return out
 
 
 def effective_samples(r: np.ndarray) -> float:
@@ -84,6 +106,8 @@ class Problem:
         if floor.exclude_arms:
             for off in (0, 29, 58):
                 self.weight[off + 15 : off + 29] = 0.0
+        if floor.group_balance:
+            self.weight = self.weight * group_balance(self.weight)
 
     def simulate(self, params: dict[str, np.ndarray], mask: np.ndarray | None = None) -> np.ndarray:
         """Simulate the segments selected by ``mask`` (all by default), shape [S', P, 93]."""

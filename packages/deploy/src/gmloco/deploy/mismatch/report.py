@@ -11,7 +11,7 @@
 * ``mismatch``: ``{nominal_energy_ratio, explained_fraction, cells: [...], windows: [...]}``; a cell is
   ``{signal, joint, phase, energy_ratio, q_fdr, n}``, a window ``{signal, t: [t0, t1], energy_ratio, q_fdr}``.
 * ``hypotheses``: ranked list, each ``{id, rank, testable, dbic_screen, confirmed, dbic, heldout_gain,
-  p_boot, passed, corr_max, weight, params: {name: {value, ci95, unit}}, confusables, explanation}``;
+  heldout_gain_lo, p_boot, passed, corr_max, weight, params: {name: {value, ci95, unit}}, confusables, explanation}``;
   followed by ``{id: "none"}`` and ``{id: "unexplained"}`` entries with their weights.
 * ``untested``: ``[{id, reason, needs}]`` effects this recording cannot test, and what would make them testable.
 * ``before_after``: held-out ``{nrmse_nominal, nrmse_fitted}`` per signal group.
@@ -99,7 +99,12 @@ def build_report(
         }
         if h.spec.id in confirmed:
             e.update(
-                dbic=float(h.dbic), heldout_gain=h.heldout_gain, p_boot=h.p_boot, passed=h.passed, corr_max=h.corr_max
+                dbic=float(h.dbic),
+                heldout_gain=h.heldout_gain,
+                heldout_gain_lo=float(h.gain_lo),
+                p_boot=h.p_boot,
+                passed=h.passed,
+                corr_max=h.corr_max,
             )
             e["params"] = _params(h.spec, h.theta, h.ci)
             e["explanation"] = _explain(h)

@@ -51,6 +51,11 @@ class EpisodeCfg:
     """Also log ground-truth base odometry."""
     drop_fraction: float = 0.0
     """Fraction of LowState samples dropped (marked invalid after resampling)."""
+    keep_before_fall: float | None = None
+    """If set and the truth robot falls, keep the log up to this many seconds before the fall instead of
+    raising (as a user would trim a real log that ends in a fall); ``min_kept`` seconds must remain."""
+    min_kept: float = 3.5
+    """Shortest log kept after trimming a fall [s]."""
 
 
 def _initial_state(model: object, data: object, q0: np.ndarray) -> None:
@@ -100,6 +105,7 @@ def generate(cfg: EpisodeCfg) -> tuple[Recording, dict]:
         )
     }
     tau = np.zeros(29)
+    fell_at = None
     for k in range(n):
         mujoco.mj_forward(model, data)
         q_enc, dq_enc = sen.encoders(data.qpos[7:].copy(), data.qvel[6:].copy())
@@ -123,12 +129,17 @@ def generate(cfg: EpisodeCfg) -> tuple[Recording, dict]:
         out["pos"][k], out["bq"][k] = data.qpos[:3], data.qpos[3:7]
         out["v"][k], out["w"][k] = rot.T @ data.qvel[:3], data.qvel[3:6]
         if data.qpos[2] < 0.45:
-            raise RuntimeError(f"truth robot fell at t = {k * dt_log:.2f} s (effect {cfg.effect.id})")
-    return _to_recording(cfg, out, n, dt_log, kp, kd, rng), {
-        "effect": cfg.effect.id,
-        "params": cfg.effect.params,
-        "seed": cfg.seed,
-    }
+            msg = f"truth robot fell at t = {k * dt_log:.2f} s (effect {cfg.effect.id})"
+            keep = None if cfg.keep_before_fall is None else round((k * dt_log - cfg.keep_before_fall) / dt_log)
+            if keep is None or keep * dt_log < cfg.min_kept:
+                raise RuntimeError(msg)
+            fell_at, n = k * dt_log, keep
+            out = {key: v[:n] for key, v in out.items()}
+            break
+    key = {"effect": cfg.effect.id, "params": cfg.effect.params, "seed": cfg.seed}
+    if fell_at is not None:
+        key["fell_at_s"], key["kept_s"] = fell_at, n * dt_log
+    return _to_recording(cfg, out, n, dt_log, kp, kd, rng), key
 
 
 def _to_recording(

@@ -20,7 +20,7 @@ import numpy as np
 __all__ = ["main", "run_episode"]
 
 
-def run_episode(ep: dict, out: str, duration: float = 8.0) -> dict:
+def run_episode(ep: dict, out: str, duration: float = 8.0, keep_before_fall: float | None = None) -> dict:
     """Generate, analyse and score-prepare one episode; returns a JSON-ready row."""
     from gmloco.deploy.mismatch.benchmark.generator import EpisodeCfg, generate
     from gmloco.deploy.mismatch.benchmark.truth import TruthEffect
@@ -30,7 +30,9 @@ def run_episode(ep: dict, out: str, duration: float = 8.0) -> dict:
     t0 = time.time()
     eff = TruthEffect(ep["effect"], ep["params"])
     try:
-        rec, key = generate(EpisodeCfg(effect=eff, duration=duration, seed=ep["seed"]))
+        rec, key = generate(
+            EpisodeCfg(effect=eff, duration=duration, seed=ep["seed"], keep_before_fall=keep_before_fall)
+        )
     except RuntimeError as exc:
         return {**ep, "error": str(exc)}
     keys = Path(out) / "keys"
@@ -45,6 +47,8 @@ def run_episode(ep: dict, out: str, duration: float = 8.0) -> dict:
         "ranked": [h["id"] for h in rep["hypotheses"] if "rank" in h],
         "runtime_s": time.time() - t0,
     }
+    if "kept_s" in key:
+        row["trimmed"] = {"fell_at_s": key["fell_at_s"], "kept_s": key["kept_s"]}
     row["untested"] = [u["id"] for u in rep["untested"]]
     hyp = next((h for h in rep["hypotheses"] if h["id"] == ep["effect"] and h.get("confirmed")), None)
     if hyp is not None:
@@ -84,6 +88,12 @@ def main(argv: list[str] | None = None) -> None:
     p.add_argument("--nulls", type=int, default=8)
     p.add_argument("--duration", type=float, default=8.0)
     p.add_argument("--strengths", default="mid")
+    p.add_argument(
+        "--keep-before-fall",
+        type=float,
+        default=None,
+        help="trim a truth log that ends in a fall to this many seconds before it (default: the episode errors)",
+    )
     p.add_argument("--only", default=None, help="comma-separated episode-name prefixes")
     p.add_argument("--score-only", action="store_true", help="score the rows already under OUT/rows and exit")
     a = p.parse_args(argv)
@@ -98,7 +108,7 @@ def main(argv: list[str] | None = None) -> None:
         eps = [e for e in eps if any(e["name"].startswith(s) for s in a.only.split(","))]
     a.out.mkdir(parents=True, exist_ok=True)
     with Pool(a.workers) as pool:
-        rows = pool.map(_star, [(e, str(a.out), a.duration) for e in eps], chunksize=1)
+        rows = pool.map(_star, [(e, str(a.out), a.duration, a.keep_before_fall) for e in eps], chunksize=1)
     (a.out / "rows.json").write_text(json.dumps(rows, indent=1, default=float))
     (a.out / "summary.json").write_text(json.dumps(score(rows), indent=2, default=float))
 
