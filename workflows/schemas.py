@@ -4,7 +4,7 @@
 Each ``conf/<group>/*.yaml`` extends its schema through its defaults list (``- base_<group>``), so a typo in
 an override or a YAML file fails at composition with the key's name. The stage sections mirror the packages'
 ``FooCfg`` dataclasses (OmegaConf cannot hold their ``Literal`` fields); each ``workflows/<stage>.py`` converts
-its section into the package's dataclass. ``eval_mpm``'s section is still a placeholder (issue 9).
+its section into the package's dataclass. ``eval_mpm``'s section mirrors ``gmloco.eval.g1_eval.G1EvalCfg`` (issue 9).
 """
 
 from __future__ import annotations
@@ -245,12 +245,26 @@ class EvalMpmCfg(StageCfg):
     out_dir: str = _interp("${run_dir}/eval_mpm")
     policy_dir: str = _interp("${export.out_dir}")
     """Folder holding ``policy.onnx``."""
+    policy_file: str = "policy.onnx"
+    """File in ``policy_dir`` (gmloco student export or mjlab actor export)."""
     num_episodes: int = 100
     """Episodes per (policy, terrain, scenario); the paper uses 100."""
     episode_s: float = 10.0
-    """Episode length [s]."""
+    """Episode length = course time limit [s]."""
     voxel_size: float = 0.03
     """MPM voxel size [m]."""
+    materials: list[str] = field(default_factory=lambda: ["dry_sand"])
+    """Media (``gmloco.contact.MATERIAL_PRESETS`` names)."""
+    scenarios: list[str] = field(default_factory=lambda: ["straight"])
+    """``straight`` and/or ``circle`` (``gmloco.eval.g1_eval``)."""
+    speeds: list[float] = field(default_factory=lambda: [1.0, 1.5, 2.0, 2.5])
+    """Forward-speed commands [m/s]; episode k uses ``speeds[k % len(speeds)]``."""
+    circle_radius: float = 2.0
+    """Radius of the circular walk [m]."""
+    course_slack: float = 0.2
+    """Fraction of the commanded path that may be left at the time limit and still count as finished."""
+    bed_depth: float = 0.15
+    """Sand depth [m]."""
 
 
 @dataclass
