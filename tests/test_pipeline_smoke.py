@@ -8,7 +8,6 @@ The end-to-end run takes 1.5-3 min on 2 CPU cores (plus the one-time MuJoCo Warp
 from __future__ import annotations
 
 import json
-import re
 from pathlib import Path
 
 import pytest
@@ -20,12 +19,13 @@ SAMPLE_LOGS = sorted((REPO_ROOT / "packages" / "deploy" / "data" / "sample_logs"
 """The committed sample recordings, analyze_logs' default input."""
 OK_STATUSES = {"done", "not_implemented", "blocked"}
 """What a healthy run may report (nothing failed, nothing faked)."""
-REAL_STAGES = ("train_teacher", "distill", "export", "analyze_logs", "mismatch")
+REAL_STAGES = ("train_teacher", "distill", "export", "eval_mpm", "analyze_logs", "mismatch")
 """Stages with a real implementation: each must be done at smoke scale."""
 STAGE_FILES = {
     "train_teacher": ["model_2.pt", "train_cfg.json"],
     "distill": ["model_2.pt", "train_cfg.json"],
     "export": ["policy.onnx", "policy.json"],
+    "eval_mpm": ["episodes.jsonl", "summary.json"],
     "analyze_logs": ["summary.md", "summary.json", "tracking.csv"],
     "mismatch": ["report.json", "report.md", "config_patch.json"],
 }
@@ -42,7 +42,7 @@ def _cuda() -> bool:
 @pytest.mark.slow
 @pytest.mark.skipif(_cuda(), reason="the main command runs full scale on a GPU machine")
 def test_main_command_runs_every_implemented_stage(tmp_path: Path) -> None:
-    """``full_pipeline.py +exp=gm_loco``: exit 0; the five real stages done with their files; eval_mpm honest."""
+    """``full_pipeline.py +exp=gm_loco``: exit 0; every stage done with its files."""
     res = run_cli(["workflows/full_pipeline.py", "+exp=gm_loco", f"run_dir={tmp_path}"], timeout=1200)
     assert res.returncode == 0, res.stderr[-4000:]
     assert "SMOKE SCALE" in res.stderr and "pipeline summary" in res.stderr
@@ -54,9 +54,7 @@ def test_main_command_runs_every_implemented_stage(tmp_path: Path) -> None:
         assert rows[name]["status"] == "done", rows[name]
         for rel in ["metrics.json", *STAGE_FILES[name]]:
             assert (tmp_path / name / rel).is_file(), f"{name}/{rel}"
-    assert rows["eval_mpm"]["status"] == "not_implemented"
-    assert re.search(r"not implemented yet \(issue 9\)", rows["eval_mpm"]["message"])
-    assert not (tmp_path / "eval_mpm").exists()  # no fake outputs
+    assert rows["eval_mpm"]["metrics"]["all/num_episodes"] >= 1
     export = rows["export"]["metrics"]
     assert export["onnx_max_abs_diff"] <= 1e-5 and export["rollout_onnx_max_abs_diff"] <= 1e-5
     assert rows["train_teacher"]["metrics"]["iteration"] == 2 and rows["distill"]["metrics"]["iteration"] == 2
