@@ -17,8 +17,9 @@ from typing import Any, Literal
 import numpy as np
 
 from gmloco.eval.box import BoxCfg
-from gmloco.eval.mpm.bed import SandBedCfg, add_bed_container, emit_sand_bed
-from gmloco.eval.mpm.materials import GranularMaterial, MpmMaterialCfg, apply_mpm_material, mpm_material
+from gmloco.eval.mpm.bed import SandBedCfg, add_bed_container
+from gmloco.eval.mpm.coupled_setup import build_sand_model, make_coupled_states, make_mpm_solver
+from gmloco.eval.mpm.materials import GranularMaterial, MpmMaterialCfg, mpm_material
 
 __all__ = ["MpmBoxScene", "MpmBoxSceneCfg", "MpmSolverCfg"]
 
@@ -85,7 +86,9 @@ class MpmBoxScene:
         self.frame_dt, self.sim_dt = s.frame_dt, s.frame_dt / s.rigid_substeps
         with wp.ScopedDevice(self.device):
             self.model = self._build_rigid_model(newton, wp)
-            self.sand_model = self._build_sand_model(newton)
+            self.sand_model, self.particle_count = build_sand_model(
+                newton, self.cfg.bed, self.cfg.solver.voxel_size, self.mat
+            )
             self._build_solvers(newton)
             self._allocate_states(newton, wp)
         self.frame = 0
@@ -119,29 +122,9 @@ class MpmBoxScene:
         self.box_body = body
         return model
 
-    def _build_sand_model(self, newton: Any) -> Any:
-        """Sand particles at density rho_c with the mapped rheology."""
-        builder = newton.ModelBuilder()
-        newton.solvers.SolverImplicitMPM.register_custom_attributes(builder)
-        self.particle_count = emit_sand_bed(builder, self.cfg.bed, self.cfg.solver.voxel_size, self.mat.density)
-        model = builder.finalize()
-        apply_mpm_material(model, self.mat)
-        return model
-
     def _build_solvers(self, newton: Any) -> None:
         """Implicit MPM reading its colliders (box + container) from the rigid model; MuJoCo for the box."""
-        s = self.cfg.solver
-        config = newton.solvers.SolverImplicitMPM.Config(
-            voxel_size=s.voxel_size,
-            max_iterations=s.max_iterations,
-            tolerance=s.tolerance,
-            grid_type=s.grid_type,
-            grid_padding=s.grid_padding,
-            max_active_cell_count=s.max_active_cell_count,
-            strain_basis=s.strain_basis,
-            critical_fraction=self.mat.critical_fraction,
-        )
-        self.mpm = newton.solvers.SolverImplicitMPM(self.sand_model, config=config)
+        self.mpm = make_mpm_solver(newton, self.sand_model, self.cfg.solver, self.mat)
         self.mpm.setup_collider(model=self.model)
         # no rigid contacts: the box touches only sand (MuJoCo C on CPU, mujoco_warp on CUDA)
         self.rigid = newton.solvers.SolverMuJoCo(
@@ -150,13 +133,9 @@ class MpmBoxScene:
 
     def _allocate_states(self, newton: Any, wp: Any) -> None:
         """Rigid states, the sand state (sharing body arrays) and the wrench buffers."""
-        self.state_0, self.state_1 = self.model.state(), self.model.state()
-        newton.eval_fk(self.model, self.model.joint_q, self.model.joint_qd, self.state_0)
-        self.control = self.model.control()
-        self.sand_state = self.sand_model.state()
-        self.sand_state.body_q = wp.clone(self.state_0.body_q)
-        self.sand_state.body_qd = wp.clone(self.state_0.body_qd)
-        self.sand_wrench = wp.zeros(self.model.body_count, dtype=wp.spatial_vector)
+        st = make_coupled_states(newton, wp, self.model, self.sand_model)
+        self.state_0, self.state_1, self.control = st.state_0, st.state_1, st.control
+        self.sand_state, self.sand_wrench = st.sand_state, st.sand_wrench
 
     # -- stepping -------------------------------------------------------------------------------------------
 
