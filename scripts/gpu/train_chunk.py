@@ -19,6 +19,7 @@ import json
 import shutil
 import subprocess
 import time
+from dataclasses import replace
 from pathlib import Path
 from typing import Any
 
@@ -33,22 +34,42 @@ def _parse() -> argparse.Namespace:
     p.add_argument("--max-minutes", type=float, default=9.0)
     p.add_argument("--seed", type=int, default=42)
     p.add_argument("--device", default="cuda:0")
+    p.add_argument(
+        "--curriculum-scale",
+        type=float,
+        default=None,
+        help="GranularTaskCfg.curriculum_scale (None: keep the task default / the run's saved config)",
+    )
+    p.add_argument(
+        "--weights-only",
+        action="store_true",
+        help="start a new run (new task config) from the artifact's policy weights instead of resuming it",
+    )
     p.add_argument("--out", type=Path, required=True)
     return p.parse_args()
 
 
-def _seed_run_dir(run_dir: Path, artifact: Path) -> int | None:
-    """Copy the committed checkpoint into an empty run directory; return its iteration."""
+def _seed_run_dir(run_dir: Path, artifact: Path, weights_only: bool) -> tuple[int | None, str | None]:
+    """Seed an empty run directory from the committed checkpoint.
+
+    Returns the artifact's iteration and, with ``weights_only``, the checkpoint to pass as ``init_checkpoint``
+    (a new run whose task config differs; the checkpoint's curriculum counter is not restored then).
+    """
     if any(run_dir.glob("model_*.pt")) or not (artifact / "checkpoint.pt").exists():
-        return None
+        return None, None
     import torch
 
     ckpt = torch.load(artifact / "checkpoint.pt", map_location="cpu", weights_only=False)
     it = int(ckpt["iter"])
+    if weights_only:
+        ckpt["infos"] = {k: v for k, v in (ckpt.get("infos") or {}).items() if k != "common_step_counter"}
+        init = run_dir.parent / f"{run_dir.name}_init.pt"
+        torch.save(ckpt, init)
+        return it, str(init)
     shutil.copy(artifact / "checkpoint.pt", run_dir / f"model_{it}.pt")
     if (artifact / "train_cfg.json").exists():
         shutil.copy(artifact / "train_cfg.json", run_dir / "train_cfg.json")
-    return it
+    return it, None
 
 
 def _curve(run_dir: Path) -> dict[str, list[float]]:
@@ -75,6 +96,28 @@ def _curve(run_dir: Path) -> dict[str, list[float]]:
     return out
 
 
+_LAST_VALUE_PREFIXES = ("Episode_Reward/", "Episode_Termination/", "Curriculum/", "Metrics/", "Loss/", "Policy/")
+"""TensorBoard tag families whose last-10-iteration means go into the summary (per-term diagnosis)."""
+
+
+def _last_values(run_dir: Path, window: int = 10) -> dict[str, float]:
+    """Mean of the last ``window`` logged values of every per-term tag (reward terms, terminations, curricula)."""
+    from tensorboard.backend.event_processing.event_accumulator import EventAccumulator
+
+    values: dict[str, dict[int, float]] = {}
+    for events in sorted(run_dir.rglob("events.out.tfevents.*")):
+        acc = EventAccumulator(str(events), size_guidance={"scalars": 0})
+        acc.Reload()
+        for tag in acc.Tags()["scalars"]:
+            if tag.startswith(_LAST_VALUE_PREFIXES):
+                values.setdefault(tag, {}).update({ev.step: ev.value for ev in acc.Scalars(tag)})
+    out = {}
+    for tag, series in sorted(values.items()):
+        last = [series[k] for k in sorted(series)[-window:]]
+        out[tag] = sum(last) / len(last)
+    return out
+
+
 def main() -> None:
     """Run one chunk and write the files that come back."""
     args = _parse()
@@ -82,9 +125,16 @@ def main() -> None:
 
     run_dir = Path("runs/gpu") / args.run
     run_dir.mkdir(parents=True, exist_ok=True)
-    seeded = _seed_run_dir(run_dir, Path("artifacts") / args.run)
+    seeded, init = _seed_run_dir(run_dir, Path("artifacts") / args.run, args.weights_only)
+    task = g1_granular_task(args.contact_model, args.terrain)
+    saved_cfg = run_dir / "train_cfg.json"
+    if args.curriculum_scale is not None:
+        task = replace(task, curriculum_scale=args.curriculum_scale)
+    elif saved_cfg.exists():
+        task = replace(task, curriculum_scale=json.loads(saved_cfg.read_text())["task"].get("curriculum_scale", 1.0))
     cfg = TrainRunCfg(
-        task=g1_granular_task(args.contact_model, args.terrain),
+        task=task,
+        init_checkpoint=init,
         num_envs=args.num_envs,
         max_iterations=args.max_iterations,
         max_minutes=args.max_minutes,
@@ -111,6 +161,7 @@ def main() -> None:
         "metrics": metrics,
         "train_cfg": json.loads((run_dir / "train_cfg.json").read_text()),
         "curve": _curve(run_dir),
+        "last_values": _last_values(run_dir),
         "wall_s": time.time() - t0,
         "commit": commit or None,
     }

@@ -77,3 +77,19 @@ def test_level_moves() -> None:
     """Walked 5 m of 4 needed -> +1; walked 1 m of 10 m commanded -> -1; 3 m of 4 m commanded -> 0."""
     moves = _level_moves(torch.tensor([5.0, 1.0, 3.0]), torch.tensor([20.0, 10.0, 4.0]), 4.0)
     np.testing.assert_array_equal(moves, [1, -1, 0])
+
+
+def test_curriculum_scale_compresses_stages_and_ramps() -> None:
+    """``curriculum_scale`` multiplies the command-stage steps and the tracking ramp length."""
+    from dataclasses import replace
+
+    from gmloco.train import g1_granular_task
+    from gmloco.train.tasks.g1_granular.rewards_cfg import make_curriculum_cfg, make_rewards_cfg
+
+    task = replace(g1_granular_task("rft3d"), curriculum_scale=0.1)
+    cur = make_curriculum_cfg(task, make_rewards_cfg(task))
+    steps = [stage["step"] for stage in cur["command_vel"].params["velocity_stages"]]
+    assert steps == [0, 24_000, 36_000]
+    assert cur["ramp_track_lin_vel_xy_exp"].params["num_steps"] == 36_000
+    paper = make_curriculum_cfg(g1_granular_task("rft3d"), make_rewards_cfg(task))
+    assert paper["ramp_track_heading_exp"].params["num_steps"] == 360_000

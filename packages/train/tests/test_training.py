@@ -55,6 +55,14 @@ def test_resume_continues_from_last_checkpoint(run_dir: Path) -> None:
     assert (run_dir / "model_3.pt").exists()
 
 
+def test_checkpoint_carries_the_curriculum_step_counter(run_dir: Path) -> None:
+    """The env's ``common_step_counter`` (command stages, reward ramps) is saved: resumed chunks continue them."""
+    import torch
+
+    ckpt = torch.load(run_dir / "model_3.pt", map_location="cpu", weights_only=False)
+    assert ckpt["infos"]["common_step_counter"] == 3 * 4
+
+
 def test_resume_refuses_a_changed_task(run_dir: Path) -> None:
     """Resuming a run directory with another contact model is an error, not a silent mix."""
     with pytest.raises(ValueError, match="task"):

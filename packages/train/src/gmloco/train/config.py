@@ -140,6 +140,13 @@ class GranularTaskCfg:
     """Widen the commanded-velocity ranges in stages (GM-Loco schedule)."""
     reward_ramp_steps: int = 15_000 * 24
     """Env steps over which tracking weights ramp 4 -> 8 and std sqrt(1.0) -> sqrt(0.1); 0 disables."""
+    command_stage_steps: tuple[int, int] = (10_000 * 24, 15_000 * 24)
+    """Env steps at which the command ranges widen to stage 2 (vx <= 1.7 m/s) and stage 3 (vx <= 2.5 m/s)."""
+    curriculum_scale: float = 1.0
+    """Multiplier on ``reward_ramp_steps`` and ``command_stage_steps``. 1.0 is GM-Loco's schedule, written for
+    tens of thousands of iterations; 0.1 fits it into a ~2k-iteration budget (ramp over 1.5k iterations, stages
+    at 1k and 1.5k). Below 1, the wide initial tracking kernel (std 1 m/s, where standing still already earns
+    ~70 % of the tracking reward) is left before the policy settles on standing."""
     reward_weights: dict[str, float] = field(default_factory=dict)
     """Overrides of reward term weights by name (see ``mdp.rewards``)."""
     play: bool = False

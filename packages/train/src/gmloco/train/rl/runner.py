@@ -115,8 +115,13 @@ class GmlocoOnPolicyRunner(MjlabOnPolicyRunner):
 
     def save(self, path: str, infos: dict | None = None) -> None:
         """Write the checkpoint to ``path + '.tmp'`` then ``os.replace`` it (a kill never leaves half a file)."""
-        sand = getattr(self.env.unwrapped, "sand", None)
-        infos = {**(infos or {}), "sand_floor_level": None if sand is None else sand.floor_level.cpu()}
+        env = self.env.unwrapped
+        sand = getattr(env, "sand", None)
+        infos = {
+            **(infos or {}),
+            "sand_floor_level": None if sand is None else sand.floor_level.cpu(),
+            "common_step_counter": getattr(env, "common_step_counter", None),
+        }
         tmp = f"{path}.tmp"
         super().save(tmp, infos)
         os.replace(tmp, path)
@@ -130,6 +135,9 @@ class GmlocoOnPolicyRunner(MjlabOnPolicyRunner):
         env = self.env.unwrapped
         if levels is not None and levels.shape[0] == env.num_envs:
             get_sand(env).floor_level.copy_(levels.to(env.device))
+        counter = (infos or {}).get("common_step_counter")
+        if counter is not None and hasattr(env, "common_step_counter"):
+            env.common_step_counter = int(counter)
         return infos
 
     def _prune(self) -> None:

@@ -127,17 +127,19 @@ def make_curriculum_cfg(task: GranularTaskCfg, rewards: dict[str, RewardTermCfg]
     if task.contact_model != "rigid" and task.terrain.floor.curriculum:
         cur["sand_floor_levels"] = CurriculumTermCfg(func=mdp.sand_floor_levels, params={"command_name": CMD})
     if task.command_curriculum:
+        step2, step3 = (round(s * task.curriculum_scale) for s in task.command_stage_steps)
         stages = [
             {"step": 0, "lin_vel_x": (-1.0, 1.0), "ang_vel_z": (-0.5, 0.5)},
-            {"step": 10_000 * 24, "lin_vel_x": (-1.0, 1.7), "ang_vel_z": (-0.7, 0.7)},
-            {"step": 15_000 * 24, "lin_vel_x": (-1.0, 2.5), "ang_vel_z": (-1.0, 1.0)},
+            {"step": step2, "lin_vel_x": (-1.0, 1.7), "ang_vel_z": (-0.7, 0.7)},
+            {"step": step3, "lin_vel_x": (-1.0, 2.5), "ang_vel_z": (-1.0, 1.0)},
         ]
         from mjlab.tasks.velocity import mdp as vel_mdp
 
         cur["command_vel"] = CurriculumTermCfg(
             func=vel_mdp.commands_vel, params={"command_name": CMD, "velocity_stages": stages}
         )
-    if task.reward_ramp_steps > 0:
+    ramp_steps = round(task.reward_ramp_steps * task.curriculum_scale)
+    if ramp_steps > 0:
         std = ("std", math.sqrt(1.0), math.sqrt(0.1))
         for name in ("track_lin_vel_xy_exp", "track_heading_exp", "track_ang_vel_z_exp"):
             if name not in rewards:
@@ -148,7 +150,7 @@ def make_curriculum_cfg(task: GranularTaskCfg, rewards: dict[str, RewardTermCfg]
                 func=mdp.reward_ramp,
                 params={
                     "reward_name": name,
-                    "num_steps": task.reward_ramp_steps,
+                    "num_steps": ramp_steps,
                     "weight": weight,
                     "param": std,
                 },
