@@ -100,6 +100,7 @@ def test_distillation_steps_reduce_action_and_latent_losses(student_alg: Student
     assert last["distill_latent"] < 0.5 * first["distill_latent"]
     assert last["distill_decoded"] < first["distill_decoded"]
     assert last["w_ppo"] == 0.0 and last["w_dist"] == 1.0
+    assert np.isfinite(last["eta_r2"]) and last["eta_r2"] <= 1.0  # logged next to eta_error
 
 
 def _snapshot_copy(batch: dict) -> dict:

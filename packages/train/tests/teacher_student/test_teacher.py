@@ -78,7 +78,8 @@ def test_teacher_ppo_update_trains_encoder_decoder_and_logs_vae_terms(
     dec0 = [p.detach().clone() for p in alg.actor.decoder.parameters()]
     _rollout(alg, toy_env, steps=4)
     logs = alg.update()
-    assert {"surrogate", "value", "entropy", "eta_reconstruction", "latent_kl", "w_ppo"} <= logs.keys()
+    assert {"surrogate", "value", "entropy", "eta_reconstruction", "latent_kl", "eta_r2", "w_ppo"} <= logs.keys()
+    assert logs["eta_r2"] <= 1.0
     assert all(np.isfinite(v) for v in logs.values())
     assert any(not torch.equal(a, b) for a, b in zip(enc0, alg.actor.encoder.parameters(), strict=True))
     assert any(not torch.equal(a, b) for a, b in zip(dec0, alg.actor.decoder.parameters(), strict=True))

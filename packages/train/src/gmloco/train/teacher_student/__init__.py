@@ -6,7 +6,10 @@
 * Student: :class:`StudentActor` (three 1-D convolutions + MLP over the N-step history) trained by
   :class:`StudentPPO` (DAgger + weighted PPO, frozen teacher) under :class:`StudentRunner`.
 * Configs: :class:`TeacherCfg`, :class:`StudentCfg`, :class:`DistillCfg`, :class:`ObsGroupsCfg`, :class:`PpoCfg`.
-* Export: :func:`policy_metadata_kwargs` maps mjlab's export metadata onto ``gmloco.deploy.export.PolicyMetadata``.
+* Export: :func:`policy_metadata_kwargs` maps mjlab's export metadata onto ``gmloco.deploy.export.PolicyMetadata``;
+  :mod:`~gmloco.train.teacher_student.export_student` rebuilds a trained student on the env, exports and checks it.
+* Held-out materials: :class:`HeldOutRegionCfg` (a (rho_c, mu_int) rectangle the DR never draws, see
+  :func:`redraw_outside`) and :func:`r2_score` for the decoded eta.
 """
 
 from gmloco.train.teacher_student.config import (
@@ -21,9 +24,11 @@ from gmloco.train.teacher_student.config import (
     PpoCfg,
     StudentCfg,
     TeacherCfg,
+    student_train_entries,
 )
 from gmloco.train.teacher_student.curriculum import LinearRamp
 from gmloco.train.teacher_student.deploy_metadata import policy_metadata_kwargs
+from gmloco.train.teacher_student.heldout import DEFAULT_HELD_OUT, HeldOutRegionCfg, r2_score, redraw_outside
 from gmloco.train.teacher_student.runner import StudentRunner
 from gmloco.train.teacher_student.student import DEFAULT_HISTORY_LENGTH, StudentActor
 from gmloco.train.teacher_student.student_ppo import StudentPPO
@@ -32,6 +37,7 @@ from gmloco.train.teacher_student.teacher_ppo import TeacherPPO
 
 __all__ = [
     "CRITIC_CLASS",
+    "DEFAULT_HELD_OUT",
     "DEFAULT_HISTORY_LENGTH",
     "STUDENT_ACTOR_CLASS",
     "STUDENT_PPO_CLASS",
@@ -39,6 +45,7 @@ __all__ = [
     "TEACHER_ACTOR_CLASS",
     "TEACHER_PPO_CLASS",
     "DistillCfg",
+    "HeldOutRegionCfg",
     "LinearRamp",
     "ObsGroupsCfg",
     "PpoCfg",
@@ -50,4 +57,7 @@ __all__ = [
     "TeacherCfg",
     "TeacherPPO",
     "policy_metadata_kwargs",
+    "r2_score",
+    "redraw_outside",
+    "student_train_entries",
 ]

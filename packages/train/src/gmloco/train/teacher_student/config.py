@@ -26,6 +26,7 @@ __all__ = [
     "PpoCfg",
     "StudentCfg",
     "TeacherCfg",
+    "student_train_entries",
 ]
 
 _PKG = "gmloco.train.teacher_student"
@@ -291,3 +292,18 @@ class DistillCfg:
             "obs_groups": groups.to_rsl_rl(),
             "teacher_checkpoint": self.teacher_checkpoint,
         }
+
+
+def student_train_entries(
+    teacher: TeacherCfg, student: StudentCfg, distill: DistillCfg, groups: ObsGroupsCfg | None = None
+) -> dict:
+    """Return the student's rsl-rl entries for ``gmloco.train.train`` (``TrainRunCfg.rsl_rl_overrides``).
+
+    ``DistillCfg.to_rsl_rl`` also names :class:`StudentRunner` and a teacher path; both are dropped: the time-boxed
+    runner of ``gmloco.train.train`` runs ``StudentPPO``, and ``TrainRunCfg.init_checkpoint`` loads the teacher
+    through ``StudentPPO.load`` (which calls ``load_teacher``), as ``StudentRunner`` would.
+    """
+    entries = distill.to_rsl_rl(teacher, student, groups or ObsGroupsCfg())
+    for key in ("class_name", "teacher_checkpoint"):
+        entries.pop(key)
+    return entries

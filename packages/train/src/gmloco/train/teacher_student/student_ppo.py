@@ -27,7 +27,7 @@ from gmloco.train.teacher_student.curriculum import LinearRamp
 from gmloco.train.teacher_student.losses import distill_terms, squared_error
 from gmloco.train.teacher_student.student import StudentActor
 from gmloco.train.teacher_student.teacher import TeacherActor
-from gmloco.train.teacher_student.teacher_ppo import eta_target
+from gmloco.train.teacher_student.teacher_ppo import batch_r2, eta_target
 
 __all__ = ["StudentPPO"]
 
@@ -116,7 +116,9 @@ class StudentPPO(AuxLossPPO):
         if self.eta_group is not None:
             with torch.no_grad():
                 eta_hat = self.teacher.decoder(self.actor.latent)
-                logs["eta_error"] = squared_error(eta_hat, eta_target(obs, self.eta_group, self.eta_index)).item()
+                eta = eta_target(obs, self.eta_group, self.eta_index)
+                logs["eta_error"] = squared_error(eta_hat, eta).item()
+                logs["eta_r2"] = batch_r2(eta_hat, eta)
         return loss, logs
 
     def update(self) -> dict[str, float]:

@@ -16,12 +16,23 @@ from gmloco.train.teacher_student.aux_ppo import AuxLossPPO
 from gmloco.train.teacher_student.losses import vae_terms
 from gmloco.train.teacher_student.teacher import TeacherActor
 
-__all__ = ["TeacherPPO", "eta_target"]
+__all__ = ["TeacherPPO", "batch_r2", "eta_target"]
 
 
 def eta_target(obs: TensorDict, group: str, index: int) -> torch.Tensor:
     """Return the normalized stiffness eta, ``[batch, 1]``, read from column ``index`` of group ``group``."""
     return obs[group][:, [index]]
+
+
+def batch_r2(predicted: torch.Tensor, target: torch.Tensor) -> float:
+    """R^2 of ``predicted`` against ``target`` (both ``[batch, 1]``) on one mini-batch; nan if the target is constant.
+
+    Logged per mini-batch and averaged over the update (``Loss/eta_r2`` in TensorBoard), so it tracks the
+    decoded-eta quality during training; the held-out evaluation computes the pooled R^2 instead.
+    """
+    ss_tot = (target - target.mean()).pow(2).sum()
+    ss_res = (target - predicted).pow(2).sum()
+    return float(1.0 - ss_res / ss_tot) if float(ss_tot) > 0.0 else float("nan")
 
 
 class TeacherPPO(AuxLossPPO):
@@ -70,4 +81,6 @@ class TeacherPPO(AuxLossPPO):
         eta = eta_target(batch.observations, self.eta_group, self.eta_index)  # type: ignore[arg-type]
         terms = vae_terms(eta, mu, logvar, self.actor.decoder)
         loss = self.reconstruction_weight * terms.reconstruction + self.kl_weight * terms.kl
-        return loss, {"eta_reconstruction": terms.reconstruction.item(), "latent_kl": terms.kl.item()}
+        with torch.no_grad():
+            r2 = batch_r2(self.actor.decoder(mu), eta)
+        return loss, {"eta_reconstruction": terms.reconstruction.item(), "latent_kl": terms.kl.item(), "eta_r2": r2}

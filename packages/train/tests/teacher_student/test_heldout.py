@@ -1,0 +1,75 @@
+# SPDX-License-Identifier: Apache-2.0
+"""The held-out (rho_c, mu_int) region: membership, the DR re-draw that avoids it, and the R^2 metrics."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+import torch
+
+import gmloco.contact as gc
+from gmloco.contact.materials import DR_RANGES_CODE
+from gmloco.train.teacher_student import DEFAULT_HELD_OUT, HeldOutRegionCfg, r2_score, redraw_outside
+from gmloco.train.teacher_student.teacher_ppo import batch_r2
+
+
+def _dr_draw(n: int, gen: torch.Generator) -> tuple[torch.Tensor, torch.Tensor]:
+    """rho_c = packing * bulk density and mu_int, as the training DR draws them (GM-Loco code ranges)."""
+    u = lambda lo_hi: lo_hi[0] + (lo_hi[1] - lo_hi[0]) * torch.rand(n, generator=gen, dtype=torch.float64)  # noqa: E731
+    return u(DR_RANGES_CODE.packing) * u(DR_RANGES_CODE.bulk_density), u(DR_RANGES_CODE.mu_int)
+
+
+def test_named_presets_lie_outside_and_the_grid_inside_the_region() -> None:
+    """Presets are a separate test set; every grid point of the held-out evaluation is inside the rectangle."""
+    for name, p in gc.MATERIAL_PRESETS.items():
+        assert not DEFAULT_HELD_OUT.contains(np.asarray(p.rho_c), np.asarray(p.mu_int)), name
+    rho, mu = DEFAULT_HELD_OUT.grid(3, 4)
+    assert rho.shape == mu.shape == (12,)
+    assert DEFAULT_HELD_OUT.contains(rho, mu).all()
+    assert len(set(zip(rho.tolist(), mu.tolist(), strict=True))) == 12
+
+
+def test_redraw_leaves_no_draw_inside_and_keeps_the_rest() -> None:
+    """After the re-draw no sample is inside; rho_c and the samples outside are untouched; ~3.5 % are moved."""
+    gen = torch.Generator().manual_seed(0)
+    rho, mu = _dr_draw(200_000, gen)
+    torch.manual_seed(1)
+    new_mu = redraw_outside(DEFAULT_HELD_OUT, rho, mu, DR_RANGES_CODE.mu_int)
+    inside = DEFAULT_HELD_OUT.contains(rho, mu)
+    assert not DEFAULT_HELD_OUT.contains(rho, new_mu).any()
+    torch.testing.assert_close(new_mu[~inside], mu[~inside], rtol=0.0, atol=0.0)
+    assert 0.025 < inside.double().mean().item() < 0.045  # the module docstring's "about 3.5 %"
+    lo, hi = DR_RANGES_CODE.mu_int
+    assert ((new_mu >= lo) & (new_mu <= hi)).all()
+
+
+def test_redraw_is_uniform_over_the_rest_of_the_mu_int_range() -> None:
+    """Given rho_c in the region's range, mu_int is U([0.2, 0.65) U (0.8, 0.9]): P(mu < 0.65) = 0.45 / 0.55."""
+    n = 100_000
+    rho = torch.full((n,), 2200.0, dtype=torch.float64)
+    mu = torch.full((n,), 0.7, dtype=torch.float64)  # all inside: every one is re-drawn
+    torch.manual_seed(0)
+    new_mu = redraw_outside(DEFAULT_HELD_OUT, rho, mu, DR_RANGES_CODE.mu_int)
+    frac_low = (new_mu < 0.65).double().mean().item()
+    # Binomial standard error sqrt(p (1 - p) / n) = 1.2e-3; 5 sigma.
+    np.testing.assert_allclose(frac_low, 0.45 / 0.55, atol=5 * math.sqrt(0.818 * 0.182 / n))
+    np.testing.assert_allclose(new_mu[new_mu < 0.65].mean().item(), 0.425, atol=5e-3)  # midpoint of [0.2, 0.65)
+
+
+def test_region_must_be_inside_the_dr_range_and_non_empty() -> None:
+    """A held-out mu_int range outside the DR's, or an inverted range, is refused."""
+    with pytest.raises(ValueError, match="inside the DR range"):
+        redraw_outside(HeldOutRegionCfg(mu_int=(0.8, 0.95)), torch.ones(1), torch.ones(1), (0.2, 0.9))
+    with pytest.raises(ValueError, match="low < high"):
+        HeldOutRegionCfg(rho_c=(2400.0, 2000.0))
+
+
+def test_r2_hand_computed() -> None:
+    """R^2 by hand: y = (1, 2, 3), y_hat = (1, 2, 4): SS_res = 1, SS_tot = 2 -> R^2 = 0.5; constant y -> nan."""
+    assert r2_score([1.0, 2.0, 4.0], [1.0, 2.0, 3.0]) == pytest.approx(0.5)
+    assert math.isnan(r2_score([1.0, 2.0], [3.0, 3.0]))
+    pred, target = torch.tensor([[1.0], [2.0], [4.0]]), torch.tensor([[1.0], [2.0], [3.0]])
+    assert batch_r2(pred, target) == pytest.approx(0.5)
+    assert math.isnan(batch_r2(pred, torch.ones(3, 1)))

@@ -1,0 +1,256 @@
+"""One time-boxed, resumable chunk of GM-Loco teacher training or student distillation on the GPU machine.
+
+    python scripts/gpu/train_ts_chunk.py --stage teacher --max-minutes 9 --out $OUT/gm_loco_teacher
+    python scripts/gpu/train_ts_chunk.py --stage student --max-minutes 9 --out $OUT/gm_loco_student
+
+1. Seeds the run directory (``runs/gpu/<run>``, kept on a warm machine) from ``artifacts/<run>/checkpoint.pt`` when
+   it has no checkpoint yet (a fresh machine). The student's first chunk starts from the teacher: the newest
+   ``runs/gpu/gm_loco_teacher/model_*.pt``, else ``artifacts/gm_loco_teacher/checkpoint.pt`` (``--teacher-checkpoint``
+   overrides); later student chunks resume from their own checkpoint, which carries the frozen teacher.
+2. Trains with :func:`gmloco.train.train` (``TeacherPPO`` / ``StudentPPO``; time box ``--max-minutes`` minus
+   ``--post-minutes`` kept for step 3). The DR leaves out the held-out (rho_c, mu_int) region
+   (:data:`gmloco.train.teacher_student.DEFAULT_HELD_OUT`) unless ``--no-held-out``.
+3. Rebuilds the newest checkpoint on a small play-mode env and rolls it out on the training DR: R^2 / MAE of the
+   decoded eta (teacher: psi(mu); student: psi(z_hat) and the teacher's psi(mu) on the student's states) and the
+   student-vs-teacher action error. For the student it also exports ``policy.onnx`` (+ ``policy.json``) with deploy
+   metadata and checks it against torch on random inputs and in a rollout with env resets (``OnnxPolicyRunner``).
+4. Writes to ``--out``: ``checkpoint.pt`` (newest), ``summary.json`` (train metrics, post-training checks, config,
+   this machine's curves from TensorBoard: reward, episode length, fps and every ``Loss/*`` term incl. the
+   eta reconstruction / KL / eta R^2 of the teacher and the distillation terms of the student), and for the student
+   ``policy.onnx`` + ``policy.json``.
+
+``scripts/gpu/collect_chunk.py --run gm_loco_teacher|gm_loco_student`` (run here) merges a chunk into ``artifacts/``.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import shutil
+import subprocess
+import sys
+import time
+from dataclasses import asdict, replace
+from pathlib import Path
+from typing import Any
+
+RUNS = {"teacher": "gm_loco_teacher", "student": "gm_loco_student"}
+"""Default run name per stage (``artifacts/<run>/``, ``runs/gpu/<run>/``)."""
+DEFAULT_ITERATIONS = {"teacher": 5000, "student": 2000}
+"""Total iterations per stage (``conf/exp/gm_loco.yaml``)."""
+CURVE_TAGS = {
+    "Train/mean_reward": "mean_reward",
+    "Train/mean_episode_length": "mean_episode_length",
+    "Perf/total_fps": "env_steps_per_s",
+    "Policy/mean_std": "action_std",
+}
+"""TensorBoard scalars of the curve besides the ``Loss/*`` terms (which are all taken)."""
+
+
+def _parse(argv: list[str] | None) -> argparse.Namespace:
+    p = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    p.add_argument("--stage", required=True, choices=sorted(RUNS))
+    p.add_argument("--run", default=None, help="run name (default gm_loco_teacher / gm_loco_student)")
+    p.add_argument("--contact-model", default="rft3d", choices=["rft3d", "heuristic_rft", "cone_multi", "rigid"])
+    p.add_argument("--terrain", default="flat", choices=["flat", "rough", "deep"])
+    p.add_argument("--num-envs", type=int, default=4096)
+    p.add_argument("--num-steps-per-env", type=int, default=24)
+    p.add_argument("--max-iterations", type=int, default=None, help="total (default 5000 teacher, 2000 student)")
+    p.add_argument("--max-minutes", type=float, default=9.0, help="whole call, post-training checks included")
+    p.add_argument("--post-minutes", type=float, default=1.5, help="part of the budget kept for step 3")
+    p.add_argument("--save-interval", type=int, default=50)
+    p.add_argument("--history-length", type=int, default=50, help="N (1 s at 50 Hz)")
+    p.add_argument("--latent-dim", type=int, default=16)
+    p.add_argument("--curriculum-finish", type=int, default=1000, help="student: w_PPO / w_dist ramp end")
+    p.add_argument("--no-held-out", action="store_true", help="let the DR draw the held-out region too")
+    p.add_argument("--teacher-checkpoint", type=Path, default=None)
+    p.add_argument("--check-envs", type=int, default=64, help="envs of the post-training rollout")
+    p.add_argument("--check-steps", type=int, default=250, help="steps of the post-training rollout (5 s)")
+    p.add_argument("--check-warmup", type=int, default=50, help="steps after a reset left out of the eta metrics")
+    p.add_argument("--parity-steps", type=int, default=40, help="student: ONNX rollout check steps")
+    p.add_argument("--seed", type=int, default=42)
+    p.add_argument("--device", default="cuda:0")
+    p.add_argument("--runs-root", type=Path, default=Path("runs/gpu"))
+    p.add_argument("--artifacts", type=Path, default=Path("artifacts"))
+    p.add_argument("--out", type=Path, required=True)
+    return p.parse_args(argv)
+
+
+def _newest(folder: Path) -> Path | None:
+    """Newest ``model_<it>.pt`` in ``folder``."""
+    from gmloco.train.rl.runner import latest_checkpoint
+
+    return latest_checkpoint(folder) if folder.is_dir() else None
+
+
+def _seed_run_dir(run_dir: Path, artifact: Path) -> int | None:
+    """Copy the committed checkpoint into an empty run directory; return its iteration."""
+    if _newest(run_dir) is not None or not (artifact / "checkpoint.pt").exists():
+        return None
+    import torch
+
+    it = int(torch.load(artifact / "checkpoint.pt", map_location="cpu", weights_only=False)["iter"])
+    shutil.copy(artifact / "checkpoint.pt", run_dir / f"model_{it}.pt")
+    if (artifact / "train_cfg.json").exists():
+        shutil.copy(artifact / "train_cfg.json", run_dir / "train_cfg.json")
+    return it
+
+
+def _teacher_checkpoint(args: argparse.Namespace) -> Path:
+    """The teacher the student starts from (see the module docstring for the order)."""
+    for path in (args.teacher_checkpoint, _newest(args.runs_root / RUNS["teacher"])):
+        if path is not None:
+            return Path(path)
+    committed = args.artifacts / RUNS["teacher"] / "checkpoint.pt"
+    if committed.exists():
+        return committed
+    sys.exit(f"no teacher checkpoint: pass --teacher-checkpoint or train the teacher first ({committed} missing)")
+
+
+def _task(args: argparse.Namespace) -> Any:
+    """The granular task: one actor frame (history goes through the encoders), DR without the held-out region."""
+    from gmloco.train import g1_granular_task
+    from gmloco.train.teacher_student import DEFAULT_HELD_OUT
+
+    task = replace(g1_granular_task(args.contact_model, args.terrain), policy_history_length=1)
+    if args.no_held_out:
+        return task
+    material = task.material
+    if not hasattr(material, "held_out_rho_c"):
+        sys.exit(
+            "MaterialRangeCfg has no held_out_rho_c / held_out_mu_int yet, so the DR would also draw the held-out "
+            "materials (see gmloco.train.teacher_student.heldout). Add them, or run with --no-held-out."
+        )
+    region = DEFAULT_HELD_OUT
+    return replace(task, material=replace(material, held_out_rho_c=region.rho_c, held_out_mu_int=region.mu_int))
+
+
+def _entries(args: argparse.Namespace) -> dict[str, Any]:
+    """rsl-rl entries of the stage (paper network sizes, package defaults)."""
+    from gmloco.train.teacher_student import DistillCfg, ObsGroupsCfg, StudentCfg, TeacherCfg, student_train_entries
+
+    teacher = TeacherCfg(latent_dim=args.latent_dim)
+    if args.stage == "teacher":
+        return teacher.to_rsl_rl(ObsGroupsCfg())
+    student = StudentCfg(history_length=args.history_length)
+    return student_train_entries(teacher, student, DistillCfg(curriculum_finish=args.curriculum_finish))
+
+
+def _curve(run_dir: Path) -> dict[str, list[float]]:
+    """This machine's TensorBoard scalars by iteration: reward, episode length, fps, std and every Loss/* term."""
+    from tensorboard.backend.event_processing.event_accumulator import EventAccumulator
+
+    series: dict[int, dict[str, float]] = {}
+    names: dict[str, str] = {}
+    for events in sorted(run_dir.rglob("events.out.tfevents.*")):
+        acc = EventAccumulator(str(events), size_guidance={"scalars": 0})
+        acc.Reload()
+        for tag in acc.Tags()["scalars"]:
+            name = CURVE_TAGS.get(tag) or (tag.replace("Loss/", "loss_") if tag.startswith("Loss/") else None)
+            if name is None:
+                continue
+            names[tag] = name
+            for ev in acc.Scalars(tag):
+                series.setdefault(ev.step, {})[name] = ev.value
+    its = sorted(series)
+    out: dict[str, list[float]] = {"iteration": [float(i) for i in its]}
+    for name in sorted(set(names.values()) | set(CURVE_TAGS.values())):
+        out[name] = [series[i].get(name, float("nan")) for i in its]
+    return out
+
+
+def _post_checks(args: argparse.Namespace, task: Any, checkpoint: Path, run_dir: Path) -> dict[str, Any]:
+    """Decoded-eta rollout on the DR; for the student also the ONNX export and its parity checks."""
+    from gmloco.train.evaluation_ts import decoded_eta_check
+    from gmloco.train.teacher_student.export_student import (
+        build_runner,
+        export_student_onnx,
+        rollout_parity_check,
+        student_policy_metadata,
+    )
+
+    play = replace(task, play=True)
+    runner = build_runner(
+        play, _entries(args), args.history_length, checkpoint, args.device, args.check_envs, args.seed + 1
+    )
+    try:
+        checks: dict[str, Any] = {}
+        if args.stage == "student":
+            commit = subprocess.run(["git", "rev-parse", "HEAD"], capture_output=True, text=True).stdout.strip()
+            metadata = student_policy_metadata(
+                runner, args.history_length, args.latent_dim, f"{run_dir.name}/{checkpoint.name}", commit or "unknown"
+            )
+            path, err = export_student_onnx(runner, args.out / "policy.onnx", metadata)
+            (args.out / "policy.json").write_text(json.dumps(asdict(metadata), indent=1))
+            checks |= {"onnx_max_abs_diff": err}
+            checks |= rollout_parity_check(runner, path, args.parity_steps, force_reset_after=args.parity_steps // 2)
+        checks |= decoded_eta_check(runner, args.check_steps, args.check_warmup)
+    finally:
+        runner.env.close()
+    return checks
+
+
+def main(argv: list[str] | None = None) -> dict[str, Any]:
+    """Run one chunk and write the files that come back; return the summary."""
+    args = _parse(argv)
+    t0 = time.monotonic()
+    from gmloco.train import TrainRunCfg, train
+
+    run = args.run or RUNS[args.stage]
+    run_dir = args.runs_root / run
+    run_dir.mkdir(parents=True, exist_ok=True)
+    args.out.mkdir(parents=True, exist_ok=True)
+    seeded = _seed_run_dir(run_dir, args.artifacts / run)
+    init = None
+    if args.stage == "student" and _newest(run_dir) is None:
+        init = _teacher_checkpoint(args)
+    task = _task(args)
+    cfg = TrainRunCfg(
+        task=task,
+        num_envs=args.num_envs,
+        max_iterations=args.max_iterations or DEFAULT_ITERATIONS[args.stage],
+        max_minutes=args.max_minutes - args.post_minutes,
+        seed=args.seed,
+        device=args.device,
+        run_dir=str(run_dir),
+        save_interval=args.save_interval,
+        num_steps_per_env=args.num_steps_per_env,
+        export_onnx=False,
+        rsl_rl_overrides=_entries(args),
+        history_length=args.history_length,
+        init_checkpoint=None if init is None else str(init),
+    )
+    metrics = train(cfg)
+    ckpt = _newest(run_dir)
+    assert ckpt is not None, f"train() left no checkpoint in {run_dir}"
+    shutil.copy(ckpt, args.out / "checkpoint.pt")
+    t_post = time.monotonic()
+    checks = _post_checks(args, task, ckpt, run_dir)
+    import torch
+
+    summary: dict[str, Any] = {
+        "run": run,
+        "stage": args.stage,
+        "args": {k: str(v) for k, v in vars(args).items()},
+        "seeded_from_artifact_iteration": seeded,
+        "teacher_checkpoint": None if init is None else str(init),
+        "held_out_excluded": not args.no_held_out,
+        "checkpoint": ckpt.name,
+        "metrics": metrics,
+        "checks": checks,
+        "train_cfg": json.loads((run_dir / "train_cfg.json").read_text()),
+        "curve": _curve(run_dir),
+        "post_checks_s": time.monotonic() - t_post,
+        "wall_s": time.monotonic() - t0,
+        "commit": subprocess.run(["git", "rev-parse", "HEAD"], capture_output=True, text=True).stdout.strip() or None,
+        "device": torch.cuda.get_device_name(0) if torch.cuda.is_available() else "cpu",
+    }
+    from gmloco.train.evaluation_ts import finite_json
+
+    (args.out / "summary.json").write_text(json.dumps(finite_json(summary), indent=1, default=str))
+    print(json.dumps(finite_json({"metrics": metrics, "checks": checks}), indent=1, default=str))
+    return summary
+
+
+if __name__ == "__main__":
+    main()
