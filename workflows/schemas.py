@@ -20,6 +20,8 @@ from omegaconf import MISSING, OmegaConf
 from stage_registry import stage_names
 
 __all__ = [
+    "AblationCfg",
+    "AblationSource",
     "AnalyzeLogsCfg",
     "ContactModelName",
     "DistillCfg",
@@ -34,6 +36,7 @@ __all__ = [
     "ScaleName",
     "StageCfg",
     "SweepCfg",
+    "SweepEvalCfg",
     "TerrainName",
     "TrackingCfg",
     "TrainAlgorithm",
@@ -302,21 +305,100 @@ class MismatchCfg(StageCfg):
 
 
 @dataclass
+class SweepEvalCfg:
+    """Evaluation of a trial's exported policy in the granular training simulator (``gmloco.train.EvalCfg``)."""
+
+    materials: list[str] = field(default_factory=lambda: ["dry_sand", "poppy_seed"])
+    """Material presets (``gmloco.contact.MATERIAL_PRESETS``), fixed for every trial."""
+    speeds: list[float] = field(default_factory=lambda: [1.0])
+    """Commanded forward speeds [m/s]."""
+    repeats: int = 4
+    """Envs per (material, speed) cell."""
+    duration_s: float = 10.0
+    """Episode duration that counts as success [s]."""
+
+
+@dataclass
 class SweepCfg:
-    """Optuna search over pipeline overrides (the sweep workflow is not implemented yet)."""
+    """Optuna search over the train stage (``workflows/sweep.py``; ``docs/sweeps.md``)."""
 
     metric: str = MISSING
-    """``<stage>/<metric>`` returned by a stage's ``run(cfg)``."""
+    """Objective: ``train_teacher/<metric>`` returned by the train stage (e.g. ``mean_reward``) or ``eval/<key>``
+    of ``gmloco.train.evaluate_policy`` on the trial's exported policy (e.g. ``eval/all/vel_error``; PPO only)."""
     direction: str = "maximize"
     """``maximize`` or ``minimize``."""
     n_trials: int = 20
-    """Trials in the study."""
+    """Finished trials (complete, pruned or failed) the study should hold."""
     sampler_seed: int = _interp("${seed}")
     """Seed of the TPE sampler (seeded samplers make sweeps reproducible)."""
     storage: str = _interp("sqlite:///${paths.runs_dir}/optuna.db")
     """Optuna storage URL (an RDB URL shares one study across machines)."""
     params: dict[str, Any] = field(default_factory=dict)
-    """Search space: override key -> ``{type: float|int|categorical, low, high, log, choices}``."""
+    """Search space: key -> ``{type: float|int|categorical, low, high, log, step, choices}``. Keys are config
+    overrides (``train_teacher.ppo.learning_rate``) or ``task.<field path>`` of ``gmloco.train.GranularTaskCfg``
+    with an index for range ends (``task.material.mu_int.0``)."""
+    study_name: str = _interp("${exp_name}")
+    """Study name inside the storage."""
+    experiment: str = "gm_loco"
+    """Experiment swept when the command line has no ``+exp=``."""
+    n_startup_trials: int = 5
+    """Random trials before the TPE sampler models the objective."""
+    pruner_startup_trials: int = 3
+    """Trials that finish before the median pruner prunes anything."""
+    pruner_warmup_steps: int = 0
+    """Training iterations of a trial before it may be pruned."""
+    report_chunks: int = 4
+    """Training of a trial runs in this many resumed chunks; the objective is reported after each (pruning)."""
+    task_overrides: dict[str, Any] = field(default_factory=dict)
+    """Fixed ``task.<field path>`` values applied to every trial (same keys as ``params``)."""
+    eval: SweepEvalCfg = field(default_factory=SweepEvalCfg)
+    """Evaluation used by ``eval/<key>`` objectives."""
+    requeue_interrupted: bool = True
+    """On start, mark trials left running by a killed or time-boxed call as failed and enqueue them again; the
+    retry continues in the same trial folder from its newest checkpoint. Only for one worker per study."""
+    smoke_trials: int = 2
+    """``n_trials`` at smoke scale."""
+    smoke_task_overrides: dict[str, Any] = field(default_factory=lambda: {"task.episode_length_s": 0.1})
+    """Extra ``task`` overrides at smoke scale, so that episodes finish within the few smoke steps."""
+    trial_params: dict[str, Any] = field(default_factory=dict)
+    """Set by the sweep in each trial's config: the trial number and its sampled values."""
+
+
+class AblationSource(str, Enum):
+    """Where the ablation's policies come from."""
+
+    artifacts = "artifacts"
+    """Committed ``artifacts/<exp>/policy.onnx`` (missing ones are reported missing)."""
+    train = "train"
+    """Train each experiment's train stage in ``<run_dir>/train/<exp>`` (time-boxed, resumable), then evaluate."""
+
+
+@dataclass
+class AblationCfg:
+    """Contact-model ablation of vanilla PPO policies (``workflows/ablation.py``; ``docs/sweeps.md``)."""
+
+    exps: list[str] = field(default_factory=lambda: ["ppo_rft3d", "ppo_heuristic_rft", "ppo_cone_multi", "ppo_rigid"])
+    """Experiments compared (``conf/exp/<name>.yaml``)."""
+    source: AblationSource = AblationSource.artifacts
+    """Evaluate committed artifacts or train the experiments first."""
+    artifacts_dir: str = _interp("${paths.root_dir}/artifacts")
+    """Folder holding ``<exp>/policy.onnx``."""
+    eval_contact_model: ContactModelName | None = ContactModelName.rft3d
+    """Contact model of the simulator every policy is evaluated in (one ground for all); None: each policy's own."""
+    terrain: TerrainName = TerrainName.flat
+    """Sand terrain of the evaluation."""
+    materials: list[str] = field(default_factory=lambda: ["dry_sand", "poppy_seed"])
+    """Material presets (``gmloco.contact.MATERIAL_PRESETS``)."""
+    speeds: list[float] = field(default_factory=lambda: [0.5, 1.0])
+    """Commanded forward speeds [m/s]."""
+    repeats: int = 4
+    """Envs per (material, speed) cell."""
+    duration_s: float = 10.0
+    """Episode duration that counts as success [s]."""
+    smoke_repeats: int = 1
+    """``repeats`` at smoke scale."""
+    smoke_duration_s: float = 0.5
+    """``duration_s`` at smoke scale [s]."""
 
 
 @dataclass
@@ -351,6 +433,8 @@ class PipelineCfg:
     mismatch: MismatchCfg = field(default_factory=MismatchCfg)
     sweep: SweepCfg | None = None
     """Optuna sweep settings, set by ``+sweep=<name>``; None outside sweeps."""
+    ablation: AblationCfg | None = None
+    """Contact-model ablation settings, set by ``+ablation=<name>``; None outside ablations."""
 
 
 def register_configs() -> None:
@@ -362,6 +446,7 @@ def register_configs() -> None:
     cs.store(group="paths", name="base_paths", node=PathsCfg)
     cs.store(group="tracking", name="base_tracking", node=TrackingCfg)
     cs.store(group="sweep", name="base_sweep", node=SweepCfg, package="sweep")
+    cs.store(group="ablation", name="base_ablation", node=AblationCfg, package="ablation")
 
 
 register_configs()

@@ -21,7 +21,19 @@ from stage_registry import StageSpec
 __all__ = ["VOLATILE_KEYS", "VOLATILE_STAGE_KEYS", "hashable_config", "stage_hashes"]
 
 VOLATILE_KEYS = frozenset(
-    {"run_dir", "run_name", "force", "max_minutes", "stages", "tracking", "paths", "device", "hydra", "sweep"}
+    {
+        "run_dir",
+        "run_name",
+        "force",
+        "max_minutes",
+        "stages",
+        "tracking",
+        "paths",
+        "device",
+        "hydra",
+        "sweep",
+        "ablation",
+    }
 )
 """Top-level keys that never change a stage's result (where it runs, how long, how it is tracked)."""
 

@@ -1,0 +1,314 @@
+# SPDX-License-Identifier: Apache-2.0
+"""The Optuna sweep workflow (``workflows/sweep.py``): search space, task overrides, study, pruning, resume, report.
+
+The study machinery runs with the train stage's ``run_training`` replaced by a fake whose metric is a known
+function of the trial's task (seconds); one ``slow`` test runs the real command at smoke scale on the CPU.
+"""
+
+from __future__ import annotations
+
+import json
+from collections.abc import Callable
+from pathlib import Path
+from typing import Any
+
+import pytest
+from omegaconf import DictConfig, OmegaConf
+
+import policy_training
+import sweep
+from stage_registry import StageIncompleteError
+from stage_runner import PipelineConfigError
+from tests.pipeline_helpers import run_cli
+
+MU_KEY = "task.material.mu_int.0"
+"""The searched DR range end in the fake-training tests."""
+LR_KEY = "train_teacher.ppo.learning_rate"
+"""A searched config override."""
+
+
+class FakeTraining:
+    """Stand-in for ``policy_training.run_training``: writes a checkpoint; mean_reward = mu_int low end x iteration."""
+
+    def __init__(self, interrupt_trial: int | None = None) -> None:
+        """``interrupt_trial``: trial number whose first call stops at its time box (after one checkpoint)."""
+        self.calls: list[dict[str, Any]] = []
+        self.interrupt_trial = interrupt_trial
+
+    def __call__(self, cfg: DictConfig, name: str, **kwargs: Any) -> dict[str, float]:
+        """Record the call, write ``model_<iteration>.pt``, return the metrics ``train`` would."""
+        section = cfg[name]
+        out = Path(section.out_dir)
+        out.mkdir(parents=True, exist_ok=True)
+        if not section.resume:
+            for p in out.glob("model_*.pt"):
+                p.unlink()
+        start = max((int(p.stem.split("_")[1]) for p in out.glob("model_*.pt")), default=0)
+        number = int(cfg.sweep.trial_params["number"])
+        task = kwargs["task"]
+        self.calls.append(
+            {
+                "trial": number,
+                "start": start,
+                "end": int(section.max_iterations),
+                "mu_low": task.material.mu_int[0],
+                "lr": float(section.ppo.learning_rate),
+                "episode_length_s": task.episode_length_s,
+            }
+        )
+        if number == self.interrupt_trial and start == 0:
+            (out / "model_1.pt").write_text("checkpoint")
+            raise StageIncompleteError("time box reached at iteration 1")
+        it = int(section.max_iterations)
+        (out / f"model_{it}.pt").write_text("checkpoint")
+        return {"iteration": float(it), "mean_reward": task.material.mu_int[0] * it}
+
+
+@pytest.fixture
+def fake_training(monkeypatch: pytest.MonkeyPatch) -> Callable[..., FakeTraining]:
+    """Install a :class:`FakeTraining` (and a task factory that does not import mjlab)."""
+    from gmloco.train.config import GranularTaskCfg
+
+    monkeypatch.setattr(policy_training, "task_cfg", lambda section: GranularTaskCfg())
+
+    def install(**kwargs: Any) -> FakeTraining:
+        fake = FakeTraining(**kwargs)
+        monkeypatch.setattr(policy_training, "run_training", fake)
+        return fake
+
+    return install
+
+
+def _sweep_cfg(compose: Callable[..., DictConfig], run_dir: Path, n_trials: int) -> DictConfig:
+    """The teacher sweep at smoke scale with a two-parameter space, 4 chunks of 8 iterations."""
+    cfg = compose(
+        "+exp=gm_loco",
+        "+sweep=optuna_teacher",
+        "+scale=smoke",
+        f"run_dir={run_dir}",
+        "device=cpu",
+        "tracking.wandb=disabled",
+        "train_teacher.max_iterations=8",
+    )
+    cfg.sweep.params = {
+        MU_KEY: {"type": "float", "low": 0.1, "high": 0.4},
+        LR_KEY: {"type": "float", "low": 3.0e-4, "high": 3.0e-3, "log": True},
+    }
+    cfg.sweep.smoke_trials = n_trials
+    cfg.sweep.n_startup_trials = 2
+    cfg.sweep.pruner_startup_trials = 1
+    return cfg
+
+
+def _load_study(run_dir: Path) -> Any:
+    """The study stored in the run directory."""
+    import optuna
+
+    return optuna.load_study(study_name="gm_loco", storage=f"sqlite:///{run_dir}/study.db")
+
+
+def test_parse_space_names_the_bad_entry() -> None:
+    """Keys outside task./train_teacher., unknown types, low >= high and empty choices are refused by name."""
+    bad = {
+        "seed": {"type": "int", "low": 0, "high": 3},
+        "task.action_scale": {"type": "uniform", "low": 0.1, "high": 0.3},
+        "task.material.mu_int.0": {"type": "float", "low": 0.4, "high": 0.1},
+        "task.command_curriculum": {"type": "categorical", "choices": []},
+    }
+    for key, spec in bad.items():
+        with pytest.raises(PipelineConfigError) as info:
+            sweep.parse_space({key: spec})
+        assert info.value.key == f"sweep.params.{key}"
+    space = sweep.parse_space({"task.reward_ramp_steps": {"type": "int", "low": 10, "high": 1000, "log": True}})
+    assert space[0].distribution().log and space[0].distribution().low == 10
+
+
+def test_apply_task_overrides_sets_nested_fields_and_range_ends() -> None:
+    """Dotted paths reach nested dataclasses and tuple ends; ints become floats in float fields; input untouched."""
+    from gmloco.train.config import GranularTaskCfg
+
+    base = GranularTaskCfg()
+    task = sweep.apply_task_overrides(
+        base,
+        {
+            "task.material.mu_int.0": 0.3,
+            "task.robot_dr.push_velocity": 0,
+            "task.terrain.floor.depth_range.1": 0.2,
+            "task.terrain.floor.num_levels": 7,
+            "task.command_curriculum": False,
+        },
+    )
+    assert task.material.mu_int == (0.3, base.material.mu_int[1])
+    assert task.robot_dr.push_velocity == 0.0 and isinstance(task.robot_dr.push_velocity, float)
+    assert task.terrain.floor.depth_range == (0.0, 0.2) and task.terrain.floor.num_levels == 7
+    assert task.command_curriculum is False
+    assert base.material.mu_int == (0.2, 0.9) and base.command_curriculum is True
+
+
+def test_apply_task_overrides_refuses_unknown_fields_and_empty_ranges() -> None:
+    """A typo names the valid fields; a range end that crosses the other end is refused."""
+    from gmloco.train.config import GranularTaskCfg
+
+    with pytest.raises(PipelineConfigError, match=r"no field 'mu_intt'.*mu_int"):
+        sweep.apply_task_overrides(GranularTaskCfg(), {"task.material.mu_intt.0": 0.3})
+    with pytest.raises(PipelineConfigError, match="not an index"):
+        sweep.apply_task_overrides(GranularTaskCfg(), {"task.material.mu_int.2": 0.3})
+    with pytest.raises(PipelineConfigError, match="low > high"):
+        sweep.apply_task_overrides(GranularTaskCfg(), {"task.material.mu_int.0": 0.95})
+
+
+def test_check_space_catches_ranges_that_only_some_samples_empty(compose: Callable[..., DictConfig]) -> None:
+    """mu_int low end searched up to 0.95 > the default high end 0.9: refused before any trial runs."""
+    cfg = compose("+exp=gm_loco", "+sweep=optuna_teacher")
+    space = sweep.parse_space({MU_KEY: {"type": "float", "low": 0.1, "high": 0.95}})
+    from gmloco.train.config import GranularTaskCfg
+
+    original = policy_training.task_cfg
+    policy_training.task_cfg = lambda section: GranularTaskCfg()  # type: ignore[assignment]
+    try:
+        with pytest.raises(PipelineConfigError, match="low > high"):
+            sweep.check_space(cfg, space, {})
+        sweep.check_space(cfg, sweep.parse_space({MU_KEY: {"type": "float", "low": 0.1, "high": 0.9}}), {})
+        with pytest.raises(PipelineConfigError, match="not a key"):
+            sweep.check_space(
+                cfg, sweep.parse_space({"train_teacher.ppo.lr": {"type": "float", "low": 0, "high": 1}}), {}
+            )
+    finally:
+        policy_training.task_cfg = original  # type: ignore[assignment]
+
+
+def test_chunk_ends_split_the_iterations() -> None:
+    """4 chunks of 10 iterations report at round(2.5)=2, 5, round(7.5)=8, 10; never more chunks than iterations."""
+    assert sweep.chunk_ends(10, 4) == [2, 5, 8, 10]
+    assert sweep.chunk_ends(2, 4) == [1, 2]
+    assert sweep.chunk_ends(1, 4) == [1]
+
+
+def test_objective_parse() -> None:
+    """``train_teacher/<m>`` and ``eval/<key>`` parse; anything else is refused naming sweep.metric."""
+    assert sweep.Objective.parse("eval/all/vel_error") == sweep.Objective("eval", "all/vel_error")
+    assert sweep.Objective.parse("train_teacher/mean_reward").key == "mean_reward"
+    with pytest.raises(PipelineConfigError) as info:
+        sweep.Objective.parse("mean_reward")
+    assert info.value.key == "sweep.metric"
+
+
+def test_study_runs_trials_in_run_dirs_prunes_and_resumes(
+    compose: Callable[..., DictConfig], fake_training: Callable[..., FakeTraining], tmp_path: Path
+) -> None:
+    """5 trials in their own run dirs, pruned by the median rule; a second call continues the study to 6.
+
+    Each trial has its resolved config and git state in ``trials/<n>``; the sampled values reach the training; the
+    summary matches the storage.
+    """
+    fake = fake_training()
+    summary = sweep.run_sweep(_sweep_cfg(compose, tmp_path, 5))
+    assert summary["exit_code"] == 0 and summary["finished"] == 5
+    assert (tmp_path / "study.db").is_file() and (tmp_path / "config.yaml").is_file() and (tmp_path / "git").is_dir()
+    rows = {r["number"]: r for r in summary["trials"]}
+    assert sorted(rows) == list(range(5))
+    for n, row in rows.items():
+        trial_dir = tmp_path / f"trials/{n:04d}"
+        assert row["run_dir"] == f"trials/{n:04d}"
+        trial_cfg = OmegaConf.load(trial_dir / "config.yaml")
+        assert trial_cfg.train_teacher.ppo.learning_rate == pytest.approx(row["params"][LR_KEY])
+        assert trial_cfg.sweep.trial_params.number == n
+        assert (trial_dir / "manifest.json").is_file() and (trial_dir / "git").is_dir()
+        calls = [c for c in fake.calls if c["trial"] == n]
+        assert all(c["mu_low"] == pytest.approx(row["params"][MU_KEY]) for c in calls)
+        assert all(c["lr"] == pytest.approx(row["params"][LR_KEY]) for c in calls)
+        assert all(c["episode_length_s"] == 0.1 for c in calls)  # smoke_task_overrides
+        # Chunks resume: each call starts where the previous one ended (8 iterations in 4 chunks).
+        assert [(c["start"], c["end"]) for c in calls] == [(0, 2), (2, 4), (4, 6), (6, 8)][: len(calls)]
+        reported = {int(k): v for k, v in row["intermediate"].items()}
+        assert reported == {c["end"]: pytest.approx(c["mu_low"] * c["end"]) for c in calls}
+        if row["state"] == "complete":
+            assert row["value"] == pytest.approx(row["params"][MU_KEY] * 8) and len(calls) == 4
+    states = summary["states"]
+    assert states["pruned"] >= 1 and states["complete"] >= 2 and sum(states.values()) == 5
+    assert all(len(r["intermediate"]) < 4 for r in rows.values() if r["state"] == "pruned")
+    best = max((r for r in rows.values() if r["state"] == "complete"), key=lambda r: r["value"])
+    assert summary["best"]["number"] == best["number"]
+    assert _load_study(tmp_path).best_trial.number == best["number"]
+    assert len((tmp_path / "trials.csv").read_text().splitlines()) == 6
+    assert (tmp_path / "figures" / "sweep.png").stat().st_size > 10_000
+    # A second call continues the study to 6 trials; the first 5 are kept as they were.
+    again = sweep.run_sweep(_sweep_cfg(compose, tmp_path, 6))
+    assert again["finished"] == 6 and [r["number"] for r in again["trials"]] == list(range(6))
+    assert [r["value"] for r in again["trials"][:5]] == [rows[n]["value"] for n in range(5)]
+
+
+def test_time_box_interrupts_a_trial_and_the_next_call_continues_it(
+    compose: Callable[..., DictConfig], fake_training: Callable[..., FakeTraining], tmp_path: Path
+) -> None:
+    """Trial 1 stops at its time box: exit 3; the rerun retries it in trials/0001 from its checkpoint."""
+    fake = fake_training(interrupt_trial=1)
+    first = sweep.run_sweep(_sweep_cfg(compose, tmp_path, 3))
+    assert first["exit_code"] == 3 and first["finished"] == 1
+    fake.interrupt_trial = None
+    second = sweep.run_sweep(_sweep_cfg(compose, tmp_path, 3))
+    assert second["exit_code"] == 0 and second["finished"] == 3
+    retry = next(r for r in second["trials"] if r["retry_of"] == 1)
+    assert retry["number"] == 2 and retry["run_dir"] == "trials/0001"
+    interrupted = [c for c in fake.calls if c["trial"] == 1]
+    continued = [c for c in fake.calls if c["trial"] == 2]
+    assert interrupted == [{**interrupted[0], "start": 0, "end": 2}]
+    assert continued[0]["start"] == 1 and continued[0]["mu_low"] == interrupted[0]["mu_low"]
+    assert 1 not in [r["number"] for r in second["trials"]]  # the interrupted attempt is not counted
+
+
+def test_requeue_interrupted_retries_a_killed_trial(tmp_path: Path) -> None:
+    """A trial left running by a killed call is failed and enqueued again with its values and folder."""
+    import optuna
+    from optuna.trial import TrialState
+
+    study = optuna.create_study(storage=f"sqlite:///{tmp_path}/s.db", study_name="s")
+    trial = study.ask({"x": optuna.distributions.FloatDistribution(0.0, 1.0)})
+    trial.set_user_attr("run_dir", "trials/0000")
+    trial.report(0.5, 3)
+    assert sweep.requeue_interrupted(study) == [0]
+    assert study.trials[0].state is TrialState.FAIL
+    waiting = study.trials[1]
+    assert waiting.state is TrialState.WAITING
+    assert waiting.user_attrs == {"run_dir": "trials/0000", "retry_of": 0, "reports": [[3, 0.5]]}
+    retried = study.ask({"x": optuna.distributions.FloatDistribution(0.0, 1.0)})
+    assert retried.params == trial.params
+    assert sweep.finished_trials(study) == []
+
+
+def test_importances_rank_the_parameter_that_matters(compose: Callable[..., DictConfig]) -> None:
+    """On f(x, y) = (x - 0.3)^2 (y unused), PED-ANOVA ranks x first; fewer than 5 complete trials give none."""
+    import optuna
+
+    study = optuna.create_study(sampler=optuna.samplers.RandomSampler(seed=0), direction="minimize")
+    study.optimize(lambda t: (t.suggest_float("x", 0, 1) - 0.3) ** 2 + 0 * t.suggest_float("y", 0, 1), n_trials=40)
+    found, why = sweep._importances(study, 40)
+    assert found is not None and why == ""
+    assert found["x"] > 0.8 and found["x"] > found["y"]
+    assert sweep._importances(study, 4)[0] is None
+
+
+@pytest.mark.parametrize(
+    ("args", "key"),
+    [(["+sweep=optuna_teacher", "sweep.metric=mean_reward"], "sweep.metric"), ([], "sweep")],
+)
+def test_bad_sweep_input_exits_2(tmp_path: Path, args: list[str], key: str) -> None:
+    """A malformed metric or no +sweep= is one paragraph naming the key, exit code 2, nothing written."""
+    res = run_cli(["workflows/sweep.py", *args, f"run_dir={tmp_path}", "+scale=smoke"], timeout=300)
+    assert res.returncode == 2, res.stderr[-3000:]
+    assert f"'{key}'" in res.stderr or f"{key}" in res.stderr
+    assert not (tmp_path / "study.db").exists() and not (tmp_path / "config.yaml").exists()
+
+
+@pytest.mark.slow
+def test_sweep_command_runs_two_real_trials_on_cpu(tmp_path: Path) -> None:
+    """``sweep.py +sweep=optuna_teacher`` on a CPU: smoke scale, 2 real trials, a summary, a CSV and a figure."""
+    res = run_cli(["workflows/sweep.py", "+sweep=optuna_teacher", f"run_dir={tmp_path}", "device=cpu"], timeout=1200)
+    assert res.returncode == 0, res.stderr[-4000:]
+    summary = json.loads((tmp_path / "study_summary.json").read_text())
+    assert summary["scale"] == "smoke" and summary["finished"] == 2
+    assert summary["states"]["complete"] + summary["states"]["pruned"] == 2
+    for row in summary["trials"]:
+        assert (tmp_path / row["run_dir"] / "train_teacher" / "model_2.pt").is_file() or row["state"] == "pruned"
+        assert len(row["intermediate"]) >= 1
+    assert (tmp_path / "figures" / "sweep.png").is_file() and (tmp_path / "trials.csv").is_file()
