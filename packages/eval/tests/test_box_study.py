@@ -8,6 +8,7 @@ from dataclasses import replace
 from pathlib import Path
 
 import numpy as np
+import pytest
 
 from gmloco.eval.box_study import box_study_smoke_cfg, run, sample_media
 from gmloco.eval.study_io import StudyRecords
@@ -51,3 +52,51 @@ def test_mpm_smoke_trial_scored(tmp_path: Path) -> None:
     series = StudyRecords(tmp_path).series()
     mpm = next(s for s in series if s["model"] == "mpm")
     assert len(mpm["grf"]) == round(cfg.box.duration / cfg.mpm.frame_dt)
+
+
+def test_size_variants_bookkeeping(tmp_path: Path) -> None:
+    """size_x<scale> variants: same mass, scaled footprint; summary carries a size-sensitivity block."""
+    from gmloco.eval.box_study import _variant_box
+
+    cfg = replace(box_study_smoke_cfg(str(tmp_path)), num_trials=2, variants=("forward", "size_x0.5"),
+                  models=("rigid", "rft3d"))  # fmt: skip
+    small = _variant_box(cfg, "size_x0.5")
+    assert small.mass == cfg.box.mass and small.size == (0.15, 0.15, 0.2)
+    summary = run(cfg)
+    sens = summary["size_sensitivity"]
+    assert set(sens["variants"]) == {"forward", "size_x0.5"}
+    assert sens["best_model_stable"]["travel_rel_err_median"] is None  # no MPM reference in this call
+    # 3D-RFT: the same weight on a quarter of the area sinks deeper
+    rows = StudyRecords(tmp_path).rows()
+    sink = {r["variant"]: r["sinkage"] for r in rows if r["model"] == "rft3d" and r["trial"] == 0}
+    assert sink["size_x0.5"] > sink["forward"]
+    with pytest.raises(ValueError, match="size_x"):
+        _variant_box(cfg, "size_xbig")
+
+
+def _fake_mpm_dir(path: Path, voxel: float, travel: list[float], sinkage: list[float]) -> Path:
+    """Write MPM-only study records with given per-trial travel and sinkage."""
+    rec = StudyRecords(path)
+    for t, (tr, sk) in enumerate(zip(travel, sinkage, strict=True)):
+        row = {"variant": "forward", "trial": t, "model": "mpm", "travel": tr, "sinkage": sk, "lateral_force": 0.0,
+               "peak_fz": 0.0, "wall_s": 1.0, "frames_per_s": 50.0, "particle_count": 10, "voxel_size": voxel}  # fmt: skip
+        rec.append(row, {"time": np.zeros(1), "grf": np.zeros((1, 3)), "pos": np.zeros((1, 3))})
+    return path
+
+
+def test_voxel_convergence_hand_values(tmp_path: Path) -> None:
+    """Differences to the finest voxel size, per trial then median; converged by the stated tolerances."""
+    from gmloco.eval.box_study_checks import voxel_convergence
+
+    d5 = _fake_mpm_dir(tmp_path / "v5", 0.05, [0.30, 0.40, 0.50], [0.020, 0.030, 0.040])
+    d3 = _fake_mpm_dir(tmp_path / "v3", 0.03, [0.21, 0.32, 0.41], [0.012, 0.022, 0.033])
+    d2 = _fake_mpm_dir(tmp_path / "v2", 0.02, [0.20, 0.30, 0.40], [0.010, 0.020, 0.030])
+    res = voxel_convergence([d3, d2, d5])
+    assert [lv["voxel_size"] for lv in res["levels"]] == [0.05, 0.03, 0.02]
+    # 3 cm vs 2 cm: travel 0.01/0.2 = 0.05, 0.02/0.3 = 0.067, 0.01/0.4 = 0.025 -> median 0.05; sinkage 2, 2, 3 mm
+    np.testing.assert_allclose(res["levels"][1]["travel_rel_diff_to_finest"], 0.05)
+    np.testing.assert_allclose(res["levels"][1]["sinkage_abs_diff_to_finest"], 0.002)
+    # 5 cm: travel 0.5, 0.333, 0.25 -> 0.333; sinkage 10 mm each
+    np.testing.assert_allclose(res["levels"][0]["travel_rel_diff_to_finest"], 1 / 3)
+    assert res["converged"] is True  # 0.05 <= 0.1 and 2 mm <= 5 mm
+    assert voxel_convergence([d5, d2])["converged"] is False

@@ -21,7 +21,10 @@ from gmloco.eval.mpm.bed import SandBedCfg, add_bed_container
 from gmloco.eval.mpm.coupled_setup import build_sand_model, make_coupled_states, make_mpm_solver
 from gmloco.eval.mpm.materials import GranularMaterial, MpmMaterialCfg, mpm_material
 
-__all__ = ["MpmBoxScene", "MpmBoxSceneCfg", "MpmSolverCfg"]
+__all__ = ["MIN_RHEOLOGY_ITERATIONS", "MpmBoxScene", "MpmBoxSceneCfg", "MpmSolverCfg"]
+
+MIN_RHEOLOGY_ITERATIONS = 25
+"""Newton 1.5.2's Gauss-Seidel ``solve_granularity``: the eager solver loop runs ``max_iterations // 25`` batches."""
 
 
 @dataclass(frozen=True)
@@ -35,7 +38,8 @@ class MpmSolverCfg:
     rigid_substeps: int = 4
     """Rigid-solver substeps per frame."""
     max_iterations: int = 50
-    """Rheology solver iterations per step."""
+    """Rheology solver iterations per step. Without a CUDA graph Newton runs ``max_iterations // 25`` batches of 25
+    Gauss-Seidel sweeps, so fewer than 25 means *no* solve at all: no collider acts (issue 5's zero plate force)."""
     tolerance: float = 1.0e-4
     """Rheology solver tolerance."""
     grid_type: Literal["sparse", "dense", "fixed"] = "sparse"
@@ -46,6 +50,15 @@ class MpmSolverCfg:
     """Active-cell capacity; raise it at fine voxels or the fixed grid overflows (issue 5 timings)."""
     strain_basis: str = "P0"
     """Strain basis (Newton's coupled example: P0)."""
+
+    def __post_init__(self) -> None:
+        """Refuse settings under which Newton's eager (CPU / no-graph) rheology loop would not iterate."""
+        if self.max_iterations < MIN_RHEOLOGY_ITERATIONS:
+            raise ValueError(
+                f"max_iterations={self.max_iterations}: SolverImplicitMPM runs max_iterations // "
+                f"{MIN_RHEOLOGY_ITERATIONS} Gauss-Seidel batches without a CUDA graph, so below "
+                f"{MIN_RHEOLOGY_ITERATIONS} no contact or rheology solve happens (sand falls through every collider)"
+            )
 
 
 @dataclass(frozen=True)
@@ -62,6 +75,10 @@ class MpmBoxSceneCfg:
     """Warp device; None = Warp's default."""
     use_cuda_graph: bool = True
     """Capture one frame in a CUDA graph when the device is CUDA and the grid is fixed."""
+    rigid_solver: Literal["mujoco", "semi_implicit"] = "mujoco"
+    """Integrator of the free box: ``"mujoco"`` (SolverMuJoCo: MuJoCo C on CPU, mujoco_warp on CUDA) or
+    ``"semi_implicit"`` (Newton's SolverSemiImplicit, no angular damping): the box has no joints or rigid
+    contacts, so both integrate the same Newton-Euler equations; the latter builds in milliseconds on a GPU."""
 
 
 class MpmBoxScene:
@@ -126,6 +143,10 @@ class MpmBoxScene:
         """Implicit MPM reading its colliders (box + container) from the rigid model; MuJoCo for the box."""
         self.mpm = make_mpm_solver(newton, self.sand_model, self.cfg.solver, self.mat)
         self.mpm.setup_collider(model=self.model)
+        if self.cfg.rigid_solver == "semi_implicit":
+            # no rigid contacts in the model's collision pipeline: step() gets contacts=None
+            self.rigid = newton.solvers.SolverSemiImplicit(self.model, angular_damping=0.0)
+            return
         # no rigid contacts: the box touches only sand (MuJoCo C on CPU, mujoco_warp on CUDA)
         self.rigid = newton.solvers.SolverMuJoCo(
             self.model, use_mujoco_cpu=not self.device.is_cuda, use_mujoco_contacts=False, njmax=16, nconmax=16

@@ -78,7 +78,7 @@ class RftFitResult:
     coeffs: np.ndarray
     """Fitted c_j^k, [20, 3] (rows k, columns j)."""
     residual_rms: float
-    """RMS of G_fit - G_measured over all components [-]."""
+    """RMS of G_fit - G_measured over all fitted components (normal-only samples: their normal part) [-]."""
     relative_residual: float
     """|G_fit - G| / |G| over all samples (Frobenius) [-]."""
     rank: int
@@ -94,10 +94,13 @@ def fit_rft3d_coeffs(
     weights: np.ndarray | None = None,
     ridge: float = 0.0,
     prior: np.ndarray | None = None,
+    normal_only: np.ndarray | None = None,
 ) -> RftFitResult:
     """Fit the 60 coefficients by (weighted, optionally ridge-regularized) linear least squares.
 
-    Minimizes sum_s w_s |A_s c - G_s|^2 + ridge |c - prior|^2.
+    Minimizes sum_s w_s |P_s (A_s c - G_s)|^2 + ridge |c - prior|^2, where P_s is the identity, or for a
+    ``normal_only`` sample the projection on its normal n_s: the RFT surface-friction cap (spec 1.1 step 7)
+    keeps G.n exactly but replaces G_t, so a friction-limited measurement constrains only G.n.
 
     Args:
         normals: Leading-face outward normals, [N, 3].
@@ -106,25 +109,40 @@ def fit_rft3d_coeffs(
         weights: Per-sample weights, [N]; None = 1.
         ridge: Tikhonov weight towards ``prior`` [-].
         prior: Prior coefficients [20, 3]; None = zeros.
+        normal_only: Samples of which only the normal component is fitted, bool [N]; None = none.
     """
     a = rft3d_design_matrix(normals, velocities)
     g = np.asarray(generic, dtype=np.float64).ravel()
     w = np.ones(len(normals)) if weights is None else np.asarray(weights, dtype=np.float64)
-    sw = np.repeat(np.sqrt(w), 3)
     c0 = np.zeros(60) if prior is None else np.asarray(prior, dtype=np.float64).ravel()
-    lhs, rhs = a * sw[:, None], g * sw
+    proj = _row_projectors(np.asarray(normals, dtype=np.float64), normal_only)  # [N, 3, 3]
+    a_p = np.einsum("sij,sjk->sik", proj, a.reshape(-1, 3, 60)).reshape(-1, 60)
+    g_p = np.einsum("sij,sj->si", proj, g.reshape(-1, 3)).ravel()
+    sw = np.repeat(np.sqrt(w), 3)
+    lhs, rhs = a_p * sw[:, None], g_p * sw
     if ridge > 0.0:
         lhs = np.vstack([lhs, np.sqrt(ridge) * np.eye(60)])
         rhs = np.concatenate([rhs, np.sqrt(ridge) * c0])
     c, *_ = np.linalg.lstsq(lhs, rhs, rcond=None)
-    resid = a @ c - g
+    resid = a_p @ c - g_p
     return RftFitResult(
         coeffs=c.reshape(20, 3),
         residual_rms=float(np.sqrt(np.mean(resid**2))),
-        relative_residual=float(np.linalg.norm(resid) / max(np.linalg.norm(g), 1e-300)),
-        rank=int(np.linalg.matrix_rank(a)),
+        relative_residual=float(np.linalg.norm(resid) / max(np.linalg.norm(g_p), 1e-300)),
+        rank=int(np.linalg.matrix_rank(a_p)),
         num_samples=len(normals),
     )
+
+
+def _row_projectors(normals: np.ndarray, normal_only: np.ndarray | None) -> np.ndarray:
+    """Per-sample 3x3 row maps: identity, or n n^T for normal-only samples, [N, 3, 3]."""
+    eye = np.broadcast_to(np.eye(3), (len(normals), 3, 3)).copy()
+    if normal_only is None:
+        return eye
+    mask = np.asarray(normal_only, dtype=bool)
+    n = normals / np.linalg.norm(normals, axis=-1, keepdims=True)
+    eye[mask] = np.einsum("si,sj->sij", n[mask], n[mask])
+    return eye
 
 
 def save_rft3d_coeffs(path: str | Path, coeffs: np.ndarray, meta: dict[str, Any] | None = None) -> Path:
