@@ -64,6 +64,12 @@ def _parse(argv: list[str] | None) -> argparse.Namespace:
     p.add_argument("--curriculum-finish", type=int, default=1000, help="student: w_PPO / w_dist ramp end")
     p.add_argument("--no-held-out", action="store_true", help="let the DR draw the held-out region too")
     p.add_argument("--teacher-checkpoint", type=Path, default=None)
+    p.add_argument(
+        "--curriculum-scale",
+        type=float,
+        default=None,
+        help="GranularTaskCfg.curriculum_scale (default: the run's saved value; student: the teacher's)",
+    )
     p.add_argument("--check-envs", type=int, default=64, help="envs of the post-training rollout")
     p.add_argument("--check-steps", type=int, default=250, help="steps of the post-training rollout (5 s)")
     p.add_argument("--check-warmup", type=int, default=50, help="steps after a reset left out of the eta metrics")
@@ -107,12 +113,30 @@ def _teacher_checkpoint(args: argparse.Namespace) -> Path:
     sys.exit(f"no teacher checkpoint: pass --teacher-checkpoint or train the teacher first ({committed} missing)")
 
 
+def _curriculum_scale(args: argparse.Namespace) -> float | None:
+    """``--curriculum-scale``, else the run's saved value, else (student) the teacher run's; None: task default."""
+    if args.curriculum_scale is not None:
+        return args.curriculum_scale
+    run = args.run or RUNS[args.stage]
+    candidates = [args.runs_root / run / "train_cfg.json"]
+    if args.stage == "student":
+        teacher = RUNS["teacher"]
+        candidates += [args.runs_root / teacher / "train_cfg.json", args.artifacts / teacher / "train_cfg.json"]
+    for path in candidates:
+        if path.exists():
+            return json.loads(path.read_text())["task"].get("curriculum_scale")
+    return None
+
+
 def _task(args: argparse.Namespace) -> Any:
     """The granular task: one actor frame (history goes through the encoders), DR without the held-out region."""
     from gmloco.train import g1_granular_task
     from gmloco.train.teacher_student import DEFAULT_HELD_OUT
 
     task = replace(g1_granular_task(args.contact_model, args.terrain), policy_history_length=1)
+    scale = _curriculum_scale(args)
+    if scale is not None:
+        task = replace(task, curriculum_scale=scale)
     if args.no_held_out:
         return task
     material = task.material
@@ -122,6 +146,9 @@ def _task(args: argparse.Namespace) -> Any:
             "materials (see gmloco.train.teacher_student.heldout). Add them, or run with --no-held-out."
         )
     region = DEFAULT_HELD_OUT
+    lo, hi = material.mu_int
+    if not lo <= region.mu_int[0] < region.mu_int[1] <= hi:
+        sys.exit(f"held-out mu_int {region.mu_int} is outside this terrain's DR range {material.mu_int}: --no-held-out")
     return replace(task, material=replace(material, held_out_rho_c=region.rho_c, held_out_mu_int=region.mu_int))
 
 
@@ -156,6 +183,16 @@ def _curve(run_dir: Path) -> dict[str, list[float]]:
     out: dict[str, list[float]] = {"iteration": [float(i) for i in its]}
     for name in sorted(set(names.values()) | set(CURVE_TAGS.values())):
         out[name] = [series[i].get(name, float("nan")) for i in its]
+    return out
+
+
+def _last_values(curve: dict[str, list[float]], window: int = 10) -> dict[str, float]:
+    """Mean of the last ``window`` finite values of every curve column (per-term state at the end of the chunk)."""
+    out = {}
+    for name, values in curve.items():
+        finite = [v for v in values[-window:] if v == v]  # drop NaN
+        if name != "iteration" and finite:
+            out[name] = sum(finite) / len(finite)
     return out
 
 
@@ -239,7 +276,8 @@ def main(argv: list[str] | None = None) -> dict[str, Any]:
         "metrics": metrics,
         "checks": checks,
         "train_cfg": json.loads((run_dir / "train_cfg.json").read_text()),
-        "curve": _curve(run_dir),
+        "curve": (curve := _curve(run_dir)),
+        "last_values": _last_values(curve),
         "post_checks_s": time.monotonic() - t_post,
         "wall_s": time.monotonic() - t0,
         "commit": subprocess.run(["git", "rev-parse", "HEAD"], capture_output=True, text=True).stdout.strip() or None,

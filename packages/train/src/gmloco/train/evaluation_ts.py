@@ -503,9 +503,10 @@ def fig_adaptation(cfg: TsEvalCfg, result: dict[str, Any], path: Path, env_index
     ax[1].set(xlabel="distance along the initial heading [m]", ylabel="height [m]")
     ax[1].legend(fontsize=8)
     bounds = [-math.inf, *cfg.adaptation_edges, math.inf]
+    s_lo, s_hi = (float(s.min()), float(s.max())) if s.size else (0.0, 1.0)
     for a in ax:
         for i, name in enumerate(cfg.adaptation_materials):
-            lo, hi = max(bounds[i], float(s.min(initial=0.0))), min(bounds[i + 1], float(s.max(initial=1.0)))
+            lo, hi = max(bounds[i], s_lo), min(bounds[i + 1], s_hi)
             if hi > lo:
                 a.axvspan(lo, hi, color=f"C{i + 4}", alpha=0.12, lw=0)
                 if a is ax[1]:
