@@ -1,19 +1,19 @@
 # SPDX-License-Identifier: Apache-2.0
 """Stage ``eval_mpm``: the exported policy walking on Newton implicit-MPM sand, scored by the paper's metrics (issue 9).
 
-Thin wrapper around ``gmloco.eval.g1_eval.run``: the G1 (MuJoCo through Newton's ``SolverMuJoCo``) coupled two-way
-with ``SolverImplicitMPM`` sand, the ONNX policy at 50 Hz over 200 Hz physics; per episode a fresh bed covering
-the commanded path. Writes ``episodes.jsonl`` (one line per episode, the resume state) and ``summary.json`` (temporary file +
-``os.replace``) under
-``cfg.eval_mpm.out_dir``; returns success rate, velocity / yaw tracking error, DTW path error, the sand's support
-ratio and frames/s per (material, scenario[, speed]) and ``all/...``.
+Thin wrapper around ``gmloco.eval.g1_eval.run``: G1s (MuJoCo through Newton's ``SolverMuJoCo``) coupled two-way
+with ``SolverImplicitMPM`` sand, the ONNX policy at 50 Hz over 200 Hz physics; ``robots_per_batch`` episodes at
+once, each robot on its own sand window that moves with it (``moving_window=false``: a static bed covering the
+course). Writes ``episodes.jsonl`` (one line per episode, the resume state), ``summary.json`` (temporary file +
+``os.replace``), ``table_*.md/csv``, ``fig_*.png`` and ``recordings/*.mcap`` under ``cfg.eval_mpm.out_dir``;
+returns success rate, velocity / yaw tracking error, DTW path error, support ratio and sinkage per
+(terrain, scenario[, speed]) and ``all/...``, and ``throughput/episodes_per_minute``.
 
 Run alone (time-boxed and resumable; works with plain ``python`` and ``PYTHONPATH=packages/*/src:workflows``)::
 
     python workflows/eval_mpm.py +exp=gm_loco run_dir=runs/gm_loco/<name> max_minutes=9
 
-Not yet at the paper's scale: a full-length bed per episode (a 25 m course at 2.5 m/s x 10 s) is far too slow;
-the moving sand window / several robots per bed of issue 9 are open.
+Throughput and the voxel-size convergence check: ``scripts/gpu/bench_mpm_eval.py``.
 """
 
 from __future__ import annotations
@@ -38,6 +38,7 @@ def run(cfg: DictConfig) -> dict[str, float]:
     from gmloco.eval.g1_eval import G1EvalCfg
     from gmloco.eval.g1_eval import run as run_eval
     from gmloco.eval.mpm.box_scene import MpmSolverCfg
+    from gmloco.eval.mpm.window import SandWindowCfg
 
     s = cfg.eval_mpm
     base = G1EvalCfg()
@@ -45,7 +46,7 @@ def run(cfg: DictConfig) -> dict[str, float]:
         base,
         policy_path=str(Path(str(s.policy_dir)) / str(s.policy_file)),
         out_dir=str(s.out_dir),
-        materials=tuple(str(m) for m in s.materials),
+        terrains=tuple(str(t) for t in s.terrains),
         scenarios=tuple(str(x) for x in s.scenarios),  # type: ignore[arg-type]
         speeds=tuple(float(v) for v in s.speeds),
         num_episodes=int(s.num_episodes),
@@ -53,6 +54,10 @@ def run(cfg: DictConfig) -> dict[str, float]:
         circle_radius=float(s.circle_radius),
         course_slack=float(s.course_slack),
         bed_depth=float(s.bed_depth),
+        window=SandWindowCfg(moving=bool(s.moving_window), length=float(s.window_length), width=float(s.window_width)),
+        robots_per_batch=int(s.robots_per_batch),
+        cell_capacity_factor=float(s.cell_capacity_factor),
+        record_mcap=bool(s.record_mcap),
         solver=replace(base.solver, voxel_size=float(s.voxel_size)),
         seed=int(cfg.seed),
         device=_device(str(cfg.device)),

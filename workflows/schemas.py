@@ -256,9 +256,12 @@ class EvalMpmCfg(StageCfg):
     """Episode length = course time limit [s]."""
     voxel_size: float = 0.03
     """MPM voxel size [m]."""
-    materials: list[str] = field(default_factory=lambda: ["dry_sand"])
-    """Media (``gmloco.contact.MATERIAL_PRESETS`` names)."""
-    scenarios: list[str] = field(default_factory=lambda: ["straight"])
+    terrains: list[str] = field(
+        default_factory=lambda: ["basalt", "dry_sand", "poppy_seed", "dry_sand_rough", "dry_sand_deep", "transition"]
+    )
+    """Terrains (``gmloco.eval.mpm.window_terrain.terrain_cfg`` names: a medium, ``<medium>_rough``,
+    ``<medium>_deep``, ``transition``)."""
+    scenarios: list[str] = field(default_factory=lambda: ["straight", "circle"])
     """``straight`` and/or ``circle`` (``gmloco.eval.g1_eval``)."""
     speeds: list[float] = field(default_factory=lambda: [1.0, 1.5, 2.0, 2.5])
     """Forward-speed commands [m/s]; episode k uses ``speeds[k % len(speeds)]``."""
@@ -267,7 +270,19 @@ class EvalMpmCfg(StageCfg):
     course_slack: float = 0.2
     """Fraction of the commanded path that may be left at the time limit and still count as finished."""
     bed_depth: float = 0.15
-    """Sand depth [m]."""
+    """Sand depth [m] (the deep terrain has its own 0.30 m)."""
+    moving_window: bool = True
+    """Sand window moving with each robot (False: a static bed covering the course, the naive baseline)."""
+    window_length: float = 1.6
+    """Moving window size along x [m]."""
+    window_width: float = 1.0
+    """Moving window size along y [m]."""
+    robots_per_batch: int = 25
+    """Robots sharing one MPM solver (one lane each)."""
+    cell_capacity_factor: float = 3.0
+    """Grid capacity = factor x particles / particles-per-cell (fixed capacity allows a CUDA graph); 0 = unbounded."""
+    record_mcap: bool = True
+    """Write the first episode of every (terrain, scenario, speed) as an MCAP recording."""
 
 
 @dataclass

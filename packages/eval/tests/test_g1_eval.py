@@ -8,7 +8,8 @@ from dataclasses import replace
 
 import numpy as np
 
-from gmloco.eval.g1_eval import EpisodeSpec, G1EvalCfg, episode_specs, score_episode, summarize
+from gmloco.eval.g1_eval import EpisodeSpec, G1EvalCfg, episode_batches, episode_specs, score_episode, summarize
+from gmloco.eval.tables_mpm import table_speeds, table_terrains
 
 
 def _log(xy: np.ndarray, vxy: np.ndarray, z: np.ndarray, dt: float, wz: float = 0.0) -> dict:
@@ -20,7 +21,7 @@ def _log(xy: np.ndarray, vxy: np.ndarray, z: np.ndarray, dt: float, wz: float = 
     qd[:, :2], qd[:, 5] = vxy, wz
     force = np.zeros((n, 2, 3))
     force[:, :, 2] = 0.5 * 30.0 * 9.81
-    return {"dt": dt, "base_q": q, "base_qd": qd, "foot_force": force, "sole_z": np.full(n, -0.02),
+    return {"dt": dt, "base_q": q, "base_qd": qd, "foot_force": force, "sinkage": np.full(n, 0.02),
             "start_xy": np.zeros(2), "robot_mass": 30.0, "particles": 1, "build_s": 0.0, "sim_s": 1.0,
             "frames": n}  # fmt: skip
 
@@ -37,6 +38,7 @@ def test_perfect_straight_walk_succeeds() -> None:
     assert math.isclose(row["vel_error"], 0.0, abs_tol=1e-12) and math.isclose(row["yaw_error"], 0.0)
     assert row["path_error"] < 0.011  # half a sample spacing at most
     assert math.isclose(row["support_ratio"], 1.0) and math.isclose(row["max_sinkage"], 0.02)
+    assert math.isclose(row["mean_sinkage"], 0.02)
 
 
 def test_standing_still_times_out_and_fall_fails() -> None:
@@ -52,14 +54,23 @@ def test_standing_still_times_out_and_fall_fails() -> None:
     assert (row["reason"], row["alive_s"]) == ("base_height", 10 * dt)
 
 
-def test_episode_specs_and_summary() -> None:
-    """2 materials x 1 scenario x 3 episodes, speeds cycled; summary groups by cell and speed."""
-    cfg = replace(G1EvalCfg(), materials=("dry_sand", "poppy_seed"), num_episodes=3, speeds=(1.0, 2.0))
+def test_episode_specs_batches_summary_and_tables() -> None:
+    """2 terrains x 1 scenario x 3 episodes, speeds cycled; batches stay in a cell; summary and tables agree."""
+    cfg = replace(G1EvalCfg(), terrains=("dry_sand", "poppy_seed"), num_episodes=3, speeds=(1.0, 2.0))
     specs = episode_specs(cfg)
     assert [s.speed for s in specs[:3]] == [1.0, 2.0, 1.0] and len({s.key for s in specs}) == 6
-    rows = [{"material": s.material, "scenario": s.scenario, "speed": s.speed, "success": s.index == 0,
+    # batches of 2: [ds0, ds1], [ds2], [ps0, ps1], [ps2] (a batch never mixes terrains)
+    assert [[s.index for s in b] for b in episode_batches(specs, 2)] == [[0, 1], [2], [0, 1], [2]]
+    rows = [{"terrain": s.terrain, "scenario": s.scenario, "speed": s.speed, "success": s.index == 0,
              "vel_error": 0.1 * s.index, "yaw_error": 0.0, "path_error": 0.0, "support_ratio": 1.0,
-             "max_sinkage": 0.01, "frames_per_s": 5.0} for s in specs]  # fmt: skip
+             "max_sinkage": 0.01, "mean_sinkage": 0.005} for s in specs]  # fmt: skip
     m = summarize(rows)
     assert math.isclose(m["all/success_rate"], 1 / 3) and m["all/num_episodes"] == 6
     assert math.isclose(m["dry_sand/straight/v1/vel_error"], 0.1) and m["poppy_seed/straight/v2/num_episodes"] == 1
+    # table: dry sand success 1/3 = 33.3 %, velocity error mean(0, 0.1, 0.2) = 0.1 m/s, sinkage 0.5 cm
+    t = table_terrains(rows, "p")
+    assert t[0][:4] == ["p", "dry_sand", "straight", 3]
+    np.testing.assert_allclose(t[0][4:], [100 / 3, 0.1, 0.0, 0.0, 0.5])
+    header, body = table_speeds(rows)
+    # v = 1: episodes 0 (success) and 2 (fail) -> 50 %; v = 2: episode 1 (fail) -> 0 %
+    assert header[2:] == ["v=1 m/s", "v=2 m/s"] and body[0][2:] == [50.0, 0.0]

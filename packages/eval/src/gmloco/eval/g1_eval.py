@@ -1,19 +1,22 @@
 # SPDX-License-Identifier: Apache-2.0
-"""Episodes of the G1 on MPM sand and their paper metrics (issue 9): resumable, time-boxed, CPU or CUDA.
+"""Episodes of the G1 on MPM sand and their paper metrics (issue 9): batched, resumable, time-boxed, CPU or CUDA.
 
-One episode = a fresh bed (seeded jitter), the robot dropped onto it in its default pose, a constant command for
-``episode_s``: ``straight`` (v_x, 0, 0) or ``circle`` (v_x, 0, v_x / R). Logged at the policy rate (50 Hz): base
-pose and velocity, sand force on the feet, sole height. Scored with :mod:`gmloco.eval.metrics.locomotion`:
+Episodes of one (terrain, scenario) cell run in batches of ``robots_per_batch`` robots that share one MPM solver,
+each in its own lane on its own sand window (:mod:`gmloco.eval.mpm.window`; moving with the robot, or a static
+bed covering the course). An episode = the robot dropped onto fresh sand in its default pose, a constant command
+for ``episode_s``: ``straight`` (v, 0, 0) or ``circle`` (v, 0, v / R). Logged at the policy rate (50 Hz) and scored
+with :mod:`gmloco.eval.metrics.locomotion`:
 
-* failure: base height < 0.2 m above the sand surface, |roll| or |pitch| > pi/4, or the course not finished
+* failure: base height < 0.2 m above the local sand surface, |roll| or |pitch| > pi/4, or the course not finished
   in ``episode_s``. The course is the commanded path (``circular_path``); it counts as finished once the nearest
   commanded sample to the base (searched forwards only) is past ``1 - course_slack`` of the path (a project
   choice: the paper gives no tolerance, and an exact v T lets no lag through).
 * velocity tracking error: mean |v_xy - v_cmd| in the yaw frame over alive steps; yaw tracking error: mean
   |w_z - w_cmd| over alive steps; path error: DTW between executed and commanded xy paths (alive part).
 
-Outputs under ``out_dir``: ``episodes.jsonl`` (one line per finished episode; the resume state) and
-``summary.json`` (per (material, scenario, speed) and overall).
+Outputs under ``out_dir``: ``episodes.jsonl`` (one line per finished episode; the resume state),
+``summary.json`` (metrics per group, throughput, config), the paper-shaped tables (``tables_mpm``), figures
+(``figures_mpm``) and ``recordings/<terrain>__<scenario>__v<speed>.mcap`` (the first episode of every group).
 """
 
 from __future__ import annotations
@@ -27,6 +30,7 @@ from typing import Any, Literal
 
 import numpy as np
 
+from gmloco.eval.g1_eval_policy import load_policy
 from gmloco.eval.metrics.locomotion import (
     FailureCfg,
     circular_path,
@@ -36,10 +40,10 @@ from gmloco.eval.metrics.locomotion import (
     metric_yaw_tracking_error,
     quat_wxyz_to_roll_pitch_yaw,
 )
-from gmloco.eval.mpm.bed import SandBedCfg
 from gmloco.eval.mpm.box_scene import MpmSolverCfg
+from gmloco.eval.mpm.window import SandWindowCfg
 
-__all__ = ["EpisodeSpec", "G1EvalCfg", "episode_specs", "load_policy", "run", "run_episode", "score_episode"]
+__all__ = ["EpisodeSpec", "G1EvalCfg", "episode_batches", "episode_specs", "load_policy", "run", "score_episode"]
 
 Scenario = Literal["straight", "circle"]
 
@@ -52,32 +56,41 @@ class G1EvalCfg:
     """Exported policy: gmloco student format (``obs`` + ``history``) or mjlab's actor export (``obs`` only)."""
     out_dir: str = "results/mpm_eval"
     """Output folder."""
-    materials: tuple[str, ...] = ("dry_sand",)
-    """Media (``gmloco.contact.MATERIAL_PRESETS`` names)."""
+    terrains: tuple[str, ...] = ("dry_sand",)
+    """Terrains (``gmloco.eval.mpm.window_terrain.terrain_cfg`` names: a preset medium, ``<medium>_rough``,
+    ``<medium>_deep``, ``transition``)."""
     scenarios: tuple[Scenario, ...] = ("straight",)
     """Command scenarios."""
     speeds: tuple[float, ...] = (1.0, 1.5, 2.0, 2.5)
     """Forward-speed commands [m/s]; episode k of a cell uses ``speeds[k % len(speeds)]``."""
     num_episodes: int = 100
-    """Episodes per (material, scenario)."""
+    """Episodes per (terrain, scenario)."""
     episode_s: float = 10.0
     """Episode length = course time limit [s]."""
     circle_radius: float = 2.0
     """Radius of the circular walk [m] (yaw rate = v / R)."""
     course_slack: float = 0.2
     """Fraction of the commanded path that may be left when time runs out and still count as finished [-]."""
-    bed_width: float = 0.6
-    """Bed width across the path [m] (straight) or margin around the circle (circle) [m]."""
     bed_depth: float = 0.15
-    """Bed depth [m]."""
-    bed_margin: float = 0.4
-    """Bed length beyond the commanded path at each end [m]."""
+    """Sand depth of the flat and rough terrains [m] (the deep terrain has its own 0.30 m)."""
+    window: SandWindowCfg = field(default_factory=SandWindowCfg)
+    """Sand window of each robot (``moving=False``: a static bed covering the course, the naive baseline)."""
+    bed_margin: float = 0.6
+    """Static beds: margin around the commanded path [m]."""
+    robots_per_batch: int = 25
+    """Robots (lanes) simulated together in one MPM solver."""
+    lane_gap: float = 2.0
+    """Free space between neighbouring lanes' windows or paths [m] (robots may drift)."""
+    cell_capacity_factor: float = 3.0
+    """Grid capacity = factor x particles / particles-per-cell (fixed capacity: CUDA graph); 0 = unbounded."""
     solver: MpmSolverCfg = field(default_factory=lambda: MpmSolverCfg(frame_dt=0.01, rigid_substeps=2))
     """MPM numerics (200 Hz physics under 100 Hz MPM frames)."""
     failure: FailureCfg = field(default_factory=FailureCfg)
     """Failure rules."""
+    record_mcap: bool = True
+    """Write the first episode of every (terrain, scenario, speed) group as an MCAP recording."""
     seed: int = 0
-    """Seed of the beds."""
+    """Seed of the sand."""
     device: str | None = None
     """Warp device."""
     max_minutes: float | None = None
@@ -90,7 +103,7 @@ class G1EvalCfg:
 class EpisodeSpec:
     """One episode."""
 
-    material: str
+    terrain: str
     scenario: Scenario
     speed: float
     index: int
@@ -98,78 +111,117 @@ class EpisodeSpec:
     @property
     def key(self) -> str:
         """Unique id in ``episodes.jsonl``."""
-        return f"{self.material}/{self.scenario}/{self.index}"
+        return f"{self.terrain}/{self.scenario}/{self.index}"
+
+    @property
+    def group(self) -> str:
+        """(terrain, scenario, speed) group id."""
+        return f"{self.terrain}/{self.scenario}/v{self.speed:g}"
 
 
 def episode_specs(cfg: G1EvalCfg) -> list[EpisodeSpec]:
     """All episodes, cell-major."""
     return [
-        EpisodeSpec(m, s, float(cfg.speeds[k % len(cfg.speeds)]), k)
-        for m in cfg.materials
+        EpisodeSpec(t, s, float(cfg.speeds[k % len(cfg.speeds)]), k)
+        for t in cfg.terrains
         for s in cfg.scenarios
         for k in range(cfg.num_episodes)
     ]
 
 
-def load_policy(path: str | Path) -> Any:
-    """Return an object with ``spec`` and ``act(terms)``: the student runner or mjlab's actor export."""
-    import onnx
+def episode_batches(specs: list[EpisodeSpec], size: int) -> list[list[EpisodeSpec]]:
+    """Split episodes into batches of at most ``size`` that share a (terrain, scenario) cell."""
+    out: list[list[EpisodeSpec]] = []
+    for s in specs:
+        if out and len(out[-1]) < size and (out[-1][0].terrain, out[-1][0].scenario) == (s.terrain, s.scenario):
+            out[-1].append(s)
+        else:
+            out.append([s])
+    return out
 
-    from gmloco.eval.mpm.g1_scene import MjlabOnnxPolicy, StudentOnnxPolicy
 
-    keys = {p.key for p in onnx.load(str(path), load_external_data=False).metadata_props}
-    return StudentOnnxPolicy(path) if "format" in keys else MjlabOnnxPolicy(path)
-
-
-def _command(spec: EpisodeSpec, cfg: G1EvalCfg) -> tuple[float, float, float]:
+def command(spec: EpisodeSpec, cfg: G1EvalCfg) -> tuple[float, float, float]:
+    """(v_x, v_y, w_z) of an episode [m/s, m/s, rad/s]."""
     wz = spec.speed / cfg.circle_radius if spec.scenario == "circle" else 0.0
     return (spec.speed, 0.0, wz)
 
 
-def _bed(spec: EpisodeSpec, cfg: G1EvalCfg, seed: int) -> SandBedCfg:
-    """A bed covering the commanded path plus margins."""
-    v, _, wz = _command(spec, cfg)
-    xy, _ = circular_path(v, wz, cfg.episode_s, 0.05)
+def _window_and_lanes(batch: list[EpisodeSpec], cfg: G1EvalCfg) -> tuple[SandWindowCfg, float]:
+    """The batch's sand window (static: covering the fastest course) and its lane spacing [m]."""
+    circle = batch[0].scenario == "circle"
+    if cfg.window.moving:
+        span = cfg.window.width + (2.0 * cfg.circle_radius if circle else 0.0)
+        return cfg.window, span + cfg.lane_gap
+    v = max(s.speed for s in batch)
+    vx, _, wz = command(replace(batch[0], speed=v), cfg)
+    xy, _ = circular_path(vx, wz, cfg.episode_s, 0.05)
     lo, hi = xy.min(axis=0) - cfg.bed_margin, xy.max(axis=0) + cfg.bed_margin
-    lo[1], hi[1] = min(lo[1], -0.5 * cfg.bed_width), max(hi[1], 0.5 * cfg.bed_width)
+    lo[1], hi[1] = min(lo[1], -0.5 * cfg.window.width), max(hi[1], 0.5 * cfg.window.width)
     c, size = 0.5 * (lo + hi), hi - lo
-    return SandBedCfg(size_x=float(size[0]), size_y=float(size[1]), depth=cfg.bed_depth, center_x=float(c[0]),
-                      center_y=float(c[1]), seed=seed)  # fmt: skip
+    win = replace(cfg.window, length=float(size[0]), width=float(size[1]), lead=float(c[0]), offset_y=float(c[1]))
+    return win, float(size[1]) + cfg.lane_gap
 
 
-def run_episode(spec: EpisodeSpec, cfg: G1EvalCfg, policy: Any) -> dict[str, Any]:
-    """Simulate one episode; return the per-step log (policy rate) and timings."""
-    from gmloco.contact import MATERIAL_PRESETS
+def run_batch(batch: list[EpisodeSpec], cfg: G1EvalCfg, policy: Any) -> list[dict[str, Any]]:
+    """Simulate a batch of episodes together; return one log per episode (policy rate) with the batch's timings."""
     from gmloco.eval.mpm.g1_scene import G1MpmScene, G1MpmSceneCfg
+    from gmloco.eval.mpm.window_terrain import terrain_cfg, terrain_surface_height
 
     t0 = time.perf_counter()
-    seed = cfg.seed * 100_003 + spec.index
-    scene_cfg = G1MpmSceneCfg(bed=_bed(spec, cfg, seed), solver=cfg.solver, command=_command(spec, cfg),
-                              device=cfg.device)  # fmt: skip
-    if hasattr(policy, "reset"):
-        policy.reset()
-    scene = G1MpmScene(scene_cfg, MATERIAL_PRESETS[spec.material], policy)
+    terrain = terrain_cfg(batch[0].terrain, depth=cfg.bed_depth)
+    window, lane = _window_and_lanes(batch, cfg)
+    n = len(batch)
+    solver = cfg.solver
+    if cfg.cell_capacity_factor > 0 and solver.grid_type != "dense":
+        per_cell = window.particles_per_voxel**3
+        est = _window_particles(window, terrain.depth, solver.voxel_size) * n
+        solver = replace(solver, max_active_cell_count=int(cfg.cell_capacity_factor * est / per_cell) + 64)
+    scene_cfg = G1MpmSceneCfg(terrain=terrain, window=window, num_robots=n, lane_spacing=lane, solver=solver,
+                              commands=tuple(command(s, cfg) for s in batch),
+                              seed=cfg.seed * 100_003 + batch[0].index, device=cfg.device)  # fmt: skip
+    if hasattr(policy, "num_robots") and policy.num_robots != n:
+        policy = load_policy(cfg.policy_path, n)
+    policy.reset()
+    scene = G1MpmScene(scene_cfg, policy)
+    scene.capture()
     build_s = time.perf_counter() - t0
-    n = round(cfg.episode_s / scene.frame_dt)
-    for _ in range(n):
-        scene.step()
-        q = scene.base_q[-1]
-        if not np.all(np.isfinite(q)) or q[2] < cfg.failure.min_base_height:
-            break  # fallen: the rest cannot change the outcome
+    frames = round(cfg.episode_s / scene.frame_dt)
     k = scene.frames_per_policy
-    return {
-        "dt": scene.frame_dt * k,
-        "base_q": np.asarray(scene.base_q)[k - 1 :: k],
-        "base_qd": np.asarray(scene.base_qd)[k - 1 :: k],
-        "foot_force": np.asarray(scene.foot_force)[k - 1 :: k],
-        "sole_z": np.asarray(scene.sole_z)[k - 1 :: k],
-        "start_xy": np.asarray(scene.base_q[0][:2]) if scene.base_q else np.zeros(2),
-        "robot_mass": scene.robot_mass,
-        "particles": scene.particle_count,
-        "build_s": build_s,
-        "sim_s": scene.wall_time,
-        "frames": scene.frame,
-    }
+    for f in range(frames):
+        scene.step()
+        if f % k == 0 and _all_failed(scene, cfg):
+            break  # every robot has fallen: the rest cannot change any outcome
+    if solver.max_active_cell_count > 0 and solver.grid_type == "sparse":
+        scene.mpm.check_sparse_grid_rebuild_status()
+    arr = {name: np.asarray(getattr(scene, name)) for name in
+           ("base_q", "base_qd", "foot_force", "sinkage", "foot_sinkage", "joint_q", "joint_qd", "target", "action")}  # fmt: skip
+    logs = []
+    for r, spec in enumerate(batch):
+        q = arr["base_q"][:, r]
+        surf = terrain_surface_height(terrain, q[:, 0], q[:, 1] - scene.lane_y[r])
+        logs.append({
+            "spec": spec, "dt": scene.frame_dt * k, "base_q": q, "base_qd": arr["base_qd"][:, r],
+            "base_height": q[:, 2] - surf, "foot_force": arr["foot_force"][:, r], "sinkage": arr["sinkage"][:, r],
+            "foot_sinkage": arr["foot_sinkage"][:, r], "joint_q": arr["joint_q"][:, r],
+            "joint_qd": arr["joint_qd"][:, r], "target": arr["target"][:, r], "action": arr["action"][:, r],
+            "command": scene.commands[r], "joint_names": scene.spec.joint_names, "kp": scene.spec.kp,
+            "kd": scene.spec.kd, "start_xy": q[0, :2].copy(), "robot_mass": scene.robot_mass,
+            "particles": scene.particle_count, "batch_size": n, "build_s": build_s, "sim_s": scene.wall_time,
+            "frames": scene.frame,
+        })  # fmt: skip
+    return logs
+
+
+def _window_particles(window: SandWindowCfg, depth: float, voxel: float) -> int:
+    """Particles of one robot's window (as :class:`SandWindow` sizes it)."""
+    h = voxel / window.particles_per_voxel
+    return math.ceil(window.length / h) * math.ceil(window.width / h) * max(1, round(depth / h))
+
+
+def _all_failed(scene: Any, cfg: G1EvalCfg) -> bool:
+    """Every robot's pelvis has been below the failure height at some logged step."""
+    z = np.asarray(scene.base_q)[:, :, 2]
+    return bool(np.all((z < cfg.failure.min_base_height).any(axis=0)))
 
 
 def score_episode(spec: EpisodeSpec, cfg: G1EvalCfg, log: dict[str, Any]) -> dict[str, Any]:
@@ -177,7 +229,7 @@ def score_episode(spec: EpisodeSpec, cfg: G1EvalCfg, log: dict[str, Any]) -> dic
     dt, q, qd = log["dt"], log["base_q"], log["base_qd"]
     quat_wxyz = np.concatenate([q[:, 6:7], q[:, 3:6]], axis=1)
     rpy = quat_wxyz_to_roll_pitch_yaw(quat_wxyz)
-    v, _, wz = _command(spec, cfg)
+    v, _, wz = command(spec, cfg)
     cmd_xy, _ = circular_path(v, wz, cfg.episode_s, dt, start_xy=tuple(log["start_xy"]))
     # progress: nearest commanded sample, searched forwards from the last one (circles revisit points)
     finished_at, idx, window = None, 0, max(1, round(0.5 / dt))
@@ -187,47 +239,65 @@ def score_episode(spec: EpisodeSpec, cfg: G1EvalCfg, log: dict[str, Any]) -> dic
         if idx >= (1.0 - cfg.course_slack) * (len(cmd_xy) - 1):
             finished_at = (t + 1) * dt
             break
-    out = episode_outcome(q[:, 2], rpy[:, 0], rpy[:, 1], dt, finished_at, cfg.failure)
+    height = np.asarray(log.get("base_height", q[:, 2]))
+    out = episode_outcome(height, rpy[:, 0], rpy[:, 1], dt, finished_at, cfg.failure)
     alive = max(out.alive_steps, 1)
     yaw = rpy[:, 2]
     c, s = np.cos(yaw), np.sin(yaw)
     v_yaw = np.stack([c * qd[:, 0] + s * qd[:, 1], -s * qd[:, 0] + c * qd[:, 1]], axis=1)
     fz = log["foot_force"][:, :, 2].sum(axis=1) if len(log["foot_force"]) else np.zeros(1)
+    sink = np.asarray(log["sinkage"])[:alive]
     return {
-        "key": spec.key, "material": spec.material, "scenario": spec.scenario, "speed": spec.speed,
+        "key": spec.key, "terrain": spec.terrain, "scenario": spec.scenario, "speed": spec.speed,
         "success": out.success, "reason": out.reason, "alive_s": out.alive_steps * dt,
         "finished_at_s": finished_at,
         "vel_error": metric_velocity_tracking_error(np.tile([v, 0.0], (len(q), 1)), v_yaw, alive),
         "yaw_error": metric_yaw_tracking_error(np.full(len(q), wz), qd[:, 5], alive),
         "path_error": metric_path_error(q[:alive, :2], cmd_xy),
         "support_ratio": float(fz[len(fz) // 2 :].mean() / (log["robot_mass"] * 9.81)),
-        "max_sinkage": float(-np.min(log["sole_z"])) if len(log["sole_z"]) else float("nan"),
-        "particles": log["particles"], "build_s": log["build_s"], "sim_s": log["sim_s"],
-        "frames_per_s": log["frames"] / max(log["sim_s"], 1e-9),
+        "max_sinkage": float(np.max(sink)) if len(sink) else float("nan"),
+        "mean_sinkage": float(np.mean(sink)) if len(sink) else float("nan"),
+        "particles": log["particles"], "batch_size": log.get("batch_size", 1), "build_s": log["build_s"],
+        "sim_s": log["sim_s"], "frames_per_s": log["frames"] / max(log["sim_s"], 1e-9),
     }  # fmt: skip
 
 
+METRIC_KEYS = ("success", "vel_error", "yaw_error", "path_error", "support_ratio", "max_sinkage", "mean_sinkage")
+
+
 def summarize(rows: list[dict[str, Any]]) -> dict[str, float]:
-    """Mean metrics per (material, scenario, speed), per (material, scenario) and over all episodes."""
+    """Mean metrics per (terrain, scenario, speed), per (terrain, scenario) and over all episodes."""
     groups: dict[str, list[dict[str, Any]]] = {"all": rows}
     for r in rows:
-        groups.setdefault(f"{r['material']}/{r['scenario']}", []).append(r)
-        groups.setdefault(f"{r['material']}/{r['scenario']}/v{r['speed']:g}", []).append(r)
+        groups.setdefault(f"{r['terrain']}/{r['scenario']}", []).append(r)
+        groups.setdefault(f"{r['terrain']}/{r['scenario']}/v{r['speed']:g}", []).append(r)
     out: dict[str, float] = {}
     for g, rs in groups.items():
         out[f"{g}/num_episodes"] = float(len(rs))
-        out[f"{g}/success_rate"] = float(np.mean([r["success"] for r in rs])) if rs else float("nan")
-        for k in ("vel_error", "yaw_error", "path_error", "support_ratio", "max_sinkage", "frames_per_s"):
-            vals = [r[k] for r in rs if r[k] is not None and math.isfinite(r[k])]
-            out[f"{g}/{k}"] = float(np.mean(vals)) if vals else float("nan")
+        for k in METRIC_KEYS:
+            vals = [float(r[k]) for r in rs if r.get(k) is not None and math.isfinite(float(r[k]))]
+            name = "success_rate" if k == "success" else k
+            out[f"{g}/{name}"] = float(np.mean(vals)) if vals else float("nan")
     return out
+
+
+def _record(log: dict[str, Any], row: dict[str, Any], cfg: G1EvalCfg, out: Path) -> None:
+    """MCAP recording of one episode (the group's first)."""
+    from gmloco.eval.g1_eval_record import write_episode_mcap
+
+    spec: EpisodeSpec = log["spec"]
+    path = out / "recordings" / f"{spec.terrain}__{spec.scenario}__v{spec.speed:g}.mcap"
+    path.parent.mkdir(parents=True, exist_ok=True)
+    notes = f"gmloco MPM eval episode {spec.key}: voxel {cfg.solver.voxel_size} m, moving window {cfg.window.moving}"
+    write_episode_mcap(path, log, {"policy": Path(cfg.policy_path).name, "material": spec.terrain, "notes": notes,
+                                   "end_reason": "completed" if row["success"] else row["reason"]})  # fmt: skip
 
 
 def run(cfg: G1EvalCfg) -> tuple[dict[str, float], bool]:
     """Run (or resume) the evaluation; return (summary metrics, complete).
 
-    Writes ``episodes.jsonl`` after every episode and ``summary.json`` at the end of the call. Stops early when
-    ``max_minutes`` is reached (complete = False) with every finished episode kept.
+    Writes ``episodes.jsonl`` after every batch, and ``summary.json``, tables and figures at the end of the call.
+    Stops early when ``max_minutes`` is reached (complete = False) with every finished episode kept.
     """
     out = Path(cfg.out_dir)
     out.mkdir(parents=True, exist_ok=True)
@@ -236,24 +306,45 @@ def run(cfg: G1EvalCfg) -> tuple[dict[str, float], bool]:
         log_path.unlink()
     rows = [json.loads(line) for line in log_path.read_text().splitlines()] if log_path.exists() else []
     done = {r["key"] for r in rows}
-    policy = load_policy(cfg.policy_path)
-    t0 = time.perf_counter()
-    complete = True
-    for spec in episode_specs(cfg):
-        if spec.key in done:
-            continue
+    recorded = {f"{r['terrain']}/{r['scenario']}/v{r['speed']:g}" for r in rows}
+    todo = [s for s in episode_specs(cfg) if s.key not in done]
+    policy = load_policy(cfg.policy_path, min(cfg.robots_per_batch, max(len(todo), 1)))
+    t0, sim_s, complete = time.perf_counter(), 0.0, True
+    for batch in episode_batches(todo, cfg.robots_per_batch):
         if cfg.max_minutes is not None and time.perf_counter() - t0 > 60.0 * cfg.max_minutes:
             complete = False
             break
-        row = score_episode(spec, cfg, run_episode(spec, cfg, policy))
-        rows.append(row)
+        logs = run_batch(batch, cfg, policy)
+        sim_s += logs[0]["build_s"] + logs[0]["sim_s"]
+        new = [score_episode(lg["spec"], cfg, lg) for lg in logs]
+        for lg, row in zip(logs, new, strict=True):
+            if cfg.record_mcap and lg["spec"].group not in recorded:
+                _record(lg, row, cfg, out)
+                recorded.add(lg["spec"].group)
+        rows += new
         with log_path.open("a") as f:
-            f.write(json.dumps(row) + "\n")
+            f.writelines(json.dumps(r) + "\n" for r in new)
     summary = summarize(rows)
-    tmp = out / "summary.json.tmp"
-    tmp.write_text(json.dumps({"complete": complete, "cfg": _jsonable(asdict(cfg)), "metrics": summary}, indent=1))
-    tmp.replace(out / "summary.json")
+    wall = time.perf_counter() - t0
+    summary["throughput/episodes_this_call"] = float(len(rows) - len(done))
+    summary["throughput/episodes_per_minute"] = 60.0 * (len(rows) - len(done)) / max(wall, 1e-9)
+    _write_outputs(out, cfg, rows, summary, complete)
     return summary, complete
+
+
+def _write_outputs(out: Path, cfg: G1EvalCfg, rows: list[dict[str, Any]], summary: dict, complete: bool) -> None:
+    """``summary.json`` (temporary file + replace), the tables and the figures."""
+    from gmloco.eval.figures_mpm import write_figures
+    from gmloco.eval.tables_mpm import write_tables
+
+    policy = Path(cfg.policy_path).parent.name or Path(cfg.policy_path).stem
+    tables = write_tables(rows, out, policy)
+    figures = write_figures(rows, out, policy) if rows else []
+    doc = {"complete": complete, "policy": cfg.policy_path, "cfg": _jsonable(asdict(cfg)), "metrics": summary,
+           "tables": [str(p.name) for p in tables], "figures": [str(p.name) for p in figures]}  # fmt: skip
+    tmp = out / "summary.json.tmp"
+    tmp.write_text(json.dumps(doc, indent=1))
+    tmp.replace(out / "summary.json")
 
 
 def _jsonable(obj: Any) -> Any:
@@ -261,6 +352,7 @@ def _jsonable(obj: Any) -> Any:
 
 
 def smoke_cfg(out_dir: str, policy_path: str) -> G1EvalCfg:
-    """CPU smoke: one 1 s straight episode at 1 m/s on a 5 cm-voxel bed."""
+    """CPU smoke: one 1 s straight episode at 1 m/s on a 5 cm-voxel moving window."""
     return replace(G1EvalCfg(), out_dir=out_dir, policy_path=policy_path, num_episodes=1, speeds=(1.0,),
-                   episode_s=1.0, solver=MpmSolverCfg(voxel_size=0.05, frame_dt=0.01, rigid_substeps=2))  # fmt: skip
+                   episode_s=1.0, solver=MpmSolverCfg(voxel_size=0.05, frame_dt=0.01, rigid_substeps=2),
+                   window=SandWindowCfg(length=1.0, width=0.6))  # fmt: skip

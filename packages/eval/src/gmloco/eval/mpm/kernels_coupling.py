@@ -5,7 +5,7 @@ from __future__ import annotations
 
 import warp as wp
 
-__all__ = ["eval_body_sand_wrench", "eval_rewind_body_velocity"]
+__all__ = ["eval_body_sand_wrench", "eval_pd_joint_force", "eval_rewind_body_velocity"]
 
 
 @wp.kernel
@@ -103,4 +103,62 @@ def eval_rewind_body_velocity(
         inputs=[body_inv_mass, body_inv_inertia, dt, body_q, body_qd, body_wrench],
         outputs=[body_qd_out],
         device=body_qd.device,
+    )
+
+
+@wp.kernel
+def _pd_joint_force(
+    # Model:
+    kp: wp.array[float],
+    kd: wp.array[float],
+    q_idx: wp.array[int],
+    qd_idx: wp.array[int],
+    coords_per_robot: int,
+    dofs_per_robot: int,
+    # Data in:
+    joint_q_in: wp.array[float],
+    joint_qd_in: wp.array[float],
+    target_in: wp.array2d[float],
+    # Data out:
+    joint_f_out: wp.array[float],
+) -> None:
+    """PD torque tau = kp (q* - q) - kd qd of actuated joint a of robot r (explicit, every physics step)."""
+    r, a = wp.tid()
+    qi = r * coords_per_robot + q_idx[a]
+    di = r * dofs_per_robot + qd_idx[a]
+    joint_f_out[di] = kp[a] * (target_in[r, a] - joint_q_in[qi]) - kd[a] * joint_qd_in[di]
+
+
+def eval_pd_joint_force(
+    kp: wp.array,
+    kd: wp.array,
+    q_idx: wp.array,
+    qd_idx: wp.array,
+    coords_per_robot: int,
+    dofs_per_robot: int,
+    joint_q: wp.array,
+    joint_qd: wp.array,
+    target: wp.array,
+    joint_f_out: wp.array,
+) -> None:
+    """Write the PD torques [N m] of every robot's actuated joints into ``joint_f_out`` (other dofs untouched).
+
+    Args:
+        kp: Stiffness per actuated joint [N m/rad], [A].
+        kd: Damping per actuated joint [N m s/rad], [A].
+        q_idx: Coordinate index of each actuated joint within one robot, [A].
+        qd_idx: Dof index of each actuated joint within one robot, [A].
+        coords_per_robot: Joint coordinates per robot (robots stored one after another).
+        dofs_per_robot: Joint dofs per robot.
+        joint_q: Joint coordinates [m, rad], [R coords_per_robot].
+        joint_qd: Joint velocities [m/s, rad/s], [R dofs_per_robot].
+        target: Joint targets q* [rad], [R, A].
+        joint_f_out: Generalized forces [N, N m], [R dofs_per_robot].
+    """
+    wp.launch(
+        _pd_joint_force,
+        dim=target.shape,
+        inputs=[kp, kd, q_idx, qd_idx, coords_per_robot, dofs_per_robot, joint_q, joint_qd, target],
+        outputs=[joint_f_out],
+        device=joint_f_out.device,
     )

@@ -1,0 +1,52 @@
+# SPDX-License-Identifier: Apache-2.0
+"""Figures of the MPM evaluation: success rate and velocity tracking error vs commanded speed, per terrain."""
+
+from __future__ import annotations
+
+import math
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+__all__ = ["fig_mpm_speed_sweep", "write_figures"]
+
+
+def _by_speed(rs: list[dict[str, Any]], key: str) -> tuple[np.ndarray, np.ndarray]:
+    """(speeds, mean metric per speed) over finite values."""
+    speeds = np.array(sorted({float(r["speed"]) for r in rs}))
+    vals = []
+    for v in speeds:
+        xs = [float(r[key]) for r in rs if r["speed"] == v and r.get(key) is not None and math.isfinite(float(r[key]))]
+        vals.append(np.mean(xs) if xs else np.nan)
+    return speeds, np.array(vals)
+
+
+def fig_mpm_speed_sweep(rows: list[dict[str, Any]], path: str | Path, policy: str) -> Path:
+    """Success rate [%] and velocity tracking error [m/s] vs commanded speed, one line per (terrain, scenario)."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    cells: dict[str, list[dict[str, Any]]] = {}
+    for r in rows:
+        cells.setdefault(f"{r['terrain']} / {r['scenario']}", []).append(r)
+    fig, (ax0, ax1) = plt.subplots(1, 2, figsize=(9, 3.4), constrained_layout=True)
+    for name, rs in cells.items():
+        v, s = _by_speed(rs, "success")
+        ax0.plot(v, 100.0 * s, "o-", label=name)
+        v, e = _by_speed(rs, "vel_error")
+        ax1.plot(v, e, "o-", label=name)
+    ax0.set(xlabel="commanded speed [m/s]", ylabel="success rate [%]", ylim=(-5, 105))
+    ax1.set(xlabel="commanded speed [m/s]", ylabel="velocity tracking error [m/s]")
+    ax0.legend(fontsize=7)
+    fig.suptitle(f"{policy} on MPM sand ({len(rows)} episodes)", fontsize=9)
+    fig.savefig(path, dpi=120)
+    plt.close(fig)
+    return Path(path)
+
+
+def write_figures(rows: list[dict[str, Any]], out_dir: str | Path, policy: str) -> list[Path]:
+    """Write the evaluation figures under ``out_dir``; return their paths."""
+    return [fig_mpm_speed_sweep(rows, Path(out_dir) / "fig_mpm_speed_sweep.png", policy)]

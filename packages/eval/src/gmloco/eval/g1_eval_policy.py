@@ -1,0 +1,153 @@
+# SPDX-License-Identifier: Apache-2.0
+"""Exported policies driving the G1 MPM scene, batched over robots (onnxruntime on CPU).
+
+Two formats: mjlab's actor export (one ``obs`` input, per-term history flattened term-major, oldest first) and
+gmloco's student export (``obs`` + ``history``, run by ``gmloco.deploy.export.OnnxPolicyRunner``). Both take one
+frame of observation terms per robot, ``{name: [num_robots, dim]}``, and return actions ``[num_robots, A]``.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+__all__ = ["MjlabOnnxPolicy", "PolicySpec", "StudentOnnxPolicy", "load_policy"]
+
+
+@dataclass(frozen=True)
+class PolicySpec:
+    """What the scene needs from a policy (read from ONNX metadata, or the default pose for PD-only runs)."""
+
+    joint_names: list[str]
+    """Actuated joints in action order."""
+    kp: np.ndarray
+    """PD stiffness [N m/rad], [A]."""
+    kd: np.ndarray
+    """PD damping [N m s/rad], [A]."""
+    default_joint_pos: np.ndarray
+    """q_0 [rad], [A]."""
+    action_scale: np.ndarray
+    """q* = q_0 + action_scale a [rad], [A]."""
+    policy_dt: float = 0.02
+    """Policy period [s]."""
+
+
+def _batched_session(path: str | Path, num_threads: int) -> Any:
+    """Return an onnxruntime session of the model with its batch dimension made symbolic (mjlab exports batch 1)."""
+    import onnx
+    import onnxruntime as ort
+
+    model = onnx.load(str(path))
+    for value in [*model.graph.input, *model.graph.output]:
+        dims = value.type.tensor_type.shape.dim
+        if len(dims) > 0:
+            dims[0].ClearField("dim_value")
+            dims[0].dim_param = "batch"
+    options = ort.SessionOptions()
+    options.intra_op_num_threads = num_threads
+    return ort.InferenceSession(model.SerializeToString(), options, providers=["CPUExecutionProvider"])
+
+
+class MjlabOnnxPolicy:
+    """An mjlab-exported actor (single ``obs`` input) for ``num_robots`` robots with per-robot histories."""
+
+    def __init__(self, path: str | Path, num_robots: int = 1, num_threads: int = 1) -> None:
+        """Load the model (batch dimension made symbolic) and parse its comma-joined metadata."""
+        self.session = _batched_session(path, num_threads)
+        meta = self.session.get_modelmeta().custom_metadata_map
+        floats = lambda key: np.array([float(v) for v in meta[key].split(",")])  # noqa: E731
+        self.joint_names = meta["joint_names"].split(",")
+        self.action_joint_names = meta.get("action_joint_names", meta["joint_names"]).split(",")
+        self.term_names = meta["observation_names"].split(",")
+        self.term_dims = [round(v) for v in floats("observation_dims")]
+        self.term_history = [round(v) for v in floats("observation_terms_history_length")]
+        self.term_scale = floats("observation_terms_scale")
+        self.obs_dim = int(meta["observation_dim"])
+        if sum(d * h for d, h in zip(self.term_dims, self.term_history, strict=True)) != self.obs_dim:
+            raise ValueError("observation layout in the metadata does not add up to observation_dim")
+        scale = floats("action_scale")
+        by_name = dict(zip(self.joint_names, range(len(self.joint_names)), strict=True))
+        idx = [by_name[n] for n in self.action_joint_names]
+        self.spec = PolicySpec(
+            joint_names=self.action_joint_names,
+            kp=floats("joint_stiffness")[idx],
+            kd=floats("joint_damping")[idx],
+            default_joint_pos=floats("default_joint_pos")[idx],
+            action_scale=np.broadcast_to(scale, (len(idx),)).copy(),
+            policy_dt=float(meta.get("policy_dt", 0.02)),
+        )
+        self.input_name = self.session.get_inputs()[0].name
+        self.num_robots = num_robots
+        self._hist: list[np.ndarray] | None = None
+
+    def reset(self) -> None:
+        """Forget the histories (the next frame is back-filled, as mjlab does after a reset)."""
+        self._hist = None
+
+    def act(self, terms: dict[str, np.ndarray]) -> np.ndarray:
+        """Push one frame of observation terms ``{name: [R, dim]}`` and return the actions [R, A]."""
+        frames = [
+            np.asarray(terms[n], dtype=np.float32).reshape(self.num_robots, -1) * s
+            for n, s in zip(self.term_names, self.term_scale, strict=True)
+        ]
+        if self._hist is None:
+            self._hist = [np.repeat(f[:, None], h, axis=1) for f, h in zip(frames, self.term_history, strict=True)]
+        else:
+            self._hist = [
+                np.concatenate([b[:, 1:], f[:, None]], axis=1) for b, f in zip(self._hist, frames, strict=True)
+            ]
+        obs = np.concatenate([b.reshape(self.num_robots, -1) for b in self._hist], axis=1).astype(np.float32)
+        return np.asarray(self.session.run(None, {self.input_name: obs})[0])
+
+
+class StudentOnnxPolicy:
+    """A gmloco student export (``obs`` + ``history``) for ``num_robots`` robots; o_t built from the metadata."""
+
+    def __init__(self, path: str | Path, num_robots: int = 1) -> None:
+        """Load the runner; check that the observation terms are ones the scene provides."""
+        from gmloco.deploy.export import OnnxPolicyRunner
+
+        self.runner = OnnxPolicyRunner(path, num_envs=num_robots)
+        meta = self.runner.metadata
+        known = {"base_ang_vel", "projected_gravity", "command", "joint_pos", "joint_vel", "actions"}
+        if not set(meta.observation_names) <= known:
+            raise ValueError(f"unsupported observation terms {sorted(set(meta.observation_names) - known)}")
+        self.meta = meta
+        self.num_robots = num_robots
+        self.spec = PolicySpec(
+            joint_names=list(meta.joint_names),
+            kp=np.asarray(meta.joint_stiffness, dtype=np.float64),
+            kd=np.asarray(meta.joint_damping, dtype=np.float64),
+            default_joint_pos=np.asarray(meta.default_joint_pos, dtype=np.float64),
+            action_scale=np.asarray(meta.action_scale, dtype=np.float64),
+            policy_dt=float(meta.policy_dt),
+        )
+
+    def reset(self) -> None:
+        """Forget the histories."""
+        self.runner.reset()
+
+    def act(self, terms: dict[str, np.ndarray]) -> np.ndarray:
+        """Clip, scale and concatenate the terms ``{name: [R, dim]}`` into o_t; return the actions [R, A]."""
+        parts = []
+        for name, clip, scale in zip(
+            self.meta.observation_names, self.meta.observation_clip, self.meta.observation_scale, strict=True
+        ):
+            x = np.asarray(terms[name], dtype=np.float64).reshape(self.num_robots, -1)
+            if clip is not None:
+                x = np.clip(x, clip[0], clip[1])
+            parts.append(x * np.asarray(scale, dtype=np.float64))
+        return np.asarray(self.runner.step(np.concatenate(parts, axis=1).astype(np.float32))).reshape(
+            self.num_robots, -1
+        )
+
+
+def load_policy(path: str | Path, num_robots: int = 1) -> MjlabOnnxPolicy | StudentOnnxPolicy:
+    """Return the student runner or mjlab's actor export for ``num_robots`` robots (format from the metadata)."""
+    import onnx
+
+    keys = {p.key for p in onnx.load(str(path), load_external_data=False).metadata_props}
+    return StudentOnnxPolicy(path, num_robots) if "format" in keys else MjlabOnnxPolicy(path, num_robots)

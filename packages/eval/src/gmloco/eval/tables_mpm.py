@@ -1,0 +1,85 @@
+# SPDX-License-Identifier: Apache-2.0
+"""The MPM evaluation's paper-shaped tables (markdown + CSV) from the per-episode rows of ``episodes.jsonl``.
+
+* ``table_terrains``: one row per (policy, terrain, scenario): episodes, success rate, velocity and yaw tracking
+  error, DTW path error, mean sinkage (GM-Loco's per-terrain and contact-model tables; several policies'
+  ``episodes.jsonl`` concatenated give the ablation rows).
+* ``table_speeds``: success rate per commanded forward speed (rows terrain x scenario).
+"""
+
+from __future__ import annotations
+
+import csv
+import math
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+__all__ = ["table_speeds", "table_terrains", "write_tables"]
+
+TERRAIN_COLUMNS = ("policy", "terrain", "scenario", "episodes", "success_rate_pct", "vel_error_mps",
+                   "yaw_error_radps", "path_error_m", "mean_sinkage_cm")  # fmt: skip
+"""Columns of ``table_terrains``."""
+
+
+def _mean(rows: list[dict[str, Any]], key: str) -> float:
+    """Mean of a finite metric over rows (NaN when none)."""
+    vals = [float(r[key]) for r in rows if r.get(key) is not None and math.isfinite(float(r[key]))]
+    return float(np.mean(vals)) if vals else float("nan")
+
+
+def _cells(rows: list[dict[str, Any]]) -> dict[tuple[str, str], list[dict[str, Any]]]:
+    """Rows grouped by (terrain, scenario), first-seen order."""
+    out: dict[tuple[str, str], list[dict[str, Any]]] = {}
+    for r in rows:
+        out.setdefault((r["terrain"], r["scenario"]), []).append(r)
+    return out
+
+
+def table_terrains(rows: list[dict[str, Any]], policy: str) -> list[list[Any]]:
+    """Rows of ``table_terrains`` (``TERRAIN_COLUMNS``), one per (terrain, scenario)."""
+    out = []
+    for (terrain, scenario), rs in _cells(rows).items():
+        out.append([policy, terrain, scenario, len(rs), 100.0 * _mean(rs, "success"), _mean(rs, "vel_error"),
+                    _mean(rs, "yaw_error"), _mean(rs, "path_error"), 100.0 * _mean(rs, "mean_sinkage")])  # fmt: skip
+    return out
+
+
+def table_speeds(rows: list[dict[str, Any]]) -> tuple[list[str], list[list[Any]]]:
+    """(header, rows) of the success rate [%] per commanded speed, one row per (terrain, scenario)."""
+    speeds = sorted({float(r["speed"]) for r in rows})
+    header = ["terrain", "scenario", *[f"v={v:g} m/s" for v in speeds]]
+    body = []
+    for (terrain, scenario), rs in _cells(rows).items():
+        body.append(
+            [terrain, scenario, *[100.0 * _mean([r for r in rs if r["speed"] == v], "success") for v in speeds]]
+        )
+    return header, body
+
+
+def _fmt(x: Any) -> str:
+    """Markdown cell: 3 significant decimals for floats, ``-`` for NaN."""
+    if isinstance(x, float):
+        return "-" if not math.isfinite(x) else f"{x:.3g}" if abs(x) < 100 else f"{x:.0f}"
+    return str(x)
+
+
+def _write(path: Path, header: list[str] | tuple[str, ...], body: list[list[Any]]) -> list[Path]:
+    """Write ``<path>.csv`` and ``<path>.md``."""
+    with path.with_suffix(".csv").open("w", newline="") as f:
+        w = csv.writer(f)
+        w.writerow(header)
+        w.writerows(body)
+    lines = ["| " + " | ".join(header) + " |", "|" + "---|" * len(header)]
+    lines += ["| " + " | ".join(_fmt(x) for x in row) + " |" for row in body]
+    path.with_suffix(".md").write_text("\n".join(lines) + "\n")
+    return [path.with_suffix(".md"), path.with_suffix(".csv")]
+
+
+def write_tables(rows: list[dict[str, Any]], out_dir: str | Path, policy: str) -> list[Path]:
+    """Write both tables under ``out_dir``; return their paths."""
+    out = Path(out_dir)
+    paths = _write(out / "table_terrains", TERRAIN_COLUMNS, table_terrains(rows, policy))
+    header, body = table_speeds(rows)
+    return paths + _write(out / "table_speeds", header, body)

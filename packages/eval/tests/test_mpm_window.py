@@ -1,0 +1,136 @@
+# SPDX-License-Identifier: Apache-2.0
+"""The moving sand window: column recycling bookkeeping, the MPM solver's cached volumes, terrain filling."""
+
+from __future__ import annotations
+
+from typing import Any
+
+import numpy as np
+import pytest
+
+from gmloco.eval.mpm.box_scene import MpmSolverCfg
+from gmloco.eval.mpm.coupled_setup import make_mpm_solver
+from gmloco.eval.mpm.window import SandWindow, SandWindowCfg
+from gmloco.eval.mpm.window_terrain import TerrainCfg, terrain_cfg, terrain_layer, terrain_surface_height
+
+VOXEL = 0.1  # columns h = 5 cm at 2 particles per voxel edge
+
+
+def _pelvis(x: np.ndarray, lane_y: np.ndarray, bodies: int) -> np.ndarray:
+    """Body poses [R bodies, 7] with each robot's pelvis at (x_r, lane_y_r, 0.7), heading +x."""
+    q = np.zeros((len(x) * bodies, 7), dtype=np.float32)
+    q[:, 6] = 1.0
+    q[::bodies, 0], q[::bodies, 1], q[::bodies, 2] = x, lane_y, 0.7
+    return q
+
+
+def _window(terrain: TerrainCfg, lane_y: np.ndarray, bodies: int = 2) -> tuple[SandWindow, Any, Any, Any]:
+    """A 2-robot window (0.5 x 0.3 m, 5 cm columns), seeded at x = 0, with its sand model, state and solver."""
+    import newton
+    import warp as wp
+
+    win = SandWindow(SandWindowCfg(moving=True, length=0.5, width=0.3, lead=0.0), terrain, VOXEL, lane_y, bodies)
+    builder = newton.ModelBuilder()
+    newton.solvers.SolverImplicitMPM.register_custom_attributes(builder)
+    win.add_particles(builder)
+    model = builder.finalize(device="cpu")
+    win.allocate(wp, model.device)
+    body_q = wp.array(_pelvis(np.zeros(len(lane_y)), lane_y, bodies), dtype=wp.transform, device="cpu")
+    win.seed_model(wp, model, body_q)
+    solver = make_mpm_solver(newton, model, MpmSolverCfg(voxel_size=VOXEL), win.materials[0])
+    state = model.state()
+    win.bind(model, state, solver)
+    return win, model, state, solver
+
+
+def test_recycle_moves_exactly_the_columns_left_behind() -> None:
+    """Advance robot 0 by 2.4 columns: 2 columns x ny x nz particles re-seeded ahead, the rest untouched, mass kept."""
+    import warp as wp
+
+    lane_y = np.array([0.0, 2.0])
+    win, model, state, _ = _window(terrain_cfg("dry_sand"), lane_y)
+    h, per = win.h, win.particles_per_robot
+    assert (win.nx, win.ny, win.nz) == (10, 6, 3) and np.isclose(h, 0.05)
+    q0, m0 = state.particle_q.numpy().copy(), model.particle_mass.numpy().sum()
+    # fill: 5 cm cubes, rho_c 1500 kg/m^3 -> 0.1875 kg each; bed 0.5 x 0.3 x 0.15 m per robot
+    np.testing.assert_allclose(model.particle_mass.numpy(), 1500.0 * 0.05**3, rtol=1e-6)
+    win.advance(wp.array(_pelvis(np.array([2.4 * h, 0.0]), lane_y, 2), dtype=wp.transform, device="cpu"))
+    q1 = state.particle_q.numpy()
+    moved = np.any(q1 != q0, axis=1)
+    assert moved[:per].sum() == 2 * win.ny * win.nz and not moved[per:].any()
+    # window [-0.25, 0.25) m (origin column -5) -> [-0.15, 0.35) m (origin -3): world columns -5 and -4 left,
+    # columns 5 and 6 (x in [0.25, 0.35) m) entered
+    x_new = q1[:per][moved[:per], 0]
+    np.testing.assert_array_equal(np.unique(np.floor(x_new / h + 1e-6)), [5.0, 6.0])
+    np.testing.assert_array_equal(np.unique(np.floor(q0[:per][moved[:per], 0] / h + 1e-6)), [-5.0, -4.0])
+    np.testing.assert_allclose(model.particle_mass.numpy().sum(), m0, rtol=1e-6)
+    lo, hi = win.bounds()[0]
+    np.testing.assert_allclose([lo[0], hi[0]], [-0.15, 0.35], atol=1e-6)
+
+
+def test_recycle_keeps_the_mpm_volume_cache_consistent() -> None:
+    """Rough transition sand: after a recycle the solver's cached volume/density equal a fresh notify's."""
+    import warp as wp
+
+    terrain = TerrainCfg(name="t", materials=("basalt", "poppy_seed"), layer_start=0.0, layer_length=0.3,
+                         rough_amplitude=0.03, rough_wavelength=0.4)  # fmt: skip
+    lane_y = np.array([0.0, 2.0])
+    win, model, state, solver = _window(terrain, lane_y)
+    win.advance(wp.array(_pelvis(np.array([0.33, -0.21]), lane_y, 2), dtype=wp.transform, device="cpu"))
+    mm = solver._mpm_model
+    cached = [a.numpy().copy() for a in (mm.particle_volume, mm.particle_density, mm.material_particle_volume)]
+    mm.notify_particle_material_changed()
+    fresh = [a.numpy() for a in (mm.particle_volume, mm.particle_density, mm.material_particle_volume)]
+    for c, f in zip(cached, fresh, strict=True):
+        np.testing.assert_allclose(c, f, rtol=1e-5)
+    # every particle carries its medium: density and friction of the layer at its column centre
+    q = state.particle_q.numpy()
+    col_x = (win.column.numpy()[:, 0] + 0.5) * win.h
+    layer = terrain_layer(terrain, col_x)
+    dens = np.array([m.density for m in win.materials])[layer]
+    np.testing.assert_allclose(fresh[1], dens, rtol=1e-5)
+    np.testing.assert_allclose(model.mpm.friction.numpy(), np.array([m.friction for m in win.materials])[layer],
+                               rtol=1e-6)  # fmt: skip
+    # columns fill floor -> surface: the column's particle volumes add up to h^2 (z_s + depth) at its jittered
+    # centre, within the surface's variation over half a column (|grad z_s| h / 2 <= A k h / 2)
+    cols = win.column.numpy()
+    r = np.arange(len(q)) // win.particles_per_robot
+    key = (cols[:, 0] * 100_003 + cols[:, 1]) * 7 + r
+    _, inv = np.unique(key, return_inverse=True)
+    vol = np.bincount(inv, weights=fresh[0])
+    first = np.unique(inv, return_index=True)[1]
+    xs, ys = q[first, 0], q[first, 1] - lane_y[r[first]]
+    expect = win.h**2 * (terrain_surface_height(terrain, xs, ys) + terrain.depth)
+    k = 2 * np.pi / terrain.rough_wavelength
+    np.testing.assert_allclose(vol, expect, atol=win.h**2 * terrain.rough_amplitude * k * win.h)
+
+
+def test_walls_keep_sand_in_the_window() -> None:
+    """A particle pushed out of its window is put back on the wall with no outward velocity."""
+    import warp as wp
+
+    lane_y = np.array([0.0, 2.0])
+    win, _, state, _ = _window(terrain_cfg("poppy_seed"), lane_y)
+    q, v = state.particle_q.numpy(), state.particle_qd.numpy()
+    q[0, 0], v[0, 0] = -1.0, -0.5
+    q[1, 1], v[1, 1] = 5.0, 0.3
+    state.particle_q.assign(q)
+    state.particle_qd.assign(v)
+    win.apply_walls()
+    lo, hi = win.bounds()[0]
+    q, v = state.particle_q.numpy(), state.particle_qd.numpy()
+    np.testing.assert_allclose([q[0, 0], v[0, 0], q[1, 1], v[1, 1]], [lo[0], 0.0, hi[1], 0.0], atol=1e-6)
+    assert wp is not None
+
+
+@pytest.mark.parametrize("name", ["basalt", "dry_sand_rough", "dry_sand_deep", "transition"])
+def test_terrain_cfgs(name: str) -> None:
+    """The paper's terrains: deep = 30 cm at tan 20 deg, rough has a surface, transition has three media."""
+    t = terrain_cfg(name)
+    if name == "dry_sand_deep":
+        assert t.depth == 0.30 and t.mu_int is not None and np.isclose(t.mu_int, np.tan(np.radians(20.0)))
+    if name == "dry_sand_rough":
+        assert t.rough_amplitude > 0
+    if name == "transition":
+        assert t.materials == ("basalt", "dry_sand", "poppy_seed")
+        np.testing.assert_array_equal(terrain_layer(t, np.array([0.0, 4.5, 7.5, 30.0])), [0, 1, 2, 2])
