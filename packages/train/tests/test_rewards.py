@@ -93,3 +93,31 @@ def test_curriculum_scale_compresses_stages_and_ramps() -> None:
     assert cur["ramp_track_lin_vel_xy_exp"].params["num_steps"] == 36_000
     paper = make_curriculum_cfg(g1_granular_task("rft3d"), make_rewards_cfg(task))
     assert paper["ramp_track_heading_exp"].params["num_steps"] == 360_000
+
+
+def test_clearance_penalty_is_zero_for_still_feet_and_grows_with_the_miss() -> None:
+    """The L2 form pays nothing to still feet (unlike the exp reward, which pays them its maximum)."""
+    from gmloco.train.mdp.rewards import _clearance, _clearance_error
+
+    height = torch.tensor([[0.0, 0.3]])
+    still = torch.zeros(1, 2)
+    assert _clearance_error(height, still, 0.1, 2.0).item() == 0.0
+    assert _clearance(height, still, 0.1, 0.05, 2.0).item() == 1.0  # the exp form's maximum
+    moving = torch.tensor([[10.0, 10.0]])
+    miss = _clearance_error(height, moving, 0.1, 2.0).item()
+    assert abs(miss - (0.01 + 0.04) * float(torch.tanh(torch.tensor(20.0)))) < 1e-6
+    assert _clearance_error(torch.tensor([[0.1, 0.1]]), moving, 0.1, 2.0).item() == 0.0
+
+
+def test_foot_clearance_form_selects_the_term() -> None:
+    """``foot_clearance="penalty"`` (default) uses foot_clearance_l2 with weight -2; "reward" the exp form."""
+    from dataclasses import replace
+
+    from gmloco.train import g1_granular_task
+    from gmloco.train.tasks.g1_granular.rewards_cfg import make_rewards_cfg
+
+    task = g1_granular_task("rft3d")
+    rewards = make_rewards_cfg(task)
+    assert rewards["foot_clearance_l2"].weight == -2.0 and "foot_clearance" not in rewards
+    rewards = make_rewards_cfg(replace(task, foot_clearance="reward"))
+    assert rewards["foot_clearance"].weight == 5.0 and "foot_clearance_l2" not in rewards

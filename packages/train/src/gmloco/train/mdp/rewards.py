@@ -37,6 +37,7 @@ __all__ = [
     "feet_slide",
     "flat_orientation_l2",
     "foot_clearance",
+    "foot_clearance_l2",
     "joint_acc_l2",
     "joint_vel_l2",
     "lin_vel_z_l2",
@@ -84,8 +85,12 @@ def _clearance(
     height: torch.Tensor, speed_xy: torch.Tensor, target: float, std: float, tanh_mult: float
 ) -> torch.Tensor:
     """exp(-sum_f (h_f - target)^2 tanh(k |v_f,xy|) / std) for feet heights h [m] and speeds [m/s]."""
-    err = torch.square(height - target) * torch.tanh(tanh_mult * speed_xy)
-    return torch.exp(-err.sum(dim=1) / std)
+    return torch.exp(-_clearance_error(height, speed_xy, target, tanh_mult) / std)
+
+
+def _clearance_error(height: torch.Tensor, speed_xy: torch.Tensor, target: float, tanh_mult: float) -> torch.Tensor:
+    """sum_f (h_f - target)^2 tanh(k |v_f,xy|) [m^2] for feet heights h [m] and speeds [m/s]; 0 for still feet."""
+    return (torch.square(height - target) * torch.tanh(tanh_mult * speed_xy)).sum(dim=1)
 
 
 def _lateral_gap_penalty(foot_pos_w: torch.Tensor, root_quat_w: torch.Tensor, min_gap: float) -> torch.Tensor:
@@ -281,6 +286,17 @@ def foot_clearance(env: ManagerBasedRlEnv, target_height: float, std: float, tan
     feet = get_sand(env).feet.update()
     speed = torch.linalg.vector_norm(feet.vel_w[..., :2], dim=-1)
     return _clearance(feet.height, speed, target_height, std, tanh_mult)
+
+
+def foot_clearance_l2(env: ManagerBasedRlEnv, target_height: float, tanh_mult: float) -> torch.Tensor:
+    """Speed-weighted squared miss of the swing height ``target_height`` [m] (use with a negative weight).
+
+    The GM-Loco project page's form (foot clearance -2 as an L2 penalty). Unlike the exp form
+    :func:`foot_clearance`, it pays nothing for feet that stay still, so standing is not rewarded.
+    """
+    feet = get_sand(env).feet.update()
+    speed = torch.linalg.vector_norm(feet.vel_w[..., :2], dim=-1)
+    return _clearance_error(feet.height, speed, target_height, tanh_mult)
 
 
 def undesired_contacts(env: ManagerBasedRlEnv, sensor_name: str) -> torch.Tensor:

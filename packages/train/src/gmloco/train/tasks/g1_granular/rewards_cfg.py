@@ -87,7 +87,22 @@ def _joint_terms() -> dict[str, RewardTermCfg]:
     }
 
 
-def _feet_terms() -> dict[str, RewardTermCfg]:
+def _clearance_term(task: GranularTaskCfg) -> dict[str, RewardTermCfg]:
+    """Swing-height term: the project page's L2 penalty (default) or the code snapshot's exp reward."""
+    if task.foot_clearance == "reward":
+        return {
+            "foot_clearance": RewardTermCfg(
+                func=mdp.foot_clearance, weight=5.0, params={"target_height": 0.10, "std": 0.05, "tanh_mult": 2.0}
+            )
+        }
+    return {
+        "foot_clearance_l2": RewardTermCfg(
+            func=mdp.foot_clearance_l2, weight=-2.0, params={"target_height": 0.10, "tanh_mult": 2.0}
+        )
+    }
+
+
+def _feet_terms(task: GranularTaskCfg) -> dict[str, RewardTermCfg]:
     """Foot orientation, gait and contact terms (signals from the granular model)."""
     return {
         "feet_roll_l2": RewardTermCfg(func=mdp.feet_roll_l2, weight=-1.0),
@@ -102,15 +117,13 @@ def _feet_terms() -> dict[str, RewardTermCfg]:
         "feet_lateral_distance": RewardTermCfg(func=mdp.feet_lateral_distance, weight=-2.0, params={"min_gap": 0.2}),
         "feet_slide": RewardTermCfg(func=mdp.feet_slide, weight=-0.25),
         "contact_impulse": RewardTermCfg(func=mdp.contact_impulse, weight=-0.005, params={"command_name": CMD}),
-        "foot_clearance": RewardTermCfg(
-            func=mdp.foot_clearance, weight=5.0, params={"target_height": 0.10, "std": 0.05, "tanh_mult": 2.0}
-        ),
+        **_clearance_term(task),
     }
 
 
 def make_rewards_cfg(task: GranularTaskCfg) -> dict[str, RewardTermCfg]:
     """Return the reward terms with ``task.reward_weights`` overrides applied (weight 0 drops a term)."""
-    rewards = {**_tracking_terms(), **_base_terms(), **_joint_terms(), **_feet_terms()}
+    rewards = {**_tracking_terms(), **_base_terms(), **_joint_terms(), **_feet_terms(task)}
     unknown = set(task.reward_weights) - set(rewards)
     if unknown:
         raise KeyError(f"Unknown reward terms in reward_weights: {sorted(unknown)}")
