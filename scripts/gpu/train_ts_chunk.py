@@ -131,7 +131,7 @@ def _curriculum_scale(args: argparse.Namespace) -> float | None:
 def _task(args: argparse.Namespace) -> Any:
     """The granular task: one actor frame (history goes through the encoders), DR without the held-out region."""
     from gmloco.train import g1_granular_task
-    from gmloco.train.teacher_student import DEFAULT_HELD_OUT
+    from gmloco.train.teacher_student.heldout import with_held_out
 
     task = replace(g1_granular_task(args.contact_model, args.terrain), policy_history_length=1)
     scale = _curriculum_scale(args)
@@ -139,17 +139,10 @@ def _task(args: argparse.Namespace) -> Any:
         task = replace(task, curriculum_scale=scale)
     if args.no_held_out:
         return task
-    material = task.material
-    if not hasattr(material, "held_out_rho_c"):
-        sys.exit(
-            "MaterialRangeCfg has no held_out_rho_c / held_out_mu_int yet, so the DR would also draw the held-out "
-            "materials (see gmloco.train.teacher_student.heldout). Add them, or run with --no-held-out."
-        )
-    region = DEFAULT_HELD_OUT
-    lo, hi = material.mu_int
-    if not lo <= region.mu_int[0] < region.mu_int[1] <= hi:
-        sys.exit(f"held-out mu_int {region.mu_int} is outside this terrain's DR range {material.mu_int}: --no-held-out")
-    return replace(task, material=replace(material, held_out_rho_c=region.rho_c, held_out_mu_int=region.mu_int))
+    try:
+        return with_held_out(task)
+    except (NotImplementedError, ValueError) as err:
+        sys.exit(f"{err}; the DR would draw the held-out materials too. Run with --no-held-out to accept that.")
 
 
 def _entries(args: argparse.Namespace) -> dict[str, Any]:
@@ -285,7 +278,9 @@ def main(argv: list[str] | None = None) -> dict[str, Any]:
     }
     from gmloco.train.evaluation_ts import finite_json
 
-    (args.out / "summary.json").write_text(json.dumps(finite_json(summary), indent=1, default=str))
+    # Curves keep NaN (iterations before the first finished episode), as train_chunk.py's, for collect_chunk.py.
+    clean = finite_json({k: v for k, v in summary.items() if k != "curve"}) | {"curve": summary["curve"]}
+    (args.out / "summary.json").write_text(json.dumps(clean, indent=1, default=str))
     print(json.dumps(finite_json({"metrics": metrics, "checks": checks}), indent=1, default=str))
     return summary
 

@@ -97,3 +97,22 @@ def test_material_writer_never_draws_the_held_out_region() -> None:
         inside += int(region.contains(rho, mu).sum())
         assert ((mu >= 0.2) & (mu <= 0.9)).all()
     assert inside == 0  # ~3.5 % of 20,480 draws (~700) would be inside without the re-draw
+
+
+def test_with_held_out_sets_the_dr_fields_or_refuses() -> None:
+    """The task's DR gets the rectangle; a DR whose mu_int range excludes it (deep sand) is refused."""
+    from dataclasses import replace
+
+    from gmloco.train.config import GranularTaskCfg, MaterialRangeCfg
+    from gmloco.train.teacher_student.heldout import with_held_out
+
+    task = GranularTaskCfg()
+    if "held_out_rho_c" not in MaterialRangeCfg.__dataclass_fields__:
+        with pytest.raises(NotImplementedError, match="held_out_rho_c"):
+            with_held_out(task)
+        return
+    held = with_held_out(task).material
+    assert (held.held_out_rho_c, held.held_out_mu_int) == (DEFAULT_HELD_OUT.rho_c, DEFAULT_HELD_OUT.mu_int)  # type: ignore[attr-defined]
+    deep = replace(task, material=replace(task.material, mu_int=(0.1, 0.4)))
+    with pytest.raises(ValueError, match="outside the task's DR range"):
+        with_held_out(deep)

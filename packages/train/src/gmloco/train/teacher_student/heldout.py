@@ -20,12 +20,16 @@ probability and no host synchronisation is needed.
 from __future__ import annotations
 
 from collections.abc import Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, fields, replace
+from typing import TYPE_CHECKING
 
 import numpy as np
 import torch
 
-__all__ = ["DEFAULT_HELD_OUT", "HeldOutRegionCfg", "r2_score", "redraw_outside"]
+if TYPE_CHECKING:
+    from gmloco.train.config import GranularTaskCfg
+
+__all__ = ["DEFAULT_HELD_OUT", "HeldOutRegionCfg", "r2_score", "redraw_outside", "with_held_out"]
 
 
 @dataclass(frozen=True)
@@ -102,3 +106,20 @@ def r2_score(predicted: Sequence[float] | np.ndarray, target: Sequence[float] | 
     if y.size == 0 or ss_tot == 0.0:
         return float("nan")
     return 1.0 - float(np.sum((y - y_hat) ** 2)) / ss_tot
+
+
+def with_held_out(task: GranularTaskCfg, region: HeldOutRegionCfg = DEFAULT_HELD_OUT) -> GranularTaskCfg:
+    """Return ``task`` whose material DR never draws ``region`` (``MaterialRangeCfg.held_out_rho_c / _mu_int``).
+
+    Raises:
+        NotImplementedError: If ``MaterialRangeCfg`` has no held-out fields (the DR cannot leave the region out).
+        ValueError: If the region's mu_int range is not inside the task's DR range (e.g. the deep terrain's).
+    """
+    material = task.material
+    if "held_out_rho_c" not in {f.name for f in fields(material)}:
+        raise NotImplementedError("MaterialRangeCfg has no held_out_rho_c / held_out_mu_int: the DR cannot skip it")
+    lo, hi = material.mu_int
+    if not lo <= region.mu_int[0] < region.mu_int[1] <= hi:
+        raise ValueError(f"held-out mu_int {region.mu_int} is outside the task's DR range {material.mu_int}")
+    held = replace(material, held_out_rho_c=region.rho_c, held_out_mu_int=region.mu_int)  # type: ignore[call-arg]
+    return replace(task, material=held)
