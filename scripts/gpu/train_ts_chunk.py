@@ -14,7 +14,8 @@
    decoded eta (teacher: psi(mu); student: psi(z_hat) and the teacher's psi(mu) on the student's states) and the
    student-vs-teacher action error. For the student it also exports ``policy.onnx`` (+ ``policy.json``) with deploy
    metadata and checks it against torch on random inputs and in a rollout with env resets (``OnnxPolicyRunner``).
-4. Writes to ``--out``: ``checkpoint.pt`` (newest), ``summary.json`` (train metrics, post-training checks, config,
+4. Writes to ``--out``: ``checkpoint.pt`` (newest; without the optimizer state unless ``--full-checkpoint``: a run
+   resumed from it starts a fresh Adam), ``summary.json`` (train metrics, post-training checks, config,
    this machine's curves from TensorBoard: reward, episode length, fps and every ``Loss/*`` term incl. the
    eta reconstruction / KL / eta R^2 of the teacher and the distillation terms of the student), and for the student
    ``policy.onnx`` + ``policy.json``.
@@ -70,6 +71,11 @@ def _parse(argv: list[str] | None) -> argparse.Namespace:
         default=None,
         help="GranularTaskCfg.curriculum_scale (default: the run's saved value; student: the teacher's)",
     )
+    p.add_argument(
+        "--full-checkpoint",
+        action="store_true",
+        help="bring back the optimizer state too (default: a slim checkpoint.pt, ~1/3 of the size, for artifacts/)",
+    )
     p.add_argument("--check-envs", type=int, default=64, help="envs of the post-training rollout")
     p.add_argument("--check-steps", type=int, default=250, help="steps of the post-training rollout (5 s)")
     p.add_argument("--check-warmup", type=int, default=50, help="steps after a reset left out of the eta metrics")
@@ -100,6 +106,22 @@ def _seed_run_dir(run_dir: Path, artifact: Path) -> int | None:
     if (artifact / "train_cfg.json").exists():
         shutil.copy(artifact / "train_cfg.json", run_dir / "train_cfg.json")
     return it
+
+
+def _copy_checkpoint(src: Path, dst: Path, slim: bool) -> None:
+    """Copy a checkpoint; ``slim`` drops the optimizer state (resuming from it starts a fresh Adam).
+
+    Every committed file travels with each device call (64 MiB in all, wheel parts included); the teacher's Adam
+    state is two thirds of its 22 MB checkpoint. The run directory on the machine keeps the full checkpoints.
+    """
+    if not slim:
+        shutil.copy(src, dst)
+        return
+    import torch
+
+    ckpt = torch.load(src, map_location="cpu", weights_only=False)
+    ckpt.pop("optimizer_state_dict", None)
+    torch.save(ckpt, dst)
 
 
 def _teacher_checkpoint(args: argparse.Namespace) -> Path:
@@ -253,7 +275,7 @@ def main(argv: list[str] | None = None) -> dict[str, Any]:
     metrics = train(cfg)
     ckpt = _newest(run_dir)
     assert ckpt is not None, f"train() left no checkpoint in {run_dir}"
-    shutil.copy(ckpt, args.out / "checkpoint.pt")
+    _copy_checkpoint(ckpt, args.out / "checkpoint.pt", slim=not args.full_checkpoint)
     t_post = time.monotonic()
     checks = _post_checks(args, task, ckpt, run_dir)
     import torch

@@ -108,3 +108,19 @@ def test_toy_teacher_and_student_learn_to_use_eta(
     student: StudentRunner = _quiet(lambda: StudentRunner(make_env(num_envs=64, seed=5), cfg, log_dir=None))  # type: ignore[call-arg,assignment]
     _quiet(lambda: student.learn(10))
     assert _action_error(student.alg.actor, make_env) < 0.5 * BEST_BLIND_ERROR
+
+
+def test_a_checkpoint_without_optimizer_state_loads_with_a_fresh_optimizer(
+    teacher_ckpt: dict, toy_env: VecEnv, teacher_cfg: TeacherCfg, groups: ObsGroupsCfg, runner_cfg: Callable
+) -> None:
+    """A slim artifact (no ``optimizer_state_dict``) restores the weights and leaves Adam untouched (empty state)."""
+    from gmloco.train.teacher_student import TeacherPPO
+
+    slim = {k: v for k, v in teacher_ckpt.items() if k != "optimizer_state_dict"}
+    alg = TeacherPPO.construct_algorithm(
+        toy_env.get_observations(), toy_env, runner_cfg(teacher_cfg.to_rsl_rl(groups)), "cpu"
+    )
+    assert alg.load(slim, None, strict=True)  # the iteration is still restored
+    for name, value in alg.actor.state_dict().items():
+        torch.testing.assert_close(value, slim["actor_state_dict"][name], rtol=0.0, atol=0.0)
+    assert alg.optimizer.state_dict()["state"] == {}

@@ -38,6 +38,12 @@ class AuxLossPPO(PPO):
             raise NotImplementedError(f"{type(self).__name__} supports feed-forward models only.")
         super().__init__(actor, critic, storage, **kwargs)  # type: ignore[arg-type]
 
+    def load(self, loaded_dict: dict, load_cfg: dict | None, strict: bool) -> bool:
+        """Load a checkpoint; one saved without ``optimizer_state_dict`` (a slim artifact) starts a fresh optimizer."""
+        if "optimizer_state_dict" not in loaded_dict:
+            load_cfg = {"actor": True, "critic": True, "iteration": True} | (load_cfg or {}) | {"optimizer": False}
+        return super().load(loaded_dict, load_cfg, strict)
+
     def policy_loss_weight(self) -> float:
         """Return w_PPO, the weight of the actor's PPO terms (1 for plain PPO)."""
         return 1.0
