@@ -1,19 +1,24 @@
 """Contact-kernel cost per launch and its share of one G1 MuJoCo Warp physics step, measured in one run.
 
-    python scripts/gpu/bench_contact.py --num-worlds 4096 --out $OUT/bench_contact.json
+    source scripts/gpu/env.sh && python3 scripts/gpu/bench_contact.py --num-worlds 4096 --out $OUT/bench_contact
 
-For every contact model and collider size (sole 5x5 = 25 points, six-face 5x5 = 150 points per foot) it
-times ``model.compute`` (the stateless part that runs inside the passive callback) and, for stateful models,
+For every contact model and collider size (sole 5x5 = 25 points, six-face 5x5 = 150 points per foot) it times
+``model.compute`` (the stateless part that runs inside the passive callback) and, for stateful models,
 ``model.update_state``, each captured in a CUDA graph of ``--reps`` launches. The reference is one physics
 substep of mjlab's stock G1 (``env.sim.step()``, rigid contact) at the same world count, built in the same
-process.
+process (``--skip-sim`` leaves it out).
 
-``--paths fused,reference`` (default) times both kernel paths of each model: ``fused`` (``model.fused = True``,
-the default: 3D-RFT points + per-foot tile sum in one launch, tiled sums for the other models, update_state
-without a force pass) under the plain key (``rft3d/150pt``) and ``reference`` (``model.fused = False``: the
-previous per-point pass, one-thread-per-foot loop and recomputing update_state) under ``<key>/reference``.
-Each fused record also carries ``wrench_max_rel_diff_vs_reference``: max |W_fused - W_ref| / max |W_ref| on
-the benchmark state after one compute (float32 round-off expected, ~1e-6).
+Paths (``--paths``, default both): ``fused`` (``model.fused = True``, the default: 3D-RFT elements + per-foot tile
+sum in one launch, tiled per-foot sums for the other models) under the plain key (``rft3d/150pt``), and
+``unfused`` (``model.fused = False``: per-point pass + one-thread-per-foot sum) under ``<key>/unfused``. Both
+paths share update_state (one launch, no force pass). Each fused record also carries
+``wrench_max_rel_diff_vs_unfused``: max |W_fused - W_unfused| / max |W_unfused| after one compute on the benchmark
+state (float32 round-off expected, ~1e-6). ``rft3d_viscous`` is 3D-RFT with ``static_friction=False`` (the cost
+of the stick anchors).
+
+Time box and resume: the JSON (``<out>/bench_contact.json``) is rewritten atomically after every record; a rerun
+with the same ``--out`` skips the records already there (``--force`` redoes them). The run stops starting new
+records after ``--max-minutes`` and exits with 3 (``"complete": false``); rerun the same command to continue.
 """
 
 from __future__ import annotations
@@ -21,23 +26,32 @@ from __future__ import annotations
 import argparse
 import json
 import os
+import sys
 import time
 from collections.abc import Callable
 from pathlib import Path
-from typing import Any
+from typing import Any, Literal
 
 import numpy as np
 
+MODELS = ("rft3d", "rft3d_viscous", "heuristic_rft", "cone_multi", "cone_single")
+"""Benchmarked model variants (``rft3d_viscous``: 3D-RFT without static friction)."""
+PATHS = ("fused", "unfused")
+"""Kernel paths of compute(): ``model.fused`` True / False."""
 
-def _parse() -> argparse.Namespace:
+
+def _parse(argv: list[str] | None = None) -> argparse.Namespace:
     p = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     p.add_argument("--num-worlds", type=int, default=4096)
-    p.add_argument("--reps", type=int, default=200)
+    p.add_argument("--reps", type=int, default=200, help="launches per timed CUDA graph")
     p.add_argument("--device", default="cuda:0")
     p.add_argument("--skip-sim", action="store_true", help="do not build the G1 env for the step reference")
-    p.add_argument("--paths", default="fused,reference", help="comma list of kernel paths: fused, reference")
-    p.add_argument("--out", type=Path, default=Path("bench_contact.json"))
-    return p.parse_args()
+    p.add_argument("--paths", default=",".join(PATHS), help="comma list of compute() paths: fused, unfused")
+    p.add_argument("--models", default=",".join(MODELS), help="comma list of model variants")
+    p.add_argument("--out", type=Path, default=Path("bench_contact"), help="output folder (bench_contact.json)")
+    p.add_argument("--max-minutes", type=float, default=9.0, help="start no new record after this [min]")
+    p.add_argument("--force", action="store_true", help="redo records already in the JSON")
+    return p.parse_args(argv)
 
 
 def _time_graph(fn: Callable[[], object], reps: int, device: str) -> float:
@@ -50,10 +64,12 @@ def _time_graph(fn: Callable[[], object], reps: int, device: str) -> float:
         with wp.ScopedCapture(device=device) as cap:
             for _ in range(reps):
                 fn()
-        wp.capture_launch(cap.graph)  # warm
+        graph = cap.graph
+        assert graph is not None
+        wp.capture_launch(graph)  # warm
         wp.synchronize()
         t0 = time.perf_counter()
-        wp.capture_launch(cap.graph)
+        wp.capture_launch(graph)
         wp.synchronize()
         return (time.perf_counter() - t0) / reps
     t0 = time.perf_counter()
@@ -91,67 +107,83 @@ def _foot_state(num_worlds: int, device: str, seed: int = 0) -> tuple[Any, ...]:
         arr(vel, wp.vec3),
         arr(angv, wp.vec3),
         arr(com, wp.vec3),
-        wp.zeros(shape, dtype=wp.spatial_vector, device=device),
+        wp.zeros(shape, dtype=wp.spatial_vectorf, device=device),
     )
 
 
-def _wrench_rel_diff(cfg: Any, num_worlds: int, device: str, material: Any) -> float:
-    """Max |W_fused - W_reference| / max |W_reference| of one compute() on the benchmark state."""
-    from gmloco.contact import make_contact_model
-
-    out = []
-    for fused in (True, False):
-        model = make_contact_model(cfg, num_worlds, 2, device)
-        model.fused = fused
-        w = np.ones(num_worlds)
-        model.set_materials(w * material.rho_c, w * material.mu_int, w * material.mu_surf)
-        state = _foot_state(num_worlds, device)
-        model.update_state(*state[:5])  # z_max at the current depth: the same branch mix as the timed loop
-        model.compute(*state)
-        out.append(state[5].numpy().astype(np.float64))
-    return float(np.abs(out[0] - out[1]).max() / max(np.abs(out[1]).max(), 1e-30))
-
-
-def bench_models(num_worlds: int, reps: int, device: str, paths: list[str]) -> dict[str, dict[str, float]]:
-    """Seconds per launch of each model's compute / update_state for 25 and 150 points per foot, per path."""
+def _model_cfgs(faces: Literal["sole", "box"]) -> dict[str, Any]:
+    """Return the benchmarked model configs on the 5x5 G1 foot collider with ``faces`` (sole or box)."""
     from gmloco.contact import (
-        MATERIAL_PRESETS,
         ColliderBoxCfg,
         ContactConeMultiCfg,
         ContactConeSingleCfg,
         ContactHeuristicRFTCfg,
         ContactRFT3DCfg,
-        make_contact_model,
     )
 
+    collider = ColliderBoxCfg(faces=faces, resolution=5)
+    return {
+        "rft3d": ContactRFT3DCfg(collider=collider),
+        "rft3d_viscous": ContactRFT3DCfg(collider=collider, static_friction=False),
+        "heuristic_rft": ContactHeuristicRFTCfg(collider=collider),
+        "cone_multi": ContactConeMultiCfg(collider=collider),
+        "cone_single": ContactConeSingleCfg(),
+    }
+
+
+def _prepared_model(cfg: Any, num_worlds: int, device: str, fused: bool) -> tuple[Any, tuple[Any, ...]]:
+    """Return a model on dry sand with its state at the benchmark pose (same branch mix as the timed loop)."""
+    from gmloco.contact import MATERIAL_PRESETS, make_contact_model
+
     sand = MATERIAL_PRESETS["dry_sand"]
-    out: dict[str, dict[str, float]] = {}
-    for faces, points in (("sole", 25), ("box", 150)):
-        collider = ColliderBoxCfg(faces=faces, resolution=5)
-        cfgs = {
-            "rft3d": ContactRFT3DCfg(collider=collider),
-            "heuristic_rft": ContactHeuristicRFTCfg(collider=collider),
-            "cone_multi": ContactConeMultiCfg(collider=collider),
-            "cone_single": ContactConeSingleCfg(),
-        }
-        for name, cfg in cfgs.items():
+    model = make_contact_model(cfg, num_worlds, 2, device)
+    model.fused = fused
+    w = np.ones(num_worlds)
+    model.set_materials(w * sand.rho_c, w * sand.mu_int, w * sand.mu_surf)
+    state = _foot_state(num_worlds, device)
+    model.update_state(*state[:5])  # z_max and anchors at the current pose
+    return model, state
+
+
+def _wrench_rel_diff(cfg: Any, num_worlds: int, device: str) -> float:
+    """Max |W_fused - W_unfused| / max |W_unfused| of one compute() on the benchmark state."""
+    out = []
+    for fused in (True, False):
+        model, state = _prepared_model(cfg, num_worlds, device, fused)
+        model.compute(*state)
+        out.append(state[5].numpy().astype(np.float64))
+    return float(np.abs(out[0] - out[1]).max() / max(np.abs(out[1]).max(), 1e-30))
+
+
+FACES: tuple[tuple[Literal["sole", "box"], int], ...] = (("sole", 25), ("box", 150))
+"""Collider faces and the points per foot they give at resolution 5."""
+
+
+def record_keys(models: list[str], paths: list[str]) -> list[tuple[str, str, Literal["sole", "box"], str]]:
+    """Return (key, model, faces, path) of every record, in run order."""
+    keys = []
+    for faces, points in FACES:
+        for name in models:
             if name == "cone_single" and faces == "box":
                 continue  # one point per foot whatever the collider
             for path in paths:
-                model = make_contact_model(cfg, num_worlds, 2, device)
-                model.fused = path == "fused"
-                w = np.ones(num_worlds)
-                model.set_materials(w * sand.rho_c, w * sand.mu_int, w * sand.mu_surf)
-                state = _foot_state(num_worlds, device)
                 key = f"{name}/{points if name != 'cone_single' else 1}pt" + ("" if path == "fused" else f"/{path}")
-                rec = {"compute_s": _time_graph(lambda m=model, s=state: m.compute(*s), reps, device)}
-                if getattr(model, "is_stateful", False):
-                    rec["update_state_s"] = _time_graph(lambda m=model, s=state: m.update_state(*s[:5]), reps, device)
-                if path == "fused" and "reference" in paths:
-                    rec["wrench_max_rel_diff_vs_reference"] = _wrench_rel_diff(cfg, num_worlds, device, sand)
-                out[key] = rec
-                print(key, rec, flush=True)
-    return out
+                keys.append((key, name, faces, path))
+    return keys
+
+
+def bench_record(
+    name: str, faces: Literal["sole", "box"], path: str, args: argparse.Namespace, paths: list[str]
+) -> dict[str, float]:
+    """Seconds per launch of one model's compute / update_state on one path."""
+    cfg = _model_cfgs(faces)[name]
+    model, state = _prepared_model(cfg, args.num_worlds, args.device, path == "fused")
+    rec = {"compute_s": _time_graph(lambda: model.compute(*state), args.reps, args.device)}
+    if model.is_stateful:
+        rec["update_state_s"] = _time_graph(lambda: model.update_state(*state[:5]), args.reps, args.device)
+    if path == "fused" and "unfused" in paths:
+        rec["wrench_max_rel_diff_vs_unfused"] = _wrench_rel_diff(cfg, args.num_worlds, args.device)
+    return rec
 
 
 def bench_step(num_worlds: int, device: str) -> dict[str, float]:
@@ -178,31 +210,70 @@ def bench_step(num_worlds: int, device: str) -> dict[str, float]:
     return {"g1_substep_s": dt}
 
 
-def main() -> None:
-    """Run the benchmark and write one JSON."""
-    args = _parse()
-    os.environ.setdefault("MUJOCO_GL", "disable")
+def _write(path: Path, res: dict[str, Any]) -> None:
+    """Write ``res`` as JSON through a temporary file and os.replace (atomic)."""
+    tmp = path.with_suffix(".json.tmp")
+    tmp.write_text(json.dumps(res, indent=1))
+    os.replace(tmp, path)
+
+
+def _device_name(device: str) -> str:
+    """Return the GPU name (torch) or "cpu"."""
+    if not device.startswith("cuda"):
+        return "cpu"
     import torch
+
+    return torch.cuda.get_device_name(torch.device(device))
+
+
+def _shares(res: dict[str, Any]) -> None:
+    """Add each record's (compute + update_state) / G1 substep when the substep was measured."""
+    step = res.get("g1_substep_s")
+    for rec in res["models"].values():
+        if step:
+            rec["share_of_substep"] = (rec["compute_s"] + rec.get("update_state_s", 0.0)) / step
+
+
+def main(argv: list[str] | None = None) -> int:
+    """Run (or continue) the benchmark, write one JSON; return 0 when complete, 3 when the time box stopped it."""
+    args = _parse(argv)
+    t_start = time.perf_counter()
+    os.environ.setdefault("MUJOCO_GL", "disable")
     import warp as wp
 
     wp.init()
-    res: dict[str, object] = {
-        "device": torch.cuda.get_device_name(0) if torch.cuda.is_available() else "cpu",
-        "num_worlds": args.num_worlds,
-        "reps": args.reps,
-    }
-    res["paths"] = args.paths.split(",")
-    res["models"] = bench_models(args.num_worlds, args.reps, args.device, res["paths"])
-    if not args.skip_sim:
-        res.update(bench_step(args.num_worlds, args.device))
-        step = res["g1_substep_s"]
-        for rec in res["models"].values():  # type: ignore[union-attr]
-            total = rec["compute_s"] + rec.get("update_state_s", 0.0)
-            rec["share_of_substep"] = total / step  # type: ignore[operator]
-    args.out.parent.mkdir(parents=True, exist_ok=True)
-    args.out.write_text(json.dumps(res, indent=1))
+    paths, models = args.paths.split(","), args.models.split(",")
+    unknown = sorted({*paths} - {*PATHS}) + sorted({*models} - {*MODELS})
+    if unknown:
+        print(f"unknown path / model {unknown}: paths are {PATHS}, models {MODELS}", file=sys.stderr)
+        return 2
+    args.out.mkdir(parents=True, exist_ok=True)
+    out_file = args.out / "bench_contact.json"
+    res: dict[str, Any] = json.loads(out_file.read_text()) if out_file.exists() and not args.force else {}
+    setup = {"device": _device_name(args.device), "num_worlds": args.num_worlds, "reps": args.reps}
+    if res and {k: res.get(k) for k in setup} != setup:
+        print(f"{out_file} holds another setup {[res.get(k) for k in setup]}; use --force or another --out")
+        return 2
+    res.update(setup, paths=paths, models=res.get("models", {}), complete=False)
+    todo = [r for r in record_keys(models, paths) if r[0] not in res["models"]]
+    want_sim = not args.skip_sim and "g1_substep_s" not in res
+    for key, name, faces, path in todo:
+        if time.perf_counter() - t_start > 60.0 * args.max_minutes:
+            break
+        res["models"][key] = bench_record(name, faces, path, args, paths)
+        print(key, res["models"][key], flush=True)
+        _write(out_file, res)
+    else:
+        if want_sim and time.perf_counter() - t_start < 60.0 * args.max_minutes:
+            res.update(bench_step(args.num_worlds, args.device))
+        res["complete"] = all(k in res["models"] for k, *_ in record_keys(models, paths)) and (
+            args.skip_sim or "g1_substep_s" in res
+        )
+    _shares(res)
+    _write(out_file, res)
     print(json.dumps(res, indent=1))
+    return 0 if res["complete"] else 3
 
 
 if __name__ == "__main__":
-    main()
+    sys.exit(main())

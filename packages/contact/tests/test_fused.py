@@ -43,7 +43,7 @@ def _load_helpers():  # noqa: ANN202
 _helpers = _load_helpers()
 foot_arrays, random_rotations = _helpers.foot_arrays, _helpers.random_rotations
 
-STATE = ("depth_max", "ema_tau", "vel_prev")
+STATE = ("depth_max", "ema_tau", "vel_prev", "anchor")
 
 
 def feet_sequence(seed: int, steps: int) -> list[tuple[np.ndarray, ...]]:

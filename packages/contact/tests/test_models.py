@@ -30,6 +30,7 @@ from gmloco.contact import (
 from gmloco.contact.reference import (
     ConeParams,
     ConeState,
+    advance_stick_anchors,
     cone_step,
     foot_wrench,
     heuristic_rft_forces,
@@ -152,24 +153,42 @@ def test_heuristic_kernel_matches_reference(device: str) -> None:
 
 
 def test_unloading_branch_matches_reference(device: str) -> None:
-    """After update_state stores z_max, lifting a foot follows rft3d_unloading_forces (elastic branch)."""
+    """After update_state stores z_max and the stick anchors, lifting and sliding a foot follows the reference.
+
+    Substeps: press (z_max and anchors at touch-down), slide 1 mm or 4 mm sideways inside the crater (anchors
+    follow beyond the 2 mm stick distance: advance_stick_anchors), then lift 2 mm while sliding
+    (rft3d_unloading_forces: elastic branch with the stick spring).
+    """
     cfg = ContactRFT3DCfg(collider=g1_foot_box_cfg("sole", 4), unloading_ratio=3.0, unloading_damping=0.002)
     model = make_contact_model(cfg, W, F, device)
     pos, rot, vel, ang, com = random_feet(5, tilt=0.1)
     pos[..., 2] = 0.02  # soles ~15 mm deep
     vel[..., 2] = -np.abs(vel[..., 2])
-    model.update_state(*foot_arrays(pos, rot, vel, ang, com))
+    col = model.collider
+    model.update_state(*foot_arrays(pos, rot, vel, ang * 0, com))
+    slide = np.zeros_like(pos)
+    slide[..., 0] = np.where(np.arange(W)[:, None] % 2 == 0, 0.001, 0.004)  # inside / beyond the stick distance
+    slid = pos + slide + np.array([0.0, 0.0, 0.0005])  # a little shallower: elastic branch
+    anchors_before = model.anchor.numpy().astype(np.float64)
     depth_max = model.depth_max.numpy().astype(np.float64)
-    lifted = pos.copy()
-    lifted[..., 2] += 0.002
+    model.update_state(*foot_arrays(slid, rot, vel, ang * 0, com))
+    anchors = model.anchor.numpy().astype(np.float64)
+    moved = np.linalg.norm(anchors - anchors_before, axis=-1).max(axis=-1)  # [W, F]
+    assert moved[1::2].min() > 1e-3 and moved[::2].max() < 1e-6  # 4 mm slides the anchors, 1 mm does not
+    lifted = slid + np.array([0.0, 0.0, 0.002]) + slide
     vel_up = vel.copy()
     vel_up[..., 2] = 0.05
     run(model, (lifted, rot, vel_up, ang * 0, com))
     forces = model.point_force.numpy()
     mat = MATERIAL_PRESETS["dry_sand"]
-    col = model.collider
     for w in range(W):
         for f in range(F):
+            pts, nrm, _ = element_kinematics(col.points, col.normals, pos[w, f], rot[w, f], vel[w, f], np.zeros(3))
+            touch_down = advance_stick_anchors(pts, nrm, np.zeros_like(pts), np.zeros(len(pts)), cfg.stick_distance)
+            np.testing.assert_allclose(anchors_before[w, f], touch_down, atol=2e-6)
+            pts, nrm, _ = element_kinematics(col.points, col.normals, slid[w, f], rot[w, f], vel[w, f], np.zeros(3))
+            ref_anchor = advance_stick_anchors(pts, nrm, anchors_before[w, f], depth_max[w, f], cfg.stick_distance)
+            np.testing.assert_allclose(anchors[w, f], ref_anchor, atol=2e-6)
             pts, nrm, v = element_kinematics(
                 col.points, col.normals, lifted[w, f], rot[w, f], vel_up[w, f], np.zeros(3)
             )
@@ -178,7 +197,7 @@ def test_unloading_branch_matches_reference(device: str) -> None:
                 nrm,
                 v,
                 col.areas,
-                depth_max[w, f],
+                model.depth_max.numpy()[w, f].astype(np.float64),
                 rho_c=mat.rho_c,
                 mu_int=mat.mu_int,
                 mu_surf=mat.mu_surf,
@@ -186,6 +205,8 @@ def test_unloading_branch_matches_reference(device: str) -> None:
                 tangential_damping=cfg.tangential_damping,
                 damping=0.002,
                 unloading_speed=cfg.unloading_speed,
+                anchors=anchors[w, f],
+                stick_distance=cfg.stick_distance,
             )
             assert np.abs(ref).max() > 0.0
             np.testing.assert_allclose(forces[w, f], ref, atol=1e-4 * np.abs(ref).max())

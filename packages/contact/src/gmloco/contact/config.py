@@ -50,8 +50,8 @@ class _AtRestCfg:
     twice in contact (EMA reversal counter tau_r < 1 at the default ema_rate 0.5), so it damps the recovery after
     an impact but never the step-rate chatter of a light foot; 0 turns it off (README, "At rest")."""
     tangential_damping: float = 1.0e4
-    """Viscous cap of the elastic branch's Coulomb friction per element area, F_t = -min(mu F_n, c_t dS |v_t|)
-    [N s/m^3] (3D-RFT only; 150 N s/m for the G1 sole)."""
+    """Viscous term of the elastic branch's friction per element area, c_t in F_t = -(k s_t + c_t dS v_t) capped
+    at mu F_n [N s/m^3] (3D-RFT only; 150 N s/m for the G1 sole)."""
     ema_rate: float = 0.5
     """EMA rigidity increment per velocity reversal c_r = 100 dt [-] (0.5 at 200 Hz, Choi 2023 S16)."""
 
@@ -70,6 +70,14 @@ class ContactRFT3DCfg(_AtRestCfg):
     """Speed below which the motion direction is taken as gravity's [m/s] (spec 1.5)."""
     gravity: float = GRAVITY
     """Gravitational acceleration in xi_n = rho_c g f(mu_int) [m/s^2]."""
+    static_friction: bool = True
+    """Static friction in the crater (``at_rest="unloading"`` only): each submerged element keeps a stick anchor
+    and its elastic branch adds a tangential spring mu |F_n| s_t / stick_distance, capped with the viscous term at
+    mu |F_n| (Cundall-Strack); False = viscous-capped Coulomb only, under which a standing G1 creeps
+    (README, "Static friction in the crater"). The loading (plastic) branch is unchanged either way."""
+    stick_distance: float = 0.002
+    """Mobilization distance s0 of the static friction [m]: the tangential slip at which the stick spring reaches
+    the Coulomb force mu |F_n| (project choice, README "Static friction in the crater")."""
 
 
 @dataclass(frozen=True)

@@ -7,15 +7,21 @@ from typing import Any
 
 import warp as wp
 
-from gmloco.contact.kernels_geometry import TerrainData, foot_point_kinematics, terrain_height
+from gmloco.contact.kernels_geometry import (
+    TerrainData,
+    foot_inputs_finite,
+    foot_point_kinematics,
+    terrain_height,
+    write_element,
+)
 from gmloco.contact.kernels_rft2d import coulomb_tangential
 from gmloco.contact.kernels_state import (
-    AT_REST_EMA,
     AT_REST_UNLOADING,
-    ema_filter,
-    ema_rigidity,
-    impact_damping,
-    unloading_depth,
+    AtRestParams,
+    ElementState,
+    at_rest_filter,
+    elastic_depth,
+    point_kernel_data,
 )
 
 __all__ = ["cone_flat_area", "cone_quasi_static", "eval_cone_point_forces"]
@@ -59,20 +65,13 @@ def cone_point_force_kernel(
     k_f: float,
     added_mass: int,
     dt: float,
-    at_rest: int,
-    unloading_ratio: float,
-    unloading_damping: float,
-    unloading_speed: float,
-    ema_rate: float,
+    rest: AtRestParams,
     # Data in:
     foot_pos_in: wp.array2d[wp.vec3],
     foot_mat_in: wp.array2d[wp.mat33],
     foot_lin_vel_in: wp.array2d[wp.vec3],
     foot_ang_vel_in: wp.array2d[wp.vec3],
-    depth_max_in: wp.array3d[float],
-    ema_tau_in: wp.array3d[float],
-    force_prev_in: wp.array3d[wp.vec3],
-    vel_prev_in: wp.array3d[wp.vec3],
+    state_in: ElementState,
     # Data out:
     point_force_out: wp.array3d[wp.vec3],
     point_depth_out: wp.array3d[float],
@@ -85,18 +84,16 @@ def cone_point_force_kernel(
     rot = foot_mat_in[w, f]
     lin_vel = foot_lin_vel_in[w, f]
     ang_vel = foot_ang_vel_in[w, f]
-    if not (wp.isfinite(pos) and wp.isfinite(rot) and wp.isfinite(lin_vel) and wp.isfinite(ang_vel)):
+    if not foot_inputs_finite(pos, rot, lin_vel, ang_vel):
         wp.atomic_add(nan_count_out, 0, 1)
-        point_force_out[w, f, p] = wp.vec3(0.0)
-        point_depth_out[w, f, p] = 0.0
-        point_vel_out[w, f, p] = wp.vec3(0.0)
+        write_element(wp.vec3(0.0), 0.0, wp.vec3(0.0), point_force_out, point_depth_out, point_vel_out, w, f, p)
         return
     kin = foot_point_kinematics(pos, rot, lin_vel, ang_vel, points_b[p], wp.vec3(0.0, 0.0, -1.0))
     x = kin[0]
     v = kin[2]
     z = terrain_height(terrain, x[0], x[1]) - x[2]
     z_dot = -v[2]
-    z_max = depth_max_in[w, f, p]
+    z_max = state_in.depth_max[w, f, p]
     r_h = radii[p]
     s_flat = sigma_flat[w % sigma_flat.shape[0]]
     s_cone = sigma_cone[w % sigma_cone.shape[0]]
@@ -107,31 +104,20 @@ def cone_point_force_kernel(
             if z_dot > 0.0:  # drag c_d M A_flat z_dot^2 (GM-Loco form of c_d m_a_dot z_dot)
                 f_n += c_d * mass_rate * cone_flat_area(z, r_h, k_cone) * z_dot * z_dot
             if added_mass != 0:
-                z_ddot = (z_dot + vel_prev_in[w, f, p][2]) / dt
+                z_ddot = (z_dot + state_in.vel_prev[w, f, p][2]) / dt
                 f_n += mass_rate * cone_flat_integral(z, r_h, k_cone) * z_ddot
             f_n = wp.max(f_n, 0.0)
-        elif at_rest == AT_REST_UNLOADING:
-            d_eff = impact_damping(
-                unloading_depth(z, z_max, unloading_ratio, unloading_damping, z_dot),
-                z_max,
-                z_dot,
-                unloading_speed,
-                ema_tau_in[w, f, p],
-            )
+        elif rest.mode == AT_REST_UNLOADING:
+            d_eff = elastic_depth(z, z_max, z_dot, rest, state_in.ema_tau[w, f, p])
             f_n = cone_quasi_static(z_max, r_h, k_cone, cos_theta, s_flat, s_cone) * d_eff / z_max
     force = coulomb_tangential(f_n, v, mu_surf[w % mu_surf.shape[0]], k_f) + wp.vec3(0.0, 0.0, f_n)
-    if at_rest == AT_REST_EMA:
-        tau = ema_rigidity(ema_tau_in[w, f, p], v, vel_prev_in[w, f, p], z, ema_rate, 1)
-        force = ema_filter(force, force_prev_in[w, f, p], tau)
-    point_force_out[w, f, p] = force
-    point_depth_out[w, f, p] = z
-    point_vel_out[w, f, p] = v
+    force = at_rest_filter(force, v, z, rest, state_in, w, f, p, 1)
+    write_element(force, z, v, point_force_out, point_depth_out, point_vel_out, w, f, p)
 
 
 def eval_cone_point_forces(model: Any, inputs: tuple, nan_count_out: wp.array) -> None:
     """Launch :func:`cone_point_force_kernel` over [num_worlds, num_feet, num_points]."""
     cfg = model.cfg
-    foot_pos, foot_mat, foot_lin_vel, foot_ang_vel, _ = inputs
     wp.launch(
         cone_point_force_kernel,
         dim=model.point_depth.shape,
@@ -150,19 +136,8 @@ def eval_cone_point_forces(model: Any, inputs: tuple, nan_count_out: wp.array) -
             cfg.k_f,
             int(cfg.enable_added_mass),
             cfg.dt,
-            model.at_rest_code,
-            cfg.unloading_ratio,
-            cfg.unloading_damping,
-            cfg.unloading_speed,
-            cfg.ema_rate,
-            foot_pos,
-            foot_mat,
-            foot_lin_vel,
-            foot_ang_vel,
-            model.depth_max,
-            model.ema_tau,
-            model.force_prev,
-            model.vel_prev,
+            model.rest,
+            *point_kernel_data(model, inputs),
         ],
         outputs=[model.point_force, model.point_depth, model.point_vel, nan_count_out],
         device=model.device,

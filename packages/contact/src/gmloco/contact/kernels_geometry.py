@@ -12,11 +12,14 @@ __all__ = [
     "eval_foot_wrench",
     "eval_foot_wrench_tiled",
     "eval_scatter_values",
+    "foot_inputs_finite",
+    "foot_partial_wrench",
     "foot_point_kinematics",
     "media_scaling",
     "point_material",
     "terrain_height",
     "tile_block_dim",
+    "write_element",
 ]
 
 HEIGHT_FLAT = wp.constant(0)
@@ -106,6 +109,47 @@ def foot_point_kinematics(
     return wp.matrix_from_rows(pos + r, rot * normal_b, lin_vel + wp.cross(ang_vel, r))
 
 
+@wp.func
+def write_element(
+    force: wp.vec3,
+    depth: float,
+    vel: wp.vec3,
+    point_force_out: wp.array3d[wp.vec3],
+    point_depth_out: wp.array3d[float],
+    point_vel_out: wp.array3d[wp.vec3],
+    w: int,
+    f: int,
+    p: int,
+) -> None:
+    """Store one element's force [N], depth [m] and velocity [m/s] (the per-point outputs of compute())."""
+    point_force_out[w, f, p] = force
+    point_depth_out[w, f, p] = depth
+    point_vel_out[w, f, p] = vel
+
+
+@wp.func
+def foot_partial_wrench(
+    points_b: wp.array[wp.vec3],
+    point_force: wp.array3d[wp.vec3],
+    w: int,
+    f: int,
+    pos: wp.vec3,
+    rot: wp.mat33,
+    com: wp.vec3,
+    start: int,
+    stride: int,
+) -> wp.spatial_vector:
+    """Return (sum F_i, sum (p_i - p_com) x F_i) over points start, start + stride, ... in that order."""
+    force = wp.vec3(0.0)
+    torque = wp.vec3(0.0)
+    for p in range(start, points_b.shape[0], stride):
+        force_p = point_force[w, f, p]
+        force += force_p
+        # tau_com = sum (p_i - p_com) x F_i = tau_ankle + (p_ankle - p_com) x F
+        torque += wp.cross(pos + rot * points_b[p] - com, force_p)
+    return wp.spatial_vector(force, torque)
+
+
 @wp.kernel
 def foot_wrench_kernel(
     # Model:
@@ -129,14 +173,7 @@ def foot_wrench_kernel(
             wp.atomic_add(nan_count_out, 0, 1)  # non-finite CoM only (pose/velocity are counted per element)
         wrench_out[worldid, footid] = wp.spatial_vector(0.0, 0.0, 0.0, 0.0, 0.0, 0.0)
         return
-    force = wp.vec3(0.0)
-    torque = wp.vec3(0.0)
-    for p in range(points_b.shape[0]):
-        f = point_force_in[worldid, footid, p]
-        force += f
-        # tau_com = sum (p_i - p_com) x F_i = tau_ankle + (p_ankle - p_com) x F
-        torque += wp.cross(pos + rot * points_b[p] - com, f)
-    wrench_out[worldid, footid] = wp.spatial_vector(force, torque)
+    wrench_out[worldid, footid] = foot_partial_wrench(points_b, point_force_in, worldid, footid, pos, rot, com, 0, 1)
 
 
 def eval_foot_wrench(model: Any, inputs: tuple, wrench_out: wp.array) -> None:
@@ -199,13 +236,8 @@ def foot_wrench_tiled_kernel(
     pos = foot_pos_in[worldid, footid]
     rot = foot_mat_in[worldid, footid]
     com = foot_com_in[worldid, footid]
-    force = wp.vec3(0.0)
-    torque = wp.vec3(0.0)
-    for p in range(lane, points_b.shape[0], wp.block_dim()):
-        f = point_force_in[worldid, footid, p]
-        force += f
-        torque += wp.cross(pos + rot * points_b[p] - com, f)
-    wrench = foot_wrench_block_sum(wp.spatial_vector(force, torque), pos, rot, com, lane, nan_count_out)
+    partial = foot_partial_wrench(points_b, point_force_in, worldid, footid, pos, rot, com, lane, wp.block_dim())
+    wrench = foot_wrench_block_sum(partial, pos, rot, com, lane, nan_count_out)
     if lane == 0:
         wrench_out[worldid, footid] = wrench
 

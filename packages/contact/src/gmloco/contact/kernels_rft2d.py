@@ -9,19 +9,21 @@ import warp as wp
 
 from gmloco.contact.kernels_geometry import (
     TerrainData,
+    foot_inputs_finite,
     foot_point_kinematics,
     media_scaling,
     point_material,
     terrain_height,
+    write_element,
 )
 from gmloco.contact.kernels_rft3d import G_HAT, unit_velocity
 from gmloco.contact.kernels_state import (
-    AT_REST_EMA,
     AT_REST_UNLOADING,
-    ema_filter,
-    ema_rigidity,
-    impact_damping,
-    unloading_depth,
+    AtRestParams,
+    ElementState,
+    at_rest_filter,
+    elastic_depth,
+    point_kernel_data,
 )
 
 __all__ = ["eval_heuristic_point_forces", "rft2d_alpha_z", "rft2d_angles"]
@@ -90,20 +92,13 @@ def heuristic_point_force_kernel(
     gravity: float,
     v_eps: float,
     k_f: float,
-    at_rest: int,
-    unloading_ratio: float,
-    unloading_damping: float,
-    unloading_speed: float,
-    ema_rate: float,
+    rest: AtRestParams,
     # Data in:
     foot_pos_in: wp.array2d[wp.vec3],
     foot_mat_in: wp.array2d[wp.mat33],
     foot_lin_vel_in: wp.array2d[wp.vec3],
     foot_ang_vel_in: wp.array2d[wp.vec3],
-    depth_max_in: wp.array3d[float],
-    ema_tau_in: wp.array3d[float],
-    force_prev_in: wp.array3d[wp.vec3],
-    vel_prev_in: wp.array3d[wp.vec3],
+    state_in: ElementState,
     # Data out:
     point_force_out: wp.array3d[wp.vec3],
     point_depth_out: wp.array3d[float],
@@ -116,11 +111,9 @@ def heuristic_point_force_kernel(
     rot = foot_mat_in[w, f]
     lin_vel = foot_lin_vel_in[w, f]
     ang_vel = foot_ang_vel_in[w, f]
-    if not (wp.isfinite(pos) and wp.isfinite(rot) and wp.isfinite(lin_vel) and wp.isfinite(ang_vel)):
+    if not foot_inputs_finite(pos, rot, lin_vel, ang_vel):
         wp.atomic_add(nan_count_out, 0, 1)
-        point_force_out[w, f, p] = wp.vec3(0.0)
-        point_depth_out[w, f, p] = 0.0
-        point_vel_out[w, f, p] = wp.vec3(0.0)
+        write_element(wp.vec3(0.0), 0.0, wp.vec3(0.0), point_force_out, point_depth_out, point_vel_out, w, f, p)
         return
     kin = foot_point_kinematics(pos, rot, lin_vel, ang_vel, points_b[p], normals_b[p])
     x = kin[0]
@@ -133,33 +126,22 @@ def heuristic_point_force_kernel(
         scale = media_scaling(mat[0], mat[1], gravity)
     v_hat = unit_velocity(v, v_eps)
     depth_eff = depth
-    depth_max = depth_max_in[w, f, p]
-    if at_rest == AT_REST_UNLOADING and depth > 0.0 and depth < depth_max:
+    depth_max = state_in.depth_max[w, f, p]
+    if rest.mode == AT_REST_UNLOADING and depth > 0.0 and depth < depth_max:
         v_hat = G_HAT  # elastic branch: static resistance on the unloading line
-        depth_eff = impact_damping(
-            unloading_depth(depth, depth_max, unloading_ratio, unloading_damping, -v[2]),
-            depth_max,
-            -v[2],
-            unloading_speed,
-            ema_tau_in[w, f, p],
-        )
+        depth_eff = elastic_depth(depth, depth_max, -v[2], rest, state_in.ema_tau[w, f, p])
     force = wp.vec3(0.0)
     if depth > 0.0:
         angles = rft2d_angles(n, v_hat)
         f_z = wp.max(0.0, scale * rft2d_alpha_z(coeffs, angles[0], angles[1]) * depth_eff * areas[p])
         force = coulomb_tangential(f_z, v, mat[2], k_f) + wp.vec3(0.0, 0.0, f_z)
-    if at_rest == AT_REST_EMA:
-        tau = ema_rigidity(ema_tau_in[w, f, p], v, vel_prev_in[w, f, p], depth, ema_rate, 1)
-        force = ema_filter(force, force_prev_in[w, f, p], tau)
-    point_force_out[w, f, p] = force
-    point_depth_out[w, f, p] = depth
-    point_vel_out[w, f, p] = v
+    force = at_rest_filter(force, v, depth, rest, state_in, w, f, p, 1)
+    write_element(force, depth, v, point_force_out, point_depth_out, point_vel_out, w, f, p)
 
 
 def eval_heuristic_point_forces(model: Any, inputs: tuple, nan_count_out: wp.array) -> None:
     """Launch :func:`heuristic_point_force_kernel` over [num_worlds, num_feet, num_points]."""
     cfg = model.cfg
-    foot_pos, foot_mat, foot_lin_vel, foot_ang_vel, _ = inputs
     wp.launch(
         heuristic_point_force_kernel,
         dim=model.point_depth.shape,
@@ -176,19 +158,8 @@ def eval_heuristic_point_forces(model: Any, inputs: tuple, nan_count_out: wp.arr
             cfg.gravity,
             cfg.v_eps,
             cfg.k_f,
-            model.at_rest_code,
-            cfg.unloading_ratio,
-            cfg.unloading_damping,
-            cfg.unloading_speed,
-            cfg.ema_rate,
-            foot_pos,
-            foot_mat,
-            foot_lin_vel,
-            foot_ang_vel,
-            model.depth_max,
-            model.ema_tau,
-            model.force_prev,
-            model.vel_prev,
+            model.rest,
+            *point_kernel_data(model, inputs),
         ],
         outputs=[model.point_force, model.point_depth, model.point_vel, nan_count_out],
         device=model.device,

@@ -16,15 +16,17 @@ from gmloco.contact.kernels_geometry import (
     point_material,
     terrain_height,
     tile_block_dim,
+    write_element,
 )
 from gmloco.contact.kernels_state import (
     AT_REST_EMA,
-    AT_REST_NONE,
     AT_REST_UNLOADING,
-    ema_filter,
-    ema_rigidity,
-    impact_damping,
-    unloading_depth,
+    AtRestParams,
+    ElementState,
+    at_rest_filter,
+    crater_friction,
+    elastic_depth,
+    point_kernel_data,
 )
 
 __all__ = [
@@ -51,19 +53,6 @@ def unit_velocity(v: wp.vec3, v_eps: float) -> wp.vec3:
     if speed < v_eps:
         return G_HAT
     return v / speed
-
-
-@wp.func
-def cubic_fit(c: wp.array2d[float], j: int, x1: float, x2: float, x3: float) -> float:
-    """Return f_j = sum_k c[k, j] T_k(x1, x2, x3) over the 20 PNAS SI monomials, in SI order."""
-    f = c[0, j] + c[1, j] * x1 + c[2, j] * x2 + c[3, j] * x3
-    f += c[4, j] * x1 * x1 + c[5, j] * x2 * x2 + c[6, j] * x3 * x3
-    f += c[7, j] * x1 * x2 + c[8, j] * x2 * x3 + c[9, j] * x3 * x1
-    f += c[10, j] * x1 * x1 * x1 + c[11, j] * x2 * x2 * x2 + c[12, j] * x3 * x3 * x3
-    f += c[13, j] * x1 * x2 * x2 + c[14, j] * x2 * x1 * x1 + c[15, j] * x2 * x3 * x3
-    f += c[16, j] * x3 * x2 * x2 + c[17, j] * x3 * x1 * x1 + c[18, j] * x1 * x3 * x3
-    f += c[19, j] * x1 * x2 * x3
-    return f
 
 
 @wp.func
@@ -97,23 +86,11 @@ def cubic_basis(x1: float, x2: float, x3: float) -> CubicBasis:
 
 
 @wp.func
-def rft3d_generic(n: wp.vec3, v_hat: wp.vec3, coeffs: wp.array2d[float]) -> wp.vec3:
-    """Return G = f1 n_e + f2 v_hat + f3 g_hat with n_e = n if n_z < 0 else -n (PNAS 2023, spec 1.1)."""
-    n_e = n
-    if n[2] >= 0.0:
-        n_e = -n
-    x1 = wp.dot(G_HAT, v_hat)
-    x2 = wp.dot(G_HAT, n_e)
-    x3 = wp.dot(n_e, v_hat)
-    f1 = cubic_fit(coeffs, 0, x1, x2, x3)
-    f2 = cubic_fit(coeffs, 1, x1, x2, x3)
-    f3 = cubic_fit(coeffs, 2, x1, x2, x3)
-    return f1 * n_e + f2 * v_hat + f3 * G_HAT
+def rft3d_generic(n: wp.vec3, v_hat: wp.vec3, coeffs: RFT3DCoeffs) -> wp.vec3:
+    """Return G = f1 n_e + f2 v_hat + f3 g_hat with n_e = n if n_z < 0 else -n (PNAS 2023, spec 1.1).
 
-
-@wp.func
-def rft3d_generic(n: wp.vec3, v_hat: wp.vec3, coeffs: RFT3DCoeffs) -> wp.vec3:  # noqa: F811
-    """Overload of :func:`rft3d_generic` for by-value coefficients: basis once, f = T^T C (same G, float32 round-off)."""
+    The 20 monomials are evaluated once and f = T^T C (3 x 20 FMAs on constant-bank operands).
+    """
     n_e = n
     if n[2] >= 0.0:
         n_e = -n
@@ -146,14 +123,11 @@ def rft3d_plastic_force(
     area: float,
     xi: float,
     mu_surf: float,
-    coeffs: Any,
+    coeffs: RFT3DCoeffs,
     v_eps: float,
     sign_fix: int,
 ) -> wp.vec3:
-    """Return F = alpha depth dS for a submerged leading element (n.v_hat >= 0), else 0 [N].
-
-    ``coeffs``: wp.array2d[float] (reference path) or :data:`RFT3DCoeffs` (fused path).
-    """
+    """Return F = alpha depth dS for a submerged leading element (n.v_hat >= 0), else 0 [N]."""
     v_hat = unit_velocity(v, v_eps)
     if depth <= 0.0 or wp.dot(n, v_hat) < 0.0:
         return wp.vec3(0.0)
@@ -164,39 +138,71 @@ def rft3d_plastic_force(
 def rft3d_elastic_force(
     n: wp.vec3,
     v: wp.vec3,
+    offset: wp.vec3,
     depth: float,
     depth_max: float,
     area: float,
     xi: float,
     mu_surf: float,
-    coeffs: Any,
-    ratio: float,
-    damping: float,
-    speed: float,
+    coeffs: RFT3DCoeffs,
+    rest: AtRestParams,
     tau_rev: float,
-    tangential_damping: float,
 ) -> wp.vec3:
-    """Return the elastic-branch force inside the crater: static alpha on d_eff plus capped viscous friction [N].
+    """Return the elastic-branch force inside the crater: static alpha on d_eff plus crater friction [N].
 
-    d_eff is the unloading line with Kelvin-Voigt and impact damping (:func:`impact_damping`).
-
-    F_t = -min(mu |F.n|, c_t dS |v_t|) v_t / |v_t| in the element plane (the viscous cap keeps the explicit
-    coupling stable, like GM-Loco's k_f for its baselines).
+    d_eff is the unloading line with Kelvin-Voigt and impact damping (:func:`impact_damping`); the tangential
+    part is :func:`crater_friction` (stick spring on ``offset`` = x - anchor, viscous term c_t dS v_t, Coulomb
+    cap mu |F.n|; the viscous cap alone keeps the explicit coupling stable, like GM-Loco's k_f for its
+    baselines, and the spring holds a static tangential load).
     """
     alpha_s = rft3d_alpha(rft3d_generic(n, G_HAT, coeffs), n, xi, mu_surf, G_HAT, 0)
-    d_eff = impact_damping(unloading_depth(depth, depth_max, ratio, damping, -v[2]), depth_max, -v[2], speed, tau_rev)
+    d_eff = elastic_depth(depth, depth_max, -v[2], rest, tau_rev)
     f = alpha_s * (d_eff * area)
-    v_t = v - wp.dot(v, n) * n
-    speed = wp.length(v_t)
-    if speed <= 0.0:
-        return f
-    return f - (wp.min(mu_surf * wp.abs(wp.dot(f, n)), tangential_damping * area * speed) / speed) * v_t
+    return f + crater_friction(f, n, v, offset, mu_surf, rest.tangential_damping * area, rest.stick_distance)
+
+
+@wp.func
+def rft3d_element_force(
+    kin: wp.mat33,
+    depth: float,
+    area: float,
+    mat: wp.vec3,
+    gravity: float,
+    coeffs: RFT3DCoeffs,
+    v_eps: float,
+    sign_fix: int,
+    rest: AtRestParams,
+    state: ElementState,
+    w: int,
+    f: int,
+    p: int,
+) -> wp.vec3:
+    """Return one submerged element's force [N]: elastic branch inside its crater, else plastic RFT; EMA filter.
+
+    ``kin`` = rows (x, n, v) of :func:`foot_point_kinematics`; ``mat`` = (rho_c, mu_int, mu_surf). The state is
+    read only where a branch needs it (z_max always; tau_r and the anchor in the elastic branch; the EMA fields
+    in ``"ema"`` mode).
+    """
+    n = kin[1]
+    v = kin[2]
+    xi = media_scaling(mat[0], mat[1], gravity)
+    depth_max = state.depth_max[w, f, p]
+    force = wp.vec3(0.0)
+    if rest.mode == AT_REST_UNLOADING and depth > 0.0 and depth < depth_max:
+        offset = wp.vec3(0.0)
+        if rest.stick_distance > 0.0:
+            offset = kin[0] - state.anchor[w, f, p]
+        tau_rev = state.ema_tau[w, f, p]
+        force = rft3d_elastic_force(n, v, offset, depth, depth_max, area, xi, mat[2], coeffs, rest, tau_rev)
+    else:
+        force = rft3d_plastic_force(n, v, depth, area, xi, mat[2], coeffs, v_eps, sign_fix)
+    return at_rest_filter(force, v, depth, rest, state, w, f, p, 0)
 
 
 @wp.kernel
 def rft3d_point_force_kernel(
     # Model:
-    coeffs: wp.array2d[float],
+    coeffs: RFT3DCoeffs,
     points_b: wp.array[wp.vec3],
     normals_b: wp.array[wp.vec3],
     areas: wp.array[float],
@@ -207,158 +213,65 @@ def rft3d_point_force_kernel(
     gravity: float,
     v_eps: float,
     sign_fix: int,
-    at_rest: int,
-    unloading_ratio: float,
-    unloading_damping: float,
-    unloading_speed: float,
-    tangential_damping: float,
-    ema_rate: float,
+    rest: AtRestParams,
     # Data in:
     foot_pos_in: wp.array2d[wp.vec3],
     foot_mat_in: wp.array2d[wp.mat33],
     foot_lin_vel_in: wp.array2d[wp.vec3],
     foot_ang_vel_in: wp.array2d[wp.vec3],
-    depth_max_in: wp.array3d[float],
-    ema_tau_in: wp.array3d[float],
-    force_prev_in: wp.array3d[wp.vec3],
-    vel_prev_in: wp.array3d[wp.vec3],
+    state_in: ElementState,
     # Data out:
     point_force_out: wp.array3d[wp.vec3],
     point_depth_out: wp.array3d[float],
     point_vel_out: wp.array3d[wp.vec3],
     nan_count_out: wp.array[int],
 ) -> None:
-    """Compute one element's 3D-RFT force, depth and velocity for [world, foot, point]."""
+    """Compute one element's 3D-RFT force, depth and velocity for [world, foot, point] (reference path)."""
     w, f, p = wp.tid()
     pos = foot_pos_in[w, f]
     rot = foot_mat_in[w, f]
     lin_vel = foot_lin_vel_in[w, f]
     ang_vel = foot_ang_vel_in[w, f]
-    if not (wp.isfinite(pos) and wp.isfinite(rot) and wp.isfinite(lin_vel) and wp.isfinite(ang_vel)):
+    if not foot_inputs_finite(pos, rot, lin_vel, ang_vel):
         wp.atomic_add(nan_count_out, 0, 1)
-        point_force_out[w, f, p] = wp.vec3(0.0)
-        point_depth_out[w, f, p] = 0.0
-        point_vel_out[w, f, p] = wp.vec3(0.0)
+        write_element(wp.vec3(0.0), 0.0, wp.vec3(0.0), point_force_out, point_depth_out, point_vel_out, w, f, p)
         return
     kin = foot_point_kinematics(pos, rot, lin_vel, ang_vel, points_b[p], normals_b[p])
     x = kin[0]
-    n = kin[1]
-    v = kin[2]
     depth = terrain_height(terrain, x[0], x[1]) - x[2]
     mat = point_material(terrain, rho_c, mu_int, mu_surf, w, x[0])
-    xi = media_scaling(mat[0], mat[1], gravity)
-    depth_max = depth_max_in[w, f, p]
-    force = wp.vec3(0.0)
-    if at_rest == AT_REST_UNLOADING and depth > 0.0 and depth < depth_max:
-        force = rft3d_elastic_force(
-            n,
-            v,
-            depth,
-            depth_max,
-            areas[p],
-            xi,
-            mat[2],
-            coeffs,
-            unloading_ratio,
-            unloading_damping,
-            unloading_speed,
-            ema_tau_in[w, f, p],
-            tangential_damping,
-        )
-    else:
-        force = rft3d_plastic_force(n, v, depth, areas[p], xi, mat[2], coeffs, v_eps, sign_fix)
-    if at_rest == AT_REST_EMA:
-        tau = ema_rigidity(ema_tau_in[w, f, p], v, vel_prev_in[w, f, p], depth, ema_rate, 0)
-        force = ema_filter(force, force_prev_in[w, f, p], tau)
-    point_force_out[w, f, p] = force
-    point_depth_out[w, f, p] = depth
-    point_vel_out[w, f, p] = v
+    force = rft3d_element_force(kin, depth, areas[p], mat, gravity, coeffs, v_eps, sign_fix, rest, state_in, w, f, p)
+    write_element(force, depth, kin[2], point_force_out, point_depth_out, point_vel_out, w, f, p)
+
+
+def _rft3d_model_inputs(model: Any) -> list:
+    """Return the ``# Model:`` arguments shared by the per-point and the fused 3D-RFT kernels."""
+    cfg = model.cfg
+    return [
+        model.coeffs,
+        model.points_b,
+        model.normals_b,
+        model.areas,
+        model.rho_c,
+        model.mu_int,
+        model.mu_surf,
+        model.terrain,
+        cfg.gravity,
+        cfg.v_eps,
+        int(cfg.sign_fix),
+        model.rest,
+    ]
 
 
 def eval_rft3d_point_forces(model: Any, inputs: tuple, nan_count_out: wp.array) -> None:
     """Launch :func:`rft3d_point_force_kernel` over [num_worlds, num_feet, num_points]."""
-    cfg = model.cfg
-    foot_pos, foot_mat, foot_lin_vel, foot_ang_vel, _ = inputs
     wp.launch(
         rft3d_point_force_kernel,
         dim=model.point_depth.shape,
-        inputs=[
-            model.coeffs,
-            model.points_b,
-            model.normals_b,
-            model.areas,
-            model.rho_c,
-            model.mu_int,
-            model.mu_surf,
-            model.terrain,
-            cfg.gravity,
-            cfg.v_eps,
-            int(cfg.sign_fix),
-            model.at_rest_code,
-            cfg.unloading_ratio,
-            cfg.unloading_damping,
-            cfg.unloading_speed,
-            cfg.tangential_damping,
-            cfg.ema_rate,
-            foot_pos,
-            foot_mat,
-            foot_lin_vel,
-            foot_ang_vel,
-            model.depth_max,
-            model.ema_tau,
-            model.force_prev,
-            model.vel_prev,
-        ],
+        inputs=[*_rft3d_model_inputs(model), *point_kernel_data(model, inputs)],
         outputs=[model.point_force, model.point_depth, model.point_vel, nan_count_out],
         device=model.device,
     )
-
-
-@wp.func
-def rft3d_element_force(
-    n: wp.vec3,
-    v: wp.vec3,
-    depth: float,
-    area: float,
-    xi: float,
-    mu_surf: float,
-    coeffs: RFT3DCoeffs,
-    v_eps: float,
-    sign_fix: int,
-    at_rest: int,
-    unloading_ratio: float,
-    unloading_damping: float,
-    unloading_speed: float,
-    tangential_damping: float,
-    ema_rate: float,
-    depth_max: float,
-    ema_tau: float,
-    force_prev: wp.vec3,
-    vel_prev: wp.vec3,
-) -> wp.vec3:
-    """Return one element's force exactly as :func:`rft3d_point_force_kernel` does (elastic / plastic / EMA) [N]."""
-    force = wp.vec3(0.0)
-    if at_rest == AT_REST_UNLOADING and depth > 0.0 and depth < depth_max:
-        force = rft3d_elastic_force(
-            n,
-            v,
-            depth,
-            depth_max,
-            area,
-            xi,
-            mu_surf,
-            coeffs,
-            unloading_ratio,
-            unloading_damping,
-            unloading_speed,
-            ema_tau,
-            tangential_damping,
-        )
-    else:
-        force = rft3d_plastic_force(n, v, depth, area, xi, mu_surf, coeffs, v_eps, sign_fix)
-    if at_rest == AT_REST_EMA:
-        force = ema_filter(force, force_prev, ema_rigidity(ema_tau, v, vel_prev, depth, ema_rate, 0))
-    return force
 
 
 @wp.kernel
@@ -375,22 +288,14 @@ def rft3d_foot_wrench_kernel(
     gravity: float,
     v_eps: float,
     sign_fix: int,
-    at_rest: int,
-    unloading_ratio: float,
-    unloading_damping: float,
-    unloading_speed: float,
-    tangential_damping: float,
-    ema_rate: float,
+    rest: AtRestParams,
     # Data in:
     foot_pos_in: wp.array2d[wp.vec3],
     foot_mat_in: wp.array2d[wp.mat33],
     foot_lin_vel_in: wp.array2d[wp.vec3],
     foot_ang_vel_in: wp.array2d[wp.vec3],
     foot_com_in: wp.array2d[wp.vec3],
-    depth_max_in: wp.array3d[float],
-    ema_tau_in: wp.array3d[float],
-    force_prev_in: wp.array3d[wp.vec3],
-    vel_prev_in: wp.array3d[wp.vec3],
+    state_in: ElementState,
     # Data out:
     point_force_out: wp.array3d[wp.vec3],
     point_depth_out: wp.array3d[float],
@@ -400,10 +305,10 @@ def rft3d_foot_wrench_kernel(
 ) -> None:
     """3D-RFT element forces and their per-foot wrench in one pass: one block per foot, lanes stride over points.
 
-    Same element outputs as :func:`rft3d_point_force_kernel` and the same wrench as :func:`foot_wrench_kernel`
-    (float32 round-off: cubic in basis form, tile-sum order). Emerged elements (depth <= 0) skip the material,
-    xi and RFT evaluation: their force is exactly zero in every at-rest mode (the EMA weight is 0 out of
-    contact). State is read only (depth_max for submerged elements; the other fields in their branches).
+    Same element outputs as :func:`rft3d_point_force_kernel` (same :func:`rft3d_element_force`) and the same
+    wrench as :func:`foot_wrench_kernel` (float32 round-off: cubic in basis form, tile-sum order). Emerged
+    elements (depth <= 0) skip the material, xi and RFT evaluation: their force is exactly zero in every
+    at-rest mode (the EMA weight is 0 out of contact).
     """
     w, f, lane = wp.tid()
     pos = foot_pos_in[w, f]
@@ -423,45 +328,17 @@ def rft3d_foot_wrench_kernel(
             x = kin[0]
             v = kin[2]
             depth = terrain_height(terrain, x[0], x[1]) - x[2]
-            if depth > 0.0 or at_rest == AT_REST_EMA:
+            if depth > 0.0 or rest.mode == AT_REST_EMA:
                 mat = point_material(terrain, rho_c, mu_int, mu_surf, w, x[0])
-                ema_tau = 0.0
-                force_prev = wp.vec3(0.0)
-                vel_prev = wp.vec3(0.0)
-                if at_rest != AT_REST_NONE:
-                    ema_tau = ema_tau_in[w, f, p]
-                if at_rest == AT_REST_EMA:
-                    force_prev = force_prev_in[w, f, p]
-                    vel_prev = vel_prev_in[w, f, p]
                 force = rft3d_element_force(
-                    kin[1],
-                    v,
-                    depth,
-                    areas[p],
-                    media_scaling(mat[0], mat[1], gravity),
-                    mat[2],
-                    coeffs,
-                    v_eps,
-                    sign_fix,
-                    at_rest,
-                    unloading_ratio,
-                    unloading_damping,
-                    unloading_speed,
-                    tangential_damping,
-                    ema_rate,
-                    depth_max_in[w, f, p],
-                    ema_tau,
-                    force_prev,
-                    vel_prev,
+                    kin, depth, areas[p], mat, gravity, coeffs, v_eps, sign_fix, rest, state_in, w, f, p
                 )
                 force_sum += force
                 # tau_com = sum (p_i - p_com) x F_i, as foot_wrench_kernel (x = pos + R p_b)
                 torque_sum += wp.cross(x - com, force)
         else:
             wp.atomic_add(nan_count_out, 0, 1)
-        point_force_out[w, f, p] = force
-        point_depth_out[w, f, p] = depth
-        point_vel_out[w, f, p] = v
+        write_element(force, depth, v, point_force_out, point_depth_out, point_vel_out, w, f, p)
     wrench = foot_wrench_block_sum(wp.spatial_vector(force_sum, torque_sum), pos, rot, com, lane, nan_count_out)
     if lane == 0:
         wrench_out[w, f] = wrench
@@ -469,39 +346,10 @@ def rft3d_foot_wrench_kernel(
 
 def eval_rft3d_foot_wrench(model: Any, inputs: tuple, wrench_out: wp.array) -> None:
     """Launch :func:`rft3d_foot_wrench_kernel` over [num_worlds, num_feet] blocks (fused compute())."""
-    cfg = model.cfg
-    foot_pos, foot_mat, foot_lin_vel, foot_ang_vel, foot_com = inputs
     wp.launch_tiled(
         rft3d_foot_wrench_kernel,
         dim=(model.num_worlds, model.num_feet),
-        inputs=[
-            model.coeffs_by_value,
-            model.points_b,
-            model.normals_b,
-            model.areas,
-            model.rho_c,
-            model.mu_int,
-            model.mu_surf,
-            model.terrain,
-            cfg.gravity,
-            cfg.v_eps,
-            int(cfg.sign_fix),
-            model.at_rest_code,
-            cfg.unloading_ratio,
-            cfg.unloading_damping,
-            cfg.unloading_speed,
-            cfg.tangential_damping,
-            cfg.ema_rate,
-            foot_pos,
-            foot_mat,
-            foot_lin_vel,
-            foot_ang_vel,
-            foot_com,
-            model.depth_max,
-            model.ema_tau,
-            model.force_prev,
-            model.vel_prev,
-        ],
+        inputs=[*_rft3d_model_inputs(model), *inputs, model.state],
         outputs=[model.point_force, model.point_depth, model.point_vel, wrench_out, model.nan_count],
         block_dim=tile_block_dim(model.num_points),
         device=model.device,

@@ -11,13 +11,19 @@ from gmloco.contact.kernels_geometry import TerrainData, foot_inputs_finite, foo
 
 __all__ = [
     "AT_REST_CODES",
+    "AtRestParams",
+    "ElementState",
+    "advance_stick_anchor",
+    "at_rest_filter",
+    "crater_friction",
+    "elastic_depth",
     "ema_filter",
     "ema_rigidity",
     "eval_reset_state",
     "eval_state_update",
-    "eval_state_update_from_kinematics",
     "eval_zero_wrench",
     "impact_damping",
+    "point_kernel_data",
     "unloading_depth",
 ]
 
@@ -26,6 +32,30 @@ AT_REST_UNLOADING = wp.constant(1)
 AT_REST_EMA = wp.constant(2)
 AT_REST_CODES: dict[str, int] = {"none": 0, "unloading": 1, "ema": 2}
 """Integer codes of the at-rest modes used by the kernels."""
+
+
+@wp.struct
+class AtRestParams:
+    """At-rest parameters of a model (``config._AtRestCfg``), one by-value kernel argument for every model."""
+
+    mode: int
+    unloading_ratio: float
+    unloading_damping: float
+    unloading_speed: float
+    tangential_damping: float
+    ema_rate: float
+    stick_distance: float
+
+
+@wp.struct
+class ElementState:
+    """Per-element memory [W, F, P], written only by update_state() / reset(); read only by compute()."""
+
+    depth_max: wp.array3d[float]
+    ema_tau: wp.array3d[float]
+    force_prev: wp.array3d[wp.vec3]
+    vel_prev: wp.array3d[wp.vec3]
+    anchor: wp.array3d[wp.vec3]
 
 
 @wp.func
@@ -56,6 +86,13 @@ def impact_damping(depth_eff: float, depth_max: float, depth_rate: float, speed:
 
 
 @wp.func
+def elastic_depth(depth: float, depth_max: float, depth_rate: float, rest: AtRestParams, tau_rev: float) -> float:
+    """Return the elastic-branch effective depth: :func:`unloading_depth`, then :func:`impact_damping` [m]."""
+    d_el = unloading_depth(depth, depth_max, rest.unloading_ratio, rest.unloading_damping, depth_rate)
+    return impact_damping(d_el, depth_max, depth_rate, rest.unloading_speed, tau_rev)
+
+
+@wp.func
 def ema_rigidity(
     tau_prev: float, vel: wp.vec3, vel_prev: wp.vec3, depth: float, rate: float, vertical_only: int
 ) -> float:
@@ -81,70 +118,111 @@ def ema_filter(force: wp.vec3, force_prev: wp.vec3, tau: float) -> wp.vec3:
     return (1.0 - 0.8 * tau) * force + 0.8 * tau * force_prev
 
 
+@wp.func
+def at_rest_filter(
+    force: wp.vec3,
+    vel: wp.vec3,
+    depth: float,
+    rest: AtRestParams,
+    state: ElementState,
+    w: int,
+    f: int,
+    p: int,
+    vertical_only: int,
+) -> wp.vec3:
+    """Return the element force after the EMA filter in ``"ema"`` mode, else ``force`` unchanged [N]."""
+    if rest.mode != AT_REST_EMA:
+        return force
+    tau = ema_rigidity(state.ema_tau[w, f, p], vel, state.vel_prev[w, f, p], depth, rest.ema_rate, vertical_only)
+    return ema_filter(force, state.force_prev[w, f, p], tau)
+
+
+@wp.func
+def crater_friction(
+    force: wp.vec3, n: wp.vec3, v: wp.vec3, offset: wp.vec3, mu: float, damping: float, distance: float
+) -> wp.vec3:
+    """Return the tangential force of an element in its crater, F_t = T min(1, mu |F.n| / |T|) [N].
+
+    T = -(mu |F.n| / s0) s_t - c v_t: a Cundall-Strack tangential spring on the offset s_t from the stick anchor
+    (stiffness mu |F.n| / s0, so it reaches the Coulomb force at the mobilization distance s0 = ``distance``;
+    s0 <= 0: no spring) plus the viscous term c v_t (``damping`` = c_t dS [N s/m]); s_t and v_t are the
+    components in the element plane. With s0 <= 0 this is the viscous-capped Coulomb law
+    -min(mu |F.n|, c |v_t|) v_t / |v_t| (README, "Static friction in the crater").
+    """
+    limit = mu * wp.abs(wp.dot(force, n))
+    trial = -damping * tangential(v, n)
+    if distance > 0.0:
+        trial -= (limit / distance) * tangential(offset, n)
+    mag = wp.length(trial)
+    if mag <= limit:
+        return trial
+    return trial * (limit / mag)
+
+
+@wp.func
+def tangential(vec: wp.vec3, n: wp.vec3) -> wp.vec3:
+    """Return the component of ``vec`` in the plane normal to the unit vector ``n``."""
+    return vec - wp.dot(vec, n) * n
+
+
+@wp.func
+def advance_stick_anchor(
+    anchor_out: wp.array3d[wp.vec3],
+    w: int,
+    f: int,
+    p: int,
+    x: wp.vec3,
+    n: wp.vec3,
+    depth: float,
+    depth_max: float,
+    distance: float,
+) -> None:
+    """Advance a submerged element's stick anchor (Cundall-Strack tangential spring with a Coulomb slider).
+
+    At touch-down (z_max = 0 before this update) the anchor is the element's position x. In contact, the
+    tangential offset s_t of x from the anchor is limited to ``distance``: beyond it the anchor slides after
+    the element, so the spring mu |F_n| s_t / distance never exceeds the Coulomb force (README, "Static
+    friction in the crater"). Unchanged anchors are not rewritten.
+    """
+    if depth >= depth_max:
+        anchor_out[w, f, p] = x
+        return
+    s_t = tangential(x - anchor_out[w, f, p], n)
+    length = wp.length(s_t)
+    if length > distance:
+        anchor_out[w, f, p] = x - s_t * (distance / length)
+
+
+def point_kernel_data(model: Any, inputs: tuple) -> list:
+    """Return the ``# Data in:`` arguments of the per-point force kernels: the foot pose, velocities and the state."""
+    return [*inputs[:4], model.state]
+
+
 @wp.kernel
 def state_update_kernel(
     # Model:
-    ema_rate: float,
-    vertical_only: int,
-    # Data in:
-    point_depth_in: wp.array3d[float],
-    point_vel_in: wp.array3d[wp.vec3],
-    point_force_in: wp.array3d[wp.vec3],
-    # Data out:
-    depth_max_out: wp.array3d[float],
-    ema_tau_out: wp.array3d[float],
-    force_prev_out: wp.array3d[wp.vec3],
-    vel_prev_out: wp.array3d[wp.vec3],
-) -> None:
-    """Advance per-element memory: z_max (reset out of contact), EMA rigidity, previous force and velocity."""
-    w, f, p = wp.tid()
-    depth = point_depth_in[w, f, p]
-    vel = point_vel_in[w, f, p]
-    if depth > 0.0:
-        depth_max_out[w, f, p] = wp.max(depth_max_out[w, f, p], depth)
-    else:
-        depth_max_out[w, f, p] = 0.0
-    ema_tau_out[w, f, p] = ema_rigidity(
-        ema_tau_out[w, f, p], vel, vel_prev_out[w, f, p], depth, ema_rate, vertical_only
-    )
-    force_prev_out[w, f, p] = point_force_in[w, f, p]
-    vel_prev_out[w, f, p] = vel
-
-
-def eval_state_update(model: Any, ema_rate: float, vertical_only: int) -> None:
-    """Launch :func:`state_update_kernel` over [num_worlds, num_feet, num_points] from the last compute()."""
-    wp.launch(
-        state_update_kernel,
-        dim=model.point_depth.shape,
-        inputs=[ema_rate, vertical_only, model.point_depth, model.point_vel, model.point_force],
-        outputs=[model.depth_max, model.ema_tau, model.force_prev, model.vel_prev],
-        device=model.device,
-    )
-
-
-@wp.kernel
-def state_update_kinematic_kernel(
-    # Model:
     points_b: wp.array[wp.vec3],
+    normals_b: wp.array[wp.vec3],
     terrain: TerrainData,
-    ema_rate: float,
+    rest: AtRestParams,
     vertical_only: int,
     # Data in:
     foot_pos_in: wp.array2d[wp.vec3],
     foot_mat_in: wp.array2d[wp.mat33],
     foot_lin_vel_in: wp.array2d[wp.vec3],
     foot_ang_vel_in: wp.array2d[wp.vec3],
+    point_force_in: wp.array3d[wp.vec3],
     # Data out:
-    depth_max_out: wp.array3d[float],
-    ema_tau_out: wp.array3d[float],
-    vel_prev_out: wp.array3d[wp.vec3],
+    state_out: ElementState,
 ) -> None:
-    """Advance z_max, the EMA rigidity and the previous velocity as :func:`state_update_kernel` does.
+    """Advance per-element memory: z_max (reset out of contact), EMA rigidity, previous velocity, stick anchor.
 
-    Depth and velocity are recomputed from the foot kinematics with the same functions the force kernels use
-    (~30 flops per element, cheaper than reading 16 B of stored depth and velocity), so no element force is
-    re-evaluated and the result does not depend on which compute() call ran last. Non-finite foot inputs give
-    depth 0 and velocity 0, as the force kernels store them. Unchanged z_max / tau_r are not rewritten.
+    Depth, position and velocity are recomputed from the foot kinematics with the functions the force kernels
+    use (~35 flops per element, cheaper than reading stored values), so no element force is evaluated and the
+    result does not depend on which compute() ran last. Non-finite foot inputs give depth 0 and velocity 0, as
+    the force kernels store them. ``"ema"`` mode also stores ``point_force_in`` (this substep's filtered
+    force); ``rest.stick_distance`` > 0 advances the anchors of submerged elements. Unchanged z_max, tau_r and
+    anchors are not rewritten.
     """
     w, f, p = wp.tid()
     pos = foot_pos_in[w, f]
@@ -152,33 +230,51 @@ def state_update_kinematic_kernel(
     lin_vel = foot_lin_vel_in[w, f]
     ang_vel = foot_ang_vel_in[w, f]
     depth = 0.0
+    x = wp.vec3(0.0)
+    n = wp.vec3(0.0)
     vel = wp.vec3(0.0)
     if foot_inputs_finite(pos, rot, lin_vel, ang_vel):
-        kin = foot_point_kinematics(pos, rot, lin_vel, ang_vel, points_b[p], wp.vec3(0.0, 0.0, -1.0))
+        kin = foot_point_kinematics(pos, rot, lin_vel, ang_vel, points_b[p], normals_b[p])
         x = kin[0]
+        n = kin[1]
         vel = kin[2]
         depth = terrain_height(terrain, x[0], x[1]) - x[2]
-    depth_max = depth_max_out[w, f, p]
+    depth_max = state_out.depth_max[w, f, p]
+    if rest.stick_distance > 0.0 and depth > 0.0:
+        advance_stick_anchor(state_out.anchor, w, f, p, x, n, depth, depth_max, rest.stick_distance)
     new_depth_max = 0.0
     if depth > 0.0:
         new_depth_max = wp.max(depth_max, depth)
     if new_depth_max != depth_max:
-        depth_max_out[w, f, p] = new_depth_max
-    tau = ema_tau_out[w, f, p]
-    new_tau = ema_rigidity(tau, vel, vel_prev_out[w, f, p], depth, ema_rate, vertical_only)
+        state_out.depth_max[w, f, p] = new_depth_max
+    tau = state_out.ema_tau[w, f, p]
+    new_tau = ema_rigidity(tau, vel, state_out.vel_prev[w, f, p], depth, rest.ema_rate, vertical_only)
     if new_tau != tau:
-        ema_tau_out[w, f, p] = new_tau
-    vel_prev_out[w, f, p] = vel
+        state_out.ema_tau[w, f, p] = new_tau
+    state_out.vel_prev[w, f, p] = vel
+    if rest.mode == AT_REST_EMA:
+        state_out.force_prev[w, f, p] = point_force_in[w, f, p]
 
 
-def eval_state_update_from_kinematics(model: Any, inputs: tuple, ema_rate: float, vertical_only: int) -> None:
-    """Launch :func:`state_update_kinematic_kernel` over [num_worlds, num_feet, num_points] (no force pass)."""
+def eval_state_update(model: Any, inputs: tuple, vertical_only: int) -> None:
+    """Launch :func:`state_update_kernel` over [num_worlds, num_feet, num_points] (no force pass)."""
     foot_pos, foot_mat, foot_lin_vel, foot_ang_vel, _ = inputs
     wp.launch(
-        state_update_kinematic_kernel,
+        state_update_kernel,
         dim=model.point_depth.shape,
-        inputs=[model.points_b, model.terrain, ema_rate, vertical_only, foot_pos, foot_mat, foot_lin_vel, foot_ang_vel],
-        outputs=[model.depth_max, model.ema_tau, model.vel_prev],
+        inputs=[
+            model.points_b,
+            model.normals_b,
+            model.terrain,
+            model.rest,
+            vertical_only,
+            foot_pos,
+            foot_mat,
+            foot_lin_vel,
+            foot_ang_vel,
+            model.point_force,
+        ],
+        outputs=[model.state],
         device=model.device,
     )
 
@@ -188,18 +284,16 @@ def reset_state_kernel(
     # Data in:
     world_ids_in: wp.array[int],
     # Data out:
-    depth_max_out: wp.array3d[float],
-    ema_tau_out: wp.array3d[float],
-    force_prev_out: wp.array3d[wp.vec3],
-    vel_prev_out: wp.array3d[wp.vec3],
+    state_out: ElementState,
 ) -> None:
     """Clear the per-element memory of the listed worlds."""
     i, f, p = wp.tid()
     w = world_ids_in[i]
-    depth_max_out[w, f, p] = 0.0
-    ema_tau_out[w, f, p] = 0.0
-    force_prev_out[w, f, p] = wp.vec3(0.0)
-    vel_prev_out[w, f, p] = wp.vec3(0.0)
+    state_out.depth_max[w, f, p] = 0.0
+    state_out.ema_tau[w, f, p] = 0.0
+    state_out.force_prev[w, f, p] = wp.vec3(0.0)
+    state_out.vel_prev[w, f, p] = wp.vec3(0.0)
+    state_out.anchor[w, f, p] = wp.vec3(0.0)
 
 
 def eval_reset_state(model: Any, world_ids: wp.array) -> None:
@@ -208,7 +302,7 @@ def eval_reset_state(model: Any, world_ids: wp.array) -> None:
         reset_state_kernel,
         dim=(world_ids.shape[0], model.num_feet, model.num_points),
         inputs=[world_ids],
-        outputs=[model.depth_max, model.ema_tau, model.force_prev, model.vel_prev],
+        outputs=[model.state],
         device=model.device,
     )
 

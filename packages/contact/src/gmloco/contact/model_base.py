@@ -18,14 +18,15 @@ from gmloco.contact.kernels_geometry import (
 )
 from gmloco.contact.kernels_state import (
     AT_REST_CODES,
+    AtRestParams,
+    ElementState,
     eval_reset_state,
     eval_state_update,
-    eval_state_update_from_kinematics,
 )
 from gmloco.contact.materials import MATERIAL_PRESETS, eta, validate_material_arrays
 from gmloco.contact.terrain import HEIGHT_KINDS, TerrainCfg
 
-__all__ = ["ContactModel", "make_terrain_data"]
+__all__ = ["ContactModel", "make_at_rest_params", "make_terrain_data"]
 
 DEFAULT_MATERIAL = MATERIAL_PRESETS["dry_sand"]
 """Material every world starts with until :meth:`ContactModel.set_materials` is called."""
@@ -49,6 +50,23 @@ def make_terrain_data(cfg: TerrainCfg, device: str) -> Any:  # a TerrainData ins
     return t
 
 
+def make_at_rest_params(cfg: Any) -> Any:  # an AtRestParams instance (Warp struct)
+    """Collect a config's at-rest fields (defaults of ``_AtRestCfg`` where it has none) into :class:`AtRestParams`.
+
+    The stick distance is kept only where static friction applies (3D-RFT, ``at_rest="unloading"``); 0 elsewhere.
+    """
+    rest = AtRestParams()
+    rest.mode = AT_REST_CODES[getattr(cfg, "at_rest", "none")]
+    rest.unloading_ratio = getattr(cfg, "unloading_ratio", 1.0)
+    rest.unloading_damping = getattr(cfg, "unloading_damping", 0.0)
+    rest.unloading_speed = getattr(cfg, "unloading_speed", 0.0)
+    rest.tangential_damping = getattr(cfg, "tangential_damping", 0.0)
+    rest.ema_rate = getattr(cfg, "ema_rate", 0.0)
+    sticks = getattr(cfg, "static_friction", False) and rest.mode == AT_REST_CODES["unloading"]
+    rest.stick_distance = float(cfg.stick_distance) if sticks else 0.0
+    return rest
+
+
 def _to_numpy(values: Any) -> np.ndarray:
     """Convert numpy, torch (any device), warp or scalars to a float64 numpy array."""
     if isinstance(values, wp.array):
@@ -67,7 +85,8 @@ class ContactModel:
         point_vel: Element velocity [m/s], wp.array3d[wp.vec3] [W, F, P]. point_depth / point_force / point_vel
             are written by compute() (the last call's inputs); update_state() does not rewrite them.
         force_prev: Previous substep's element force [N], [W, F, P]: kept only in ``at_rest="ema"``, the only
-            mode that reads it (the fast update_state skips it in the other modes).
+            mode that reads it.
+        anchor: Stick anchor of each submerged element, world frame [m], [W, F, P] (3D-RFT static friction).
         nan_count: Count of non-finite element inputs seen by compute() (one per element per call), [1].
         eta: Normalized stiffness xi / xi_max of each world's material (paper definition) [-], [W].
         eta_log: Log-scaled normalized stiffness (materials.eta scale="log") [-], [W].
@@ -75,9 +94,10 @@ class ContactModel:
 
     is_rigid: bool = False
     fused: bool = True
-    """Fast kernels (default): tiled per-foot sums, the model's fused points + wrench pass where it has one, and
-    update_state() without a force pass. False: the previous per-point pass, one-thread-per-foot sum and
-    recomputing update_state (kept as the parity oracle and for benchmarks; same results to float32 round-off)."""
+    """compute() path. True (default): the model's fused points + wrench pass where it has one (3D-RFT), else its
+    per-point pass + a tiled per-foot sum (one block per foot). False: per-point pass + one-thread-per-foot sum,
+    kept as the parity oracle of the tile sums and for benchmarks; both paths evaluate each element with the
+    same functions (same results to float32 round-off in the sum order). update_state() is one path."""
     _vertical_only: int = 0
     _eval_points: Callable[[Any, tuple, wp.array], None]
     _eval_fused: Callable[[Any, tuple, wp.array], None] | None = None
@@ -96,7 +116,8 @@ class ContactModel:
         self.num_worlds, self.num_feet, self.num_points = num_worlds, num_feet, collider.num_points
         self.device = device
         self.collider = collider
-        self.at_rest_code = AT_REST_CODES[getattr(cfg, "at_rest", "none")]
+        self.rest = make_at_rest_params(cfg)
+        self.at_rest_code = self.rest.mode
         self.terrain_cfg = terrain or TerrainCfg()
         self.terrain = make_terrain_data(self.terrain_cfg, device)
         self.points_b = wp.array(collider.points, dtype=wp.vec3, device=device)
@@ -116,6 +137,11 @@ class ContactModel:
         self.ema_tau = wp.zeros(shape, dtype=float, device=device)
         self.force_prev = wp.zeros(shape, dtype=wp.vec3, device=device)
         self.vel_prev = wp.zeros(shape, dtype=wp.vec3, device=device)
+        self.anchor = wp.zeros(shape, dtype=wp.vec3, device=device)
+        self.state = ElementState()
+        """The memory above as one kernel argument (the same arrays: views, never reallocated)."""
+        self.state.depth_max, self.state.ema_tau, self.state.anchor = self.depth_max, self.ema_tau, self.anchor
+        self.state.force_prev, self.state.vel_prev = self.force_prev, self.vel_prev
         self.nan_count = wp.zeros(1, dtype=int, device=device)
         self._scratch_count = wp.zeros(1, dtype=int, device=device)
 
@@ -224,22 +250,18 @@ class ContactModel:
 
         Contract: the new state depends only on these inputs and the current state, never on what compute()
         left in ``point_*`` (compute() may run any number of times per substep, e.g. again in ``sim.forward()``,
-        or not at all). The update needs each element's depth and velocity (z_max, reversal counter, previous
-        velocity), which it recomputes from the inputs in one launch with the kinematics functions compute()
-        uses (cheaper than storing and re-reading them, and immune to a later compute() with other inputs); no
-        element force is evaluated. ``at_rest="ema"`` (and ``fused=False``) keeps the previous path, which
-        re-evaluates the element forces because the EMA's ``force_prev`` is the filtered force.
+        or not at all). The update needs each element's depth, position and velocity (z_max, stick anchor,
+        reversal counter, previous velocity), which one launch recomputes from the inputs with the kinematics
+        functions compute() uses (cheaper than storing and re-reading them, and immune to a later compute()
+        with other inputs); no element force is evaluated. Only ``at_rest="ema"`` first re-evaluates the element
+        forces of this substep, because the EMA's ``force_prev`` is the filtered force.
         """
         inputs = (foot_pos_w, foot_mat_w, foot_lin_vel_w, foot_ang_vel_w, foot_com_w)
-        ema_rate = getattr(self.cfg, "ema_rate", 0.0)
-        if self.fused and self.at_rest_code != AT_REST_CODES["ema"]:
-            # z_max, EMA rigidity, previous velocity from recomputed element depth and velocity, one launch
-            eval_state_update_from_kinematics(self, inputs, ema_rate, self._vertical_only)
-            return
-        # 1. recompute the element forces of this substep (not counted twice in nan_count)
-        self._eval_points(self, inputs, self._scratch_count)
-        # 2. z_max, EMA rigidity, previous force and velocity
-        eval_state_update(self, ema_rate, self._vertical_only)
+        if self.at_rest_code == AT_REST_CODES["ema"]:
+            # element forces of this substep for force_prev (not counted twice in nan_count)
+            self._eval_points(self, inputs, self._scratch_count)
+        # z_max, stick anchor, EMA rigidity, previous velocity (and force in "ema" mode), one launch
+        eval_state_update(self, inputs, self._vertical_only)
 
     def reset(self, env_ids: Any = None) -> None:
         """Clear the state of the given worlds (all when None)."""

@@ -49,10 +49,8 @@ class ContactRFT3D(ContactModel):
     ) -> None:
         """Build from ``cfg``; see :class:`ContactModel`."""
         super().__init__(cfg, num_worlds, num_feet, device, terrain, box_collider(cfg.collider))
-        coeffs = np.asarray(resolve_rft3d_coeffs(cfg.coeffs), dtype=np.float32)
-        self.coeffs = wp.array(coeffs, dtype=float, device=device)
-        self.coeffs_by_value = RFT3DCoeffs(coeffs)
-        """The same 20 x 3 coefficients as a by-value kernel parameter (fused path)."""
+        self.coeffs = RFT3DCoeffs(np.asarray(resolve_rft3d_coeffs(cfg.coeffs), dtype=np.float32))
+        """The 20 x 3 coefficients as a by-value kernel parameter (constant-bank operands, no loads)."""
 
 
 class ContactHeuristicRFT(ContactModel):

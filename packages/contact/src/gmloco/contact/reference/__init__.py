@@ -17,6 +17,7 @@ from gmloco.contact.reference.cone import (
 )
 from gmloco.contact.reference.rft2d import heuristic_rft_forces, rft2d_alpha, rft2d_angles
 from gmloco.contact.reference.rft3d import (
+    advance_stick_anchors,
     foot_wrench,
     rft3d_alpha,
     rft3d_forces,
@@ -28,6 +29,7 @@ from gmloco.contact.reference.rft3d import (
 __all__ = [
     "ConeParams",
     "ConeState",
+    "advance_stick_anchors",
     "cone_flat_area",
     "cone_multi_quasi_static_force",
     "cone_quasi_static_force",

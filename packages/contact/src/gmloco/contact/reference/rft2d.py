@@ -7,7 +7,7 @@ import numpy as np
 
 from gmloco.contact.coefficients import RFT2D_COEFFS, RFT2D_DIMENSIONAL
 from gmloco.contact.materials import GRAVITY, xi_n
-from gmloco.contact.reference.rft3d import _local_frame, unit_velocity
+from gmloco.contact.reference.rft3d import _beta_gamma, _local_frame, unit_velocity
 
 __all__ = ["heuristic_rft_forces", "rft2d_alpha", "rft2d_angles"]
 
@@ -34,12 +34,7 @@ def rft2d_angles(normals: np.ndarray, velocities: np.ndarray, v_eps: float = 1e-
     n = np.atleast_2d(np.asarray(normals, dtype=np.float64))
     v_hat = np.atleast_2d(unit_velocity(velocities, v_eps))
     e_r, _ = _local_frame(n, v_hat)
-    gamma = np.arccos(np.clip(np.sum(v_hat * e_r, -1), -1.0, 1.0))
-    gamma = np.where(v_hat[:, 2] > 0.0, -gamma, gamma)
-    a = np.arccos(np.clip(n[:, 2], -1.0, 1.0))
-    n_r, n_z = np.sum(n * e_r, -1), n[:, 2]
-    beta = np.where(n_r >= 0, np.where(n_z >= 0, -a, np.pi - a), np.where(n_z >= 0, a, -np.pi + a))
-    return beta, gamma
+    return _beta_gamma(n, v_hat, e_r)
 
 
 def heuristic_rft_forces(

@@ -13,6 +13,7 @@ from gmloco.contact.materials import GRAVITY, xi_n
 
 __all__ = [
     "G_HAT",
+    "advance_stick_anchors",
     "foot_wrench",
     "rft3d_alpha",
     "rft3d_forces",
@@ -75,6 +76,16 @@ def _local_frame(n: np.ndarray, v_hat: np.ndarray) -> tuple[np.ndarray, np.ndarr
     return e_r, np.cross(e_z, e_r)
 
 
+def _beta_gamma(n: np.ndarray, v_hat: np.ndarray, e_r: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Return (beta, gamma) [rad] of spec 1.2: gamma from v_hat.e_r (negative moving up), four-case beta."""
+    gamma = np.arccos(np.clip(np.sum(v_hat * e_r, -1), -1.0, 1.0))
+    gamma = np.where(v_hat[:, 2] > 0.0, -gamma, gamma)
+    a = np.arccos(np.clip(n[:, 2], -1.0, 1.0))
+    n_r, n_z = np.sum(n * e_r, -1), n[:, 2]
+    beta = np.where(n_r >= 0, np.where(n_z >= 0, -a, np.pi - a), np.where(n_z >= 0, a, -np.pi + a))
+    return beta, gamma
+
+
 def rft3d_generic_angles(
     normals: np.ndarray,
     velocities: np.ndarray,
@@ -92,12 +103,8 @@ def rft3d_generic_angles(
     v_hat = np.atleast_2d(unit_velocity(velocities, v_eps))
     e_r, e_t = _local_frame(n, v_hat)
     e_z = np.array([0.0, 0.0, 1.0])
-    gamma = np.arccos(np.clip(np.sum(v_hat * e_r, -1), -1.0, 1.0))
-    gamma = np.where(v_hat @ e_z > 0.0, -gamma, gamma)
-    a = np.arccos(np.clip(n @ e_z, -1.0, 1.0))
-    n_r, n_z = np.sum(n * e_r, -1), n @ e_z
-    beta = np.where(n_r >= 0, np.where(n_z >= 0, -a, np.pi - a), np.where(n_z >= 0, a, -np.pi + a))
-    h = n - np.outer(n_z, e_z)
+    beta, gamma = _beta_gamma(n, v_hat, e_r)
+    h = n - np.outer(n[:, 2], e_z)
     h_r, h_t = np.sum(h * e_r, -1), np.sum(h * e_t, -1)
     if compat == "gmloco":
         psi = np.arctan2(h_t, h_r)
@@ -208,13 +215,18 @@ def rft3d_unloading_forces(
     v_eps: float = 1e-4,
     unloading_speed: float = 0.0,
     impact_damped: bool | np.ndarray = True,
+    anchors: np.ndarray | None = None,
+    stick_distance: float = 0.0,
 ) -> np.ndarray:
     """Return 3D-RFT forces with the project's elastic unloading branch [N], shape [N, 3].
 
     Elements deeper than their remembered maximum depth z_max (virgin loading) get plain RFT. Inside
     the crater (0 < depth < z_max) the element is on an elastic branch: the static resistance
     alpha_s = alpha(n, v_hat = g_hat) acts on an effective depth d_eff = max(0, z_max - r (z_max - d) + damping r
-    d_dot) with d_dot = -v_z, plus a capped viscous friction -min(mu |F.n|, c_t dS |v_t|) v_t / |v_t|.
+    d_dot) with d_dot = -v_z (times 1 - v_z / u0 where impact-damped, clamped to [0, z_max]), plus the crater
+    friction F_t = T min(1, mu |F.n| / |T|), T = -(mu |F.n| / s0) s_t - c_t dS v_t, where s_t is the offset of
+    the element from its stick anchor and v_t its velocity, both in the element plane (s0 = ``stick_distance``;
+    without anchors or with s0 <= 0: T = -c_t dS v_t, the viscous-capped Coulomb law).
     """
     n = np.asarray(normals, dtype=np.float64)
     v = np.asarray(velocities, dtype=np.float64)
@@ -238,14 +250,43 @@ def rft3d_unloading_forces(
         d_eff = np.where(impact_damped, d_eff * (1.0 - v[:, 2] / unloading_speed), d_eff)
     d_eff = np.clip(d_eff, 0.0, depth_max)
     f_el = alpha_s * (d_eff * areas)[:, None]
-    v_t = v - np.sum(v * n, -1, keepdims=True) * n
-    speed_t = np.linalg.norm(v_t, axis=-1, keepdims=True)
-    cap = np.minimum(
-        mu_surf * np.abs(np.sum(f_el * n, -1, keepdims=True)), tangential_damping * areas[:, None] * speed_t
-    )
-    f_el = f_el - cap * v_t / np.maximum(speed_t, 1e-300)
+    limit = mu_surf * np.abs(np.sum(f_el * n, -1, keepdims=True))
+    trial = -tangential_damping * areas[:, None] * _tangential(v, n)
+    if anchors is not None and stick_distance > 0.0:
+        trial -= limit / stick_distance * _tangential(np.asarray(points, dtype=np.float64) - anchors, n)
+    mag = np.linalg.norm(trial, axis=-1, keepdims=True)
+    f_el = f_el + trial * np.minimum(1.0, limit / np.maximum(mag, 1e-300))
     elastic = (depth > 0.0) & (depth < depth_max)
     return np.where(elastic[:, None], f_el, plastic)
+
+
+def _tangential(vec: np.ndarray, n: np.ndarray) -> np.ndarray:
+    """Return the components of ``vec`` in the planes normal to the unit vectors ``n``, [N, 3]."""
+    return vec - np.sum(vec * n, -1, keepdims=True) * n
+
+
+def advance_stick_anchors(
+    points: np.ndarray,
+    normals: np.ndarray,
+    anchors: np.ndarray,
+    depth_max: np.ndarray,
+    stick_distance: float,
+    surface_z: float | np.ndarray = 0.0,
+) -> np.ndarray:
+    """Return the stick anchors after one substep [m], [N, 3] (Cundall-Strack spring with a Coulomb slider).
+
+    ``depth_max`` is z_max before this substep's update. Emerged elements keep their anchor (never read); at
+    touch-down (z_max = 0) the anchor is the element's position; otherwise it slides after the element just
+    enough that the tangential offset |s_t| <= ``stick_distance``.
+    """
+    x = np.asarray(points, dtype=np.float64)
+    a = np.asarray(anchors, dtype=np.float64)
+    depth = np.asarray(surface_z, dtype=np.float64) - x[:, 2]
+    s_t = _tangential(x - a, np.asarray(normals, dtype=np.float64))
+    length = np.linalg.norm(s_t, axis=-1, keepdims=True)
+    slid = np.where(length > stick_distance, x - s_t * stick_distance / np.maximum(length, 1e-300), a)
+    new = np.where((np.asarray(depth_max) <= 0.0)[:, None], x, slid)
+    return np.where((depth > 0.0)[:, None], new, a)
 
 
 def foot_wrench(points: np.ndarray, forces: np.ndarray, ref_point: np.ndarray) -> tuple[np.ndarray, np.ndarray]:

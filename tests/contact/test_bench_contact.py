@@ -1,0 +1,59 @@
+# SPDX-License-Identifier: Apache-2.0
+"""scripts/gpu/bench_contact.py on the CPU with tiny worlds: every record, one JSON, time box and resume."""
+
+from __future__ import annotations
+
+import importlib.util
+import json
+import sys
+from pathlib import Path
+from types import ModuleType
+
+ROOT = Path(__file__).resolve().parents[2]
+
+
+def bench_module() -> ModuleType:
+    """Import scripts/gpu/bench_contact.py by path."""
+    name = "bench_contact_script"
+    if name not in sys.modules:
+        spec = importlib.util.spec_from_file_location(name, ROOT / "scripts/gpu/bench_contact.py")
+        assert spec is not None and spec.loader is not None
+        module = importlib.util.module_from_spec(spec)
+        sys.modules[name] = module
+        spec.loader.exec_module(module)
+    return sys.modules[name]
+
+
+def test_bench_writes_every_record_and_resumes(tmp_path: Path) -> None:
+    """Time box 0 -> exit 3 and no record; rerun -> all 3D-RFT / baseline records on both paths, exit 0."""
+    bench = bench_module()
+    argv = ["--num-worlds", "3", "--reps", "2", "--device", "cpu", "--skip-sim", "--out", str(tmp_path)]
+    assert bench.main([*argv, "--max-minutes", "0"]) == 3
+    first = json.loads((tmp_path / "bench_contact.json").read_text())
+    assert first["complete"] is False and first["models"] == {}
+    assert bench.main(argv) == 0
+    res = json.loads((tmp_path / "bench_contact.json").read_text())
+    assert res["complete"] is True and res["num_worlds"] == 3 and res["device"] == "cpu"
+    expected = {
+        f"{m}/{n}pt{suffix}"
+        for m in ("rft3d", "rft3d_viscous", "heuristic_rft", "cone_multi")
+        for n in (25, 150)
+        for suffix in ("", "/unfused")
+    } | {"cone_single/1pt", "cone_single/1pt/unfused"}
+    assert set(res["models"]) == expected
+    for key, rec in res["models"].items():
+        assert rec["compute_s"] > 0.0 and rec["update_state_s"] > 0.0, key
+        if not key.endswith("/unfused"):  # fused vs unfused wrench: float32 round-off of the sum order
+            assert rec["wrench_max_rel_diff_vs_unfused"] < 1e-5, key
+    assert bench.main(argv) == 0  # resume: nothing left to time, records kept as they were
+    again = json.loads((tmp_path / "bench_contact.json").read_text())
+    assert again["models"] == res["models"]
+
+
+def test_bench_refuses_a_foreign_setup(tmp_path: Path) -> None:
+    """A rerun with another world count into the same folder is refused (exit 2) instead of mixing results."""
+    bench = bench_module()
+    argv = ["--reps", "1", "--device", "cpu", "--skip-sim", "--out", str(tmp_path), "--models", "cone_single"]
+    assert bench.main(["--num-worlds", "2", *argv]) == 0
+    assert bench.main(["--num-worlds", "5", *argv]) == 2
+    assert bench.main(["--num-worlds", "2", *argv, "--paths", "fast"]) == 2
