@@ -35,6 +35,7 @@ def main() -> None:
     p.add_argument("--max-iterations", type=int, default=50, help="MPM rheology iterations (>= 25)")
     p.add_argument("--max-active-cells", type=int, default=-1, help="MPM active-cell capacity (fixed grid)")
     p.add_argument("--grid-type", default="sparse", choices=["sparse", "fixed", "dense"])
+    p.add_argument("--mpm-batch", type=int, default=1, help="MPM trials per solve (GPU: ~10)")
     p.add_argument("--rigid-solver", default="semi_implicit", choices=["semi_implicit", "mujoco"])
     p.add_argument("--bed", type=float, nargs=3, default=[1.2, 0.8, 0.3], help="bed x, y, depth [m]")
     p.add_argument("--duration", type=float, default=1.0, help="simulated time per trial [s]")
@@ -64,7 +65,7 @@ def main() -> None:
             base, out_dir=a.out_dir, num_trials=a.num_trials, seed=a.seed, variants=tuple(a.variants), box=box,
             rom=replace(base.rom, box=box), bed=SandBedCfg(size_x=a.bed[0], size_y=a.bed[1], depth=a.bed[2]),
             mpm=mpm, rft3d_fitted_coeffs=a.fitted_coeffs, max_minutes=a.max_minutes, device=a.device,
-            rigid_solver=a.rigid_solver, make_figure=not a.no_figure,
+            rigid_solver=a.rigid_solver, make_figure=not a.no_figure, mpm_batch=a.mpm_batch,
         )  # fmt: skip
     if a.models:
         cfg = replace(cfg, models=tuple(a.models))

@@ -34,10 +34,13 @@ def main() -> None:
     p.add_argument("--plate-size", type=float, default=0.1)
     p.add_argument("--speed", type=float, default=0.5, help="plate speed [m/s]")
     p.add_argument("--bed", type=float, nargs=3, default=[0.7, 0.7, 0.35], help="bed x, y, depth [m]")
+    p.add_argument("--depth-range", type=float, nargs=2, default=[0.08, 0.2], help="sampled centroid depths [m]")
+    p.add_argument("--lead-in", type=float, default=0.1, help="travel before sampling [m]")
     p.add_argument("--gammas", type=float, nargs="+", default=None, help="intrusion angles [deg]")
     p.add_argument("--betas", type=float, nargs="+", default=None, help="plate tilts [deg]")
     p.add_argument("--psis", type=float, nargs="+", default=None, help="tilt headings [deg]")
     p.add_argument("--ridge", type=float, default=1e-3)
+    p.add_argument("--batch", type=int, default=1, help="plate runs per MPM solve (GPU: ~9)")
     p.add_argument("--max-minutes", type=float, default=60.0)
     p.add_argument("--device", default=None)
     p.add_argument("--smoke", action="store_true", help="CPU smoke: 2 plate runs, tiny bed")
@@ -48,9 +51,10 @@ def main() -> None:
         base = RftFitCfg()
         bed = SandBedCfg(size_x=a.bed[0], size_y=a.bed[1], depth=a.bed[2], center_x=0.0)
         solver = MpmSolverCfg(voxel_size=a.voxel_size, max_iterations=a.max_iterations)
-        plate = replace(base.plate, plate_size=a.plate_size, speed=a.speed, bed=bed, solver=solver, device=a.device)
+        plate = replace(base.plate, plate_size=a.plate_size, speed=a.speed, bed=bed, solver=solver, device=a.device,
+                        depth_range=tuple(a.depth_range), travel_before_sampling=a.lead_in)  # fmt: skip
         cfg = replace(base, out_dir=a.out_dir, material=a.material, plate=plate, ridge=a.ridge,
-                      max_minutes=a.max_minutes)  # fmt: skip
+                      max_minutes=a.max_minutes, batch=a.batch)  # fmt: skip
         for name, value in (("gamma_deg", a.gammas), ("beta_deg", a.betas), ("psi_deg", a.psis)):
             if value:
                 cfg = replace(cfg, **{name: tuple(value)})

@@ -41,17 +41,23 @@ def test_rom_study_records_and_resume(tmp_path: Path) -> None:
     assert all(r["sinkage"] < 0.01 for r in rows if r["model"] == "rigid")
 
 
-def test_mpm_smoke_trial_scored(tmp_path: Path) -> None:
-    """One MPM trial (tiny bed, 0.2 s) plus Rigid and 3D-RFT: matched and scored, timings recorded."""
-    cfg = replace(box_study_smoke_cfg(str(tmp_path)), models=("mpm", "rigid", "rft3d"))
+def test_mpm_smoke_trials_batched_and_scored(tmp_path: Path) -> None:
+    """Run two MPM trials in one solve (tiny beds, 0.2 s) plus Rigid and 3D-RFT: matched, scored and timed.
+
+    Each trial's trajectory is expressed in its own region's frame (it starts at the box's initial position).
+    """
+    cfg = replace(box_study_smoke_cfg(str(tmp_path)), num_trials=2, mpm_batch=2, models=("mpm", "rigid", "rft3d"))
     summary = run(cfg)
     fwd = summary["variants"]["forward"]
-    assert fwd["mpm_trials_done"] == 1
-    assert fwd["scores"]["rft3d"]["matched_trials"] == 1
+    assert fwd["mpm_trials_done"] == 2
+    assert fwd["scores"]["rft3d"]["matched_trials"] == 2
     assert fwd["timing"]["mpm"]["particle_count"] > 0 and fwd["timing"]["mpm"]["frames_per_s_median"] > 0
-    series = StudyRecords(tmp_path).series()
-    mpm = next(s for s in series if s["model"] == "mpm")
-    assert len(mpm["grf"]) == round(cfg.box.duration / cfg.mpm.frame_dt)
+    series = [s for s in StudyRecords(tmp_path).series() if s["model"] == "mpm"]
+    assert len(series) == 2 and all(len(s["grf"]) == round(cfg.box.duration / cfg.mpm.frame_dt) for s in series)
+    for s in series:  # first frame: 1 cm along +x from the launch point, still in the air
+        np.testing.assert_allclose(s["pos"][0][:2], [0.01, 0.0], atol=2e-3)
+    rows = [r for r in StudyRecords(tmp_path).rows() if r["model"] == "mpm"]
+    assert all(0.05 < r["travel"] < 0.3 for r in rows)  # 0.2 s launched at 1 m/s, slowed by the sand
 
 
 def test_size_variants_bookkeeping(tmp_path: Path) -> None:

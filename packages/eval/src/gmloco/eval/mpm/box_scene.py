@@ -6,22 +6,28 @@ with the sand wrench of the previous frame; MPM then sees the box with that wren
 and solves the frictional contact implicitly against the box's mass and inertia (the body is a *dynamic*
 collider, ``SolverImplicitMPM.setup_collider(model=..)``); the collider-node impulses of that step divided by
 the frame time are the new sand wrench. Pattern learnt from Newton's ``example_mpm_twoway_coupling``.
+
+Batching: given a list of media, the scene holds one walled bed per medium ("region"), side by side in one MPM
+solve, each with its own box. Regions are separated by their walls and a gap of several voxels, so no grid node
+is shared and each region is the single-medium scene (the floor plane, 0.3 m under the sand, takes the first
+medium's friction). A GPU step is dominated by launch overhead at these sizes, so N regions cost about one.
 """
 
 from __future__ import annotations
 
 import time
-from dataclasses import dataclass, field
+from collections.abc import Sequence
+from dataclasses import dataclass, field, replace
 from typing import Any, Literal
 
 import numpy as np
 
 from gmloco.eval.box import BoxCfg
-from gmloco.eval.mpm.bed import SandBedCfg, add_bed_container
-from gmloco.eval.mpm.coupled_setup import build_sand_model, make_coupled_states, make_mpm_solver
-from gmloco.eval.mpm.materials import GranularMaterial, MpmMaterialCfg, mpm_material
+from gmloco.eval.mpm.bed import SandBedCfg, add_bed_container, emit_sand_bed
+from gmloco.eval.mpm.coupled_setup import make_coupled_states, make_mpm_solver
+from gmloco.eval.mpm.materials import GranularMaterial, MpmMaterialCfg, apply_mpm_material, mpm_material
 
-__all__ = ["MIN_RHEOLOGY_ITERATIONS", "MpmBoxScene", "MpmBoxSceneCfg", "MpmSolverCfg"]
+__all__ = ["MIN_RHEOLOGY_ITERATIONS", "MpmBoxScene", "MpmBoxSceneCfg", "MpmSolverCfg", "region_offsets"]
 
 MIN_RHEOLOGY_ITERATIONS = 25
 """Newton 1.5.2's Gauss-Seidel ``solve_granularity``: the eager solver loop runs ``max_iterations // 25`` batches."""
@@ -43,7 +49,8 @@ class MpmSolverCfg:
     tolerance: float = 1.0e-4
     """Rheology solver tolerance."""
     grid_type: Literal["sparse", "dense", "fixed"] = "sparse"
-    """Grid type; ``"fixed"`` allows CUDA graph capture (set ``max_active_cell_count``)."""
+    """Grid type; ``"fixed"`` allows CUDA graph capture (set ``max_active_cell_count``). Caution: in the box scene
+    on CPU, ``"fixed"`` (padding 0 or 4) missed the box's impact and then launched it upwards; use ``"sparse"``."""
     grid_padding: int = 0
     """Empty cells around the particles (fixed grids only)."""
     max_active_cell_count: int = -1
@@ -75,6 +82,8 @@ class MpmBoxSceneCfg:
     """Warp device; None = Warp's default."""
     use_cuda_graph: bool = True
     """Capture one frame in a CUDA graph when the device is CUDA and the grid is fixed."""
+    region_gap: float = 0.25
+    """Clear distance between neighbouring regions' sand when batching several media [m] (walls inside it)."""
     rigid_solver: Literal["mujoco", "semi_implicit"] = "mujoco"
     """Integrator of the free box: ``"mujoco"`` (SolverMuJoCo: MuJoCo C on CPU, mujoco_warp on CUDA) or
     ``"semi_implicit"`` (Newton's SolverSemiImplicit, no angular damping): the box has no joints or rigid
@@ -85,59 +94,102 @@ class MpmBoxScene:
     """Example-shaped scene (``__init__``, ``capture``, ``step``, ``test_final``) with per-frame logging.
 
     Attributes:
-        body_q: Box pose (p, q_xyzw) after each frame, list of [7].
-        body_qd: Box (linear, angular) velocity after each frame [m/s, rad/s], list of [6].
-        sand_force: Sand force on the box of each frame [N], list of [3].
-        particle_count: Number of MPM particles.
+        body_q_all: Box poses (p, q_xyzw) after each frame, list of [R, 7] (R regions).
+        body_qd_all: Box (linear, angular) velocities after each frame [m/s, rad/s], list of [R, 6].
+        sand_force_all: Sand force on each box of each frame [N], list of [R, 3].
+        offsets: Position of each region relative to the configured bed and box [m], [R, 3].
+        particle_count: Number of MPM particles (all regions).
     """
 
-    def __init__(self, cfg: MpmBoxSceneCfg, material: GranularMaterial | MpmMaterialCfg) -> None:
-        """Build the rigid model, the sand model, both solvers and the coupling buffers."""
+    def __init__(
+        self, cfg: MpmBoxSceneCfg, material: GranularMaterial | MpmMaterialCfg | Sequence[GranularMaterial]
+    ) -> None:
+        """Build the rigid model, the sand model, both solvers and the coupling buffers.
+
+        Args:
+            cfg: Scene configuration (one region's bed and box).
+            material: One medium, or a sequence of media: one region each, batched in one MPM solve.
+        """
         import newton
         import warp as wp
 
         self.cfg = cfg
-        self.mat = material if isinstance(material, MpmMaterialCfg) else mpm_material(material)
+        mats = list(material) if isinstance(material, Sequence) else [material]
+        self.mats = [m if isinstance(m, MpmMaterialCfg) else mpm_material(m) for m in mats]
+        self.mat = self.mats[0]
+        self.offsets = region_offsets(cfg, len(self.mats))
         self.device = wp.get_device(cfg.device)
         s = cfg.solver
         self.frame_dt, self.sim_dt = s.frame_dt, s.frame_dt / s.rigid_substeps
         with wp.ScopedDevice(self.device):
             self.model = self._build_rigid_model(newton, wp)
-            self.sand_model, self.particle_count = build_sand_model(
-                newton, self.cfg.bed, self.cfg.solver.voxel_size, self.mat
-            )
+            self.sand_model, self.particle_count = self._build_sand_model(newton)
             self._build_solvers(newton)
             self._allocate_states(newton, wp)
         self.frame = 0
         self.wall_time = 0.0
-        self.body_q: list[np.ndarray] = []
-        self.body_qd: list[np.ndarray] = []
-        self.sand_force: list[np.ndarray] = []
+        self.body_q_all: list[np.ndarray] = []
+        self.body_qd_all: list[np.ndarray] = []
+        self.sand_force_all: list[np.ndarray] = []
         self.graph = None
         self.capture()
+
+    @property
+    def body_q(self) -> list[np.ndarray]:
+        """Region 0's box pose (p, q_xyzw) after each frame, list of [7]."""
+        return [q[0] for q in self.body_q_all]
+
+    @property
+    def body_qd(self) -> list[np.ndarray]:
+        """Region 0's box velocity after each frame [m/s, rad/s], list of [6]."""
+        return [q[0] for q in self.body_qd_all]
+
+    @property
+    def sand_force(self) -> list[np.ndarray]:
+        """Region 0's sand force of each frame [N], list of [3]."""
+        return [f[0] for f in self.sand_force_all]
 
     # -- construction ---------------------------------------------------------------------------------------
 
     def _build_rigid_model(self, newton: Any, wp: Any) -> Any:
-        """Box body (uniform density, mu = mu_surf) plus the static bed container."""
+        """One box body per region (uniform density, mu = mu_surf) plus each region's static container."""
         box = self.cfg.box
         hx, hy, hz = (float(v) for v in box.half_extents)
         builder = newton.ModelBuilder()
         q = box.initial_quat_wxyz
-        body = builder.add_body(
-            xform=wp.transform(wp.vec3(*box.initial_pos), wp.quat(q[1], q[2], q[3], q[0])), label="box"
-        )
         density = float(box.mass / (8.0 * hx * hy * hz))
-        shape_cfg = newton.ModelBuilder.ShapeConfig(density=density, mu=float(self.mat.collider_friction))
-        builder.add_shape_box(body, hx=float(hx), hy=float(hy), hz=float(hz), cfg=shape_cfg)
-        add_bed_container(builder, self.cfg.bed, friction=self.mat.friction)
+        self.box_bodies = []
+        for off, mat in zip(self.offsets, self.mats, strict=True):
+            pos = wp.vec3(*(box.initial_pos + off))
+            body = builder.add_body(xform=wp.transform(pos, wp.quat(q[1], q[2], q[3], q[0])), label="box")
+            shape_cfg = newton.ModelBuilder.ShapeConfig(density=density, mu=float(mat.collider_friction))
+            builder.add_shape_box(body, hx=hx, hy=hy, hz=hz, cfg=shape_cfg)
+            self.box_bodies.append(body)
+        add_bed_container(builder, self.cfg.bed, friction=self.mats[0].friction)  # region 0 + the floor plane
+        for off, mat in zip(self.offsets[1:], self.mats[1:], strict=True):
+            _add_region_walls(newton, wp, builder, _shifted_bed(self.cfg.bed, off), mat.friction)
         model = builder.finalize()
-        # initial velocity through the free joint (linear part first), then forward kinematics
-        qd = model.joint_qd.numpy()
-        qd[0:3] = box.initial_velocity
-        model.joint_qd.assign(qd)
-        self.box_body = body
+        # initial velocity through each free joint (linear part first), then forward kinematics
+        qd = model.joint_qd.numpy().reshape(len(self.mats), 6)
+        qd[:, 0:3] = box.initial_velocity
+        model.joint_qd.assign(qd.ravel())
+        self.box_body = self.box_bodies[0]
         return model
+
+    def _build_sand_model(self, newton: Any) -> tuple[Any, int]:
+        """Particles of every region at its medium's density, then each region's rheology."""
+        builder = newton.ModelBuilder()
+        newton.solvers.SolverImplicitMPM.register_custom_attributes(builder)
+        ranges, start = [], 0
+        for i, (off, mat) in enumerate(zip(self.offsets, self.mats, strict=True)):
+            bed = replace(_shifted_bed(self.cfg.bed, off), seed=self.cfg.bed.seed + i)
+            n = emit_sand_bed(builder, bed, self.cfg.solver.voxel_size, mat.density)
+            ranges.append(np.arange(start, start + n))
+            start += n
+        model = builder.finalize()
+        for ids, mat in zip(ranges, self.mats, strict=True):
+            apply_mpm_material(model, mat, None if len(self.mats) == 1 else ids)
+        return model, start
 
     def _build_solvers(self, newton: Any) -> None:
         """Implicit MPM reading its colliders (box + container) from the rigid model; MuJoCo for the box."""
@@ -148,8 +200,9 @@ class MpmBoxScene:
             self.rigid = newton.solvers.SolverSemiImplicit(self.model, angular_damping=0.0)
             return
         # no rigid contacts: the box touches only sand (MuJoCo C on CPU, mujoco_warp on CUDA)
+        n = 16 * len(self.mats)
         self.rigid = newton.solvers.SolverMuJoCo(
-            self.model, use_mujoco_cpu=not self.device.is_cuda, use_mujoco_contacts=False, njmax=16, nconmax=16
+            self.model, use_mujoco_cpu=not self.device.is_cuda, use_mujoco_contacts=False, njmax=n, nconmax=n
         )
 
     def _allocate_states(self, newton: Any, wp: Any) -> None:
@@ -195,7 +248,7 @@ class MpmBoxScene:
         )  # fmt: skip
 
     def step(self) -> None:
-        """Advance one frame (graph replay when captured) and log the box state and sand force."""
+        """Advance one frame (graph replay when captured) and log the boxes' states and sand forces."""
         import warp as wp
 
         t0 = time.perf_counter()
@@ -203,12 +256,12 @@ class MpmBoxScene:
             wp.capture_launch(self.graph)
         else:
             self.simulate()
-        wrench = self.sand_wrench.numpy()[self.box_body]
+        wrench = self.sand_wrench.numpy()[self.box_bodies]
         self.wall_time += time.perf_counter() - t0
         self.frame += 1
-        self.body_q.append(self.state_0.body_q.numpy()[self.box_body].copy())
-        self.body_qd.append(self.state_0.body_qd.numpy()[self.box_body].copy())
-        self.sand_force.append(np.asarray(wrench[:3], dtype=np.float64))
+        self.body_q_all.append(self.state_0.body_q.numpy()[self.box_bodies].copy())
+        self.body_qd_all.append(self.state_0.body_qd.numpy()[self.box_bodies].copy())
+        self.sand_force_all.append(np.asarray(wrench[:, :3], dtype=np.float64))
 
     def run(self, num_frames: int | None = None) -> None:
         """Step ``num_frames`` frames (default: the box's ``duration``)."""
@@ -222,9 +275,37 @@ class MpmBoxScene:
         return self.frame / max(self.wall_time, 1e-9)
 
     def test_final(self) -> None:
-        """Assert physical sanity: finite state, box above the floor, sand inside the container."""
-        q = np.asarray(self.body_q[-1])
+        """Assert physical sanity: finite state, boxes above the floor, sand inside the containers."""
+        q = np.asarray(self.body_q_all[-1])
         assert np.all(np.isfinite(q)), "box state is not finite"
-        assert q[2] > -self.cfg.bed.depth, f"box fell through the bed (z = {q[2]:.3f} m)"
+        assert np.all(q[:, 2] > -self.cfg.bed.depth), f"a box fell through the bed (z = {q[:, 2].min():.3f} m)"
         z = self.sand_state.particle_q.numpy()[:, 2]
         assert np.all(z > -self.cfg.bed.depth - 2 * self.cfg.solver.voxel_size), "sand leaked through the floor"
+
+
+def region_offsets(cfg: MpmBoxSceneCfg, count: int) -> np.ndarray:
+    """Return the offsets [m] [count, 3] of ``count`` regions on a near-square grid (region 0 at the origin)."""
+    cols = int(np.ceil(np.sqrt(count)))
+    pitch = np.array([cfg.bed.size_x + cfg.region_gap, cfg.bed.size_y + cfg.region_gap])
+    idx = np.arange(count)
+    return np.stack([(idx // cols) * pitch[0], (idx % cols) * pitch[1], np.zeros(count)], axis=-1)
+
+
+def _shifted_bed(bed: SandBedCfg, offset: np.ndarray) -> SandBedCfg:
+    """Return the bed moved horizontally by ``offset`` [m]."""
+    return replace(bed, center_x=bed.center_x + float(offset[0]), center_y=bed.center_y + float(offset[1]))
+
+
+def _add_region_walls(newton: Any, wp: Any, builder: Any, bed: SandBedCfg, friction: float) -> None:
+    """Add the four static walls of one extra region (``add_bed_container`` without another floor plane)."""
+    cfg = newton.ModelBuilder.ShapeConfig(mu=friction, density=0.0)
+    lo, hi, t = bed.lower, bed.upper, 0.05
+    c = 0.5 * (lo + hi)
+    half = 0.5 * (hi - lo)
+    wall_hz = 0.5 * bed.depth + 0.3
+    cz = -bed.depth + wall_hz
+    walls = [((lo[0] - t, c[1]), (t, half[1] + 2 * t)), ((hi[0] + t, c[1]), (t, half[1] + 2 * t)),
+             ((c[0], lo[1] - t), (half[0], t)), ((c[0], hi[1] + t), (half[0], t))]  # fmt: skip
+    for (x, y), (hx, hy) in walls:
+        xform = wp.transform(wp.vec3(float(x), float(y), float(cz)), wp.quat_identity())
+        builder.add_shape_box(body=-1, xform=xform, hx=float(hx), hy=float(hy), hz=float(wall_hz), cfg=cfg)

@@ -8,7 +8,7 @@ from gmloco.eval.rft_fit.fit import (
     rft3d_design_matrix,
     save_rft3d_coeffs,
 )
-from gmloco.eval.rft_fit.plate import PlateIntrusionCfg, PlateRun, plate_path, run_plate_intrusion
+from gmloco.eval.rft_fit.plate import PlateIntrusionCfg, PlateRun, plate_path, run_plate_intrusion, run_plate_intrusions
 from gmloco.eval.rft_fit.run import SPEC_CASES, RftFitCfg, plate_directions, rft_fit_smoke_cfg, run
 from gmloco.eval.rft_fit.steady import plate_direction, plate_record, steady_alpha
 
@@ -28,6 +28,7 @@ __all__ = [
     "rft_fit_smoke_cfg",
     "run",
     "run_plate_intrusion",
+    "run_plate_intrusions",
     "save_rft3d_coeffs",
     "steady_alpha",
 ]

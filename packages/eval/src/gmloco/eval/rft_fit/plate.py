@@ -15,7 +15,7 @@ from __future__ import annotations
 
 import math
 import time
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from typing import Any
 
 import numpy as np
@@ -25,7 +25,14 @@ from gmloco.eval.mpm.box_scene import MpmSolverCfg
 from gmloco.eval.mpm.coupled_setup import make_mpm_solver
 from gmloco.eval.mpm.materials import GranularMaterial, MpmMaterialCfg, apply_mpm_material, mpm_material
 
-__all__ = ["PlateIntrusionCfg", "PlateRun", "plate_path", "plate_rotation", "run_plate_intrusion"]
+__all__ = [
+    "PlateIntrusionCfg",
+    "PlateRun",
+    "plate_path",
+    "plate_rotation",
+    "run_plate_intrusion",
+    "run_plate_intrusions",
+]
 
 
 @dataclass(frozen=True)
@@ -71,7 +78,7 @@ class PlateRun:
     particle_count: int
     """MPM particles."""
     wall_time: float
-    """Wall-clock time of the run, construction included [s]."""
+    """Wall-clock time of the run, construction included [s] (batched runs: the batch's / its size)."""
     frames_per_s: float
     """Simulated frames per wall-clock second of the stepping loop [1/s]."""
 
@@ -103,18 +110,31 @@ def plate_path(cfg: PlateIntrusionCfg, velocity: np.ndarray) -> tuple[np.ndarray
     return start, length / cfg.speed
 
 
-def _build_colliders(newton: Any, wp: Any, cfg: PlateIntrusionCfg, start: np.ndarray, rot: np.ndarray,
-                     friction: float, mat: MpmMaterialCfg) -> tuple[Any, int]:  # fmt: skip
-    """Collider model: the kinematic plate body plus the static bed container; return (model, plate body)."""
+def _build_colliders(newton: Any, wp: Any, cfg: PlateIntrusionCfg, poses: list[tuple[np.ndarray, np.ndarray]],
+                     offsets: np.ndarray, friction: float, mat: MpmMaterialCfg) -> tuple[Any, list[int]]:  # fmt: skip
+    """Collider model: one kinematic plate per region plus each region's static walls (one floor plane)."""
+    from gmloco.eval.mpm.box_scene import _add_region_walls, _shifted_bed
+
     builder = newton.ModelBuilder()
-    q = _quat_xyzw(rot)
-    xform = wp.transform(wp.vec3(*start.tolist()), wp.quat(*q))
-    body = builder.add_body(xform=xform, is_kinematic=True, label="plate")
     half = 0.5 * np.array([cfg.plate_size, cfg.plate_size, cfg.plate_thickness])
     shape = newton.ModelBuilder.ShapeConfig(density=0.0, mu=float(friction))
-    builder.add_shape_box(body, hx=float(half[0]), hy=float(half[1]), hz=float(half[2]), cfg=shape)
+    bodies = []
+    for start, rot in poses:
+        xform = wp.transform(wp.vec3(*start.tolist()), wp.quat(*_quat_xyzw(rot)))
+        body = builder.add_body(xform=xform, is_kinematic=True, label="plate")
+        builder.add_shape_box(body, hx=float(half[0]), hy=float(half[1]), hz=float(half[2]), cfg=shape)
+        bodies.append(body)
     add_bed_container(builder, cfg.bed, friction=mat.friction)
-    return builder.finalize(), body
+    for off in offsets[1:]:
+        _add_region_walls(newton, wp, builder, _shifted_bed(cfg.bed, off), mat.friction)
+    return builder.finalize(), bodies
+
+
+def _plate_offsets(cfg: PlateIntrusionCfg, count: int) -> np.ndarray:
+    """Region offsets [m] [count, 3] of a batch (the box scene's grid layout, 0.25 m between beds)."""
+    from gmloco.eval.mpm.box_scene import MpmBoxSceneCfg, region_offsets
+
+    return region_offsets(MpmBoxSceneCfg(bed=cfg.bed), count)
 
 
 def run_plate_intrusion(
@@ -128,6 +148,22 @@ def run_plate_intrusion(
         normal: Plate normal [-], [3].
         velocity: Plate velocity [m/s], [3] (its magnitude is replaced by ``cfg.speed``).
     """
+    return run_plate_intrusions(cfg, material, [(normal, velocity)])[0]
+
+
+def run_plate_intrusions(
+    cfg: PlateIntrusionCfg, material: GranularMaterial | MpmMaterialCfg, directions: list[tuple[np.ndarray, np.ndarray]]
+) -> list[PlateRun]:
+    """Push several plates, each through its own walled bed, in one MPM solve; log each plate's force per frame.
+
+    Every plate moves at constant velocity for its own path duration and then holds still until the longest path
+    ends (frames after its path are not sampled). ``wall_time`` of each run is the batch's, divided by its size.
+
+    Args:
+        cfg: Plate, bed and numerics (one region's bed).
+        material: The medium (mapped through :func:`mpm_material`).
+        directions: (plate normal [3], velocity [3]) per run (velocity magnitudes are replaced by ``cfg.speed``).
+    """
     import newton
     import warp as wp
 
@@ -136,50 +172,82 @@ def run_plate_intrusion(
     t0 = time.perf_counter()
     mat = material if isinstance(material, MpmMaterialCfg) else mpm_material(material)
     friction = mat.collider_friction if cfg.plate_friction is None else cfg.plate_friction
-    v = cfg.speed * np.asarray(velocity, dtype=np.float64) / np.linalg.norm(velocity)
-    start, duration = plate_path(cfg, v)
-    rot = plate_rotation(normal)
-    q = _quat_xyzw(rot)
+    offsets = _plate_offsets(cfg, len(directions))
+    vels = [cfg.speed * np.asarray(v, dtype=np.float64) / np.linalg.norm(v) for _, v in directions]
+    paths = [plate_path(cfg, v) for v in vels]
+    starts = [start + off for (start, _), off in zip(paths, offsets, strict=True)]
+    rots = [plate_rotation(n) for n, _ in directions]
+    quats = [_quat_xyzw(r) for r in rots]
     half = 0.5 * np.array([cfg.plate_size, cfg.plate_size, cfg.plate_thickness])
     s = cfg.solver
+    num_frames = max(math.ceil(duration / s.frame_dt) for _, duration in paths)
     with wp.ScopedDevice(wp.get_device(cfg.device)):
-        colliders, body = _build_colliders(newton, wp, cfg, start, rot, friction, mat)
+        colliders, bodies = _build_colliders(newton, wp, cfg, list(zip(starts, rots, strict=True)), offsets,
+                                             friction, mat)  # fmt: skip
 
-        def outside_plate(p: np.ndarray) -> np.ndarray:
-            """Carve the plate's start volume (plus half a voxel) out of the bed."""
-            return np.any(np.abs((p - start) @ rot) > half + 0.5 * s.voxel_size, axis=1)
+        def outside_plates(p: np.ndarray) -> np.ndarray:
+            """Carve each plate's start volume (plus half a voxel) out of the bed."""
+            keep = np.ones(len(p), dtype=bool)
+            for start, rot in zip(starts, rots, strict=True):
+                keep &= np.any(np.abs((p - start) @ rot) > half + 0.5 * s.voxel_size, axis=1)
+            return keep
 
         sand = newton.ModelBuilder()
         newton.solvers.SolverImplicitMPM.register_custom_attributes(sand)
-        count = emit_sand_bed(sand, cfg.bed, s.voxel_size, mat.density, keep=outside_plate)
+        count = 0
+        for i, off in enumerate(offsets):
+            bed = replace(cfg.bed, center_x=cfg.bed.center_x + off[0], center_y=cfg.bed.center_y + off[1],
+                          seed=cfg.bed.seed + i)  # fmt: skip
+            count += emit_sand_bed(sand, bed, s.voxel_size, mat.density, keep=outside_plates)
         model = sand.finalize()
         apply_mpm_material(model, mat)
         mpm = make_mpm_solver(newton, model, s, mat)
-        mpm.setup_collider(model=colliders)  # kinematic body -> zero effective mass: prescribed motion
+        mpm.setup_collider(model=colliders)  # kinematic bodies -> zero effective mass: prescribed motion
         state = model.state()
-        qd = np.zeros((colliders.body_count, 6), dtype=np.float32)
-        qd[body, :3] = v
         state.body_q = body_q = wp.clone(colliders.body_q)
-        state.body_qd = wp.array(qd, dtype=wp.spatial_vectorf)
+        state.body_qd = body_qd = wp.zeros(colliders.body_count, dtype=wp.spatial_vectorf)
         wrench = wp.zeros(colliders.body_count, dtype=wp.spatial_vectorf)
-        num_frames = math.ceil(duration / s.frame_dt)
-        depth, force = np.zeros(num_frames), np.zeros((num_frames, 3))
+        depth, force = np.zeros((len(bodies), num_frames)), np.zeros((len(bodies), num_frames, 3))
         t_loop = time.perf_counter()
         for k in range(num_frames):
-            p = start + v * k * s.frame_dt
-            body_q.assign([wp.transform(wp.vec3(*p.tolist()), wp.quat(*q))])
+            q_np, qd_np = _plate_poses(colliders.body_count, bodies, starts, quats, vels, paths, k, s.frame_dt)
+            body_q.assign(q_np)
+            body_qd.assign(qd_np)
             # Newton annotates control/contacts as required, but SolverImplicitMPM.step documents both as unused
             mpm.step(state, state, None, None, s.frame_dt)  # pyright: ignore[reportArgumentType]
             eval_body_sand_wrench(mpm.collider_body_index, colliders.body_com, s.frame_dt,
                                   mpm.collect_collider_impulses(state), body_q, wrench)  # fmt: skip
-            force[k] = wrench.numpy()[body][:3]
-            depth[k] = -(p + 0.5 * v * s.frame_dt)[2]  # centroid depth at mid-step
+            force[:, k] = wrench.numpy()[bodies][:, :3]
+            depth[:, k] = -(q_np[bodies, 2] + 0.5 * qd_np[bodies, 2] * s.frame_dt)  # centroid depth at mid-step
         loop_s = time.perf_counter() - t_loop
-    travelled = cfg.speed * s.frame_dt * np.arange(1, num_frames + 1)
-    d_lo, d_hi = cfg.depth_range
-    sampled = (travelled >= cfg.travel_before_sampling) & (depth >= d_lo - 1e-9) & (depth <= d_hi + 1e-9)
-    return PlateRun(np.asarray(normal, dtype=np.float64), v, depth, force, sampled, count,
-                    time.perf_counter() - t0, num_frames / max(loop_s, 1e-9))  # fmt: skip
+    wall = (time.perf_counter() - t0) / len(bodies)
+    runs = []
+    for i, ((n, _), v, (_, duration)) in enumerate(zip(directions, vels, paths, strict=True)):
+        frames = np.arange(1, num_frames + 1)
+        travelled = cfg.speed * s.frame_dt * np.minimum(frames, math.ceil(duration / s.frame_dt))
+        d_lo, d_hi = cfg.depth_range
+        moving = frames * s.frame_dt <= duration + 1e-9
+        sampled = (
+            moving & (travelled >= cfg.travel_before_sampling) & (depth[i] >= d_lo - 1e-9) & (depth[i] <= d_hi + 1e-9)
+        )
+        runs.append(PlateRun(np.asarray(n, dtype=np.float64), v, depth[i], force[i], sampled, count // len(bodies),
+                             wall, num_frames / max(loop_s, 1e-9)))  # fmt: skip
+    return runs
+
+
+def _plate_poses(
+    body_count: int, bodies: list[int], starts: list[np.ndarray], quats: list[tuple[float, ...]],
+    vels: list[np.ndarray], paths: list[tuple[np.ndarray, float]], k: int, dt: float,
+) -> tuple[np.ndarray, np.ndarray]:  # fmt: skip
+    """Body poses [B, 7] (p, q_xyzw) and velocities [B, 6] of frame ``k``: moving along the path, then at rest."""
+    q = np.zeros((body_count, 7), dtype=np.float32)
+    qd = np.zeros((body_count, 6), dtype=np.float32)
+    for b, start, quat, v, (_, duration) in zip(bodies, starts, quats, vels, paths, strict=True):
+        moving = (k + 1) * dt <= duration + 1e-9
+        t = min(k * dt, duration)
+        q[b, :3], q[b, 3:] = start + v * t, quat
+        qd[b, :3] = v if moving else 0.0
+    return q, qd
 
 
 def _quat_xyzw(rot: np.ndarray) -> tuple[float, float, float, float]:

@@ -17,7 +17,7 @@ from typing import Any
 import numpy as np
 
 from gmloco.eval.rft_fit.fit import fit_rft3d_coeffs, generic_from_coeffs, save_rft3d_coeffs
-from gmloco.eval.rft_fit.plate import PlateIntrusionCfg, run_plate_intrusion
+from gmloco.eval.rft_fit.plate import PlateIntrusionCfg, run_plate_intrusions
 from gmloco.eval.rft_fit.steady import plate_direction, plate_record
 
 __all__ = ["SPEC_CASES", "RftFitCfg", "plate_directions", "rft_fit_smoke_cfg", "run"]
@@ -59,14 +59,16 @@ class RftFitCfg:
     """Prior / comparison coefficient set of the contact package."""
     friction_tol: float = 0.95
     """A run is friction-limited when |alpha_t| >= friction_tol mu_plate |alpha_n|; only its normal part is fitted."""
+    batch: int = 1
+    """Plate runs per MPM solve (one walled bed each, ``run_plate_intrusions``); ~9 on a GPU, 1-2 on a CPU."""
     max_minutes: float = 60.0
-    """Wall-clock budget [min]; the sweep stops before a run it expects to overrun."""
+    """Wall-clock budget [min]; the sweep stops before a batch it expects to overrun."""
     make_figure: bool = True
     """Write ``fig_rft_fit.png``."""
 
 
 def rft_fit_smoke_cfg(out_dir: str) -> RftFitCfg:
-    """Return a CPU smoke configuration: 2 runs (down, horizontal), 0.3 x 0.3 x 0.2 m bed at 4 cm voxels."""
+    """Return a CPU smoke configuration: 2 runs (down, horizontal) in one solve, 0.3 x 0.3 x 0.2 m beds, 4 cm voxels."""
     from gmloco.eval.mpm.bed import SandBedCfg
     from gmloco.eval.mpm.box_scene import MpmSolverCfg
 
@@ -76,7 +78,7 @@ def rft_fit_smoke_cfg(out_dir: str) -> RftFitCfg:
         solver=MpmSolverCfg(voxel_size=0.04, max_iterations=25), device="cpu",
     )  # fmt: skip
     return RftFitCfg(out_dir=out_dir, plate=plate, gamma_deg=(90.0, 0.0), beta_deg=(0.0, 90.0), psi_deg=(0.0,),
-                     make_figure=False)  # fmt: skip
+                     batch=2, make_figure=False)  # fmt: skip
 
 
 def plate_directions(cfg: RftFitCfg) -> list[tuple[tuple[float, float, float], np.ndarray, np.ndarray]]:
@@ -114,20 +116,22 @@ def _done_runs(path: Path) -> list[dict[str, Any]]:
 
 
 def _sweep(cfg: RftFitCfg, material: Any, log: Path, t_start: float) -> bool:
-    """Run the missing plate intrusions; return False if the time budget stopped the sweep."""
+    """Run the missing plate intrusions, ``batch`` per MPM solve; return False if the time budget stopped them."""
     done = {(r["gamma_deg"], r["beta_deg"], r["psi_deg"]) for r in _done_runs(log)}
     mu_plate = material.mu_surf if cfg.plate.plate_friction is None else cfg.plate.plate_friction
+    todo = [d for d in plate_directions(cfg) if d[0] not in done]
     last = 0.0
-    for angles, n, v in plate_directions(cfg):
-        if angles in done:
-            continue
+    for i in range(0, len(todo), cfg.batch):
         if time.perf_counter() - t_start + 1.2 * last > 60.0 * cfg.max_minutes:
             return False
-        res = run_plate_intrusion(cfg.plate, material, n, v)
-        last = res.wall_time
-        rec = plate_record(res, cfg.plate, material.xi, angles, mu_plate, cfg.friction_tol)
+        chunk = todo[i : i + cfg.batch]
+        t0 = time.perf_counter()
+        results = run_plate_intrusions(cfg.plate, material, [(n, v) for _, n, v in chunk])
+        last = time.perf_counter() - t0
         with log.open("a") as f:
-            f.write(json.dumps(rec) + "\n")
+            for (angles, _, _), res in zip(chunk, results, strict=True):
+                rec = plate_record(res, cfg.plate, material.xi, angles, mu_plate, cfg.friction_tol)
+                f.write(json.dumps(rec | {"batch": len(chunk)}) + "\n")
     return True
 
 
