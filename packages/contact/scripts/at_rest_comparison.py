@@ -1,7 +1,7 @@
 # SPDX-License-Identifier: Apache-2.0
 """Compare at-rest treatments: standing G1 and box rebound (dev script; needs mujoco, mjlab's G1 and gmloco-eval).
 
-Usage: ``uv run python packages/contact/scripts/at_rest_comparison.py``. Prints one row per option; the numbers are
+Usage: ``uv run python packages/contact/scripts/at_rest_comparison.py [--only TEXT]``. Prints one row per option; the numbers are
 quoted in packages/contact/README.md ("At rest").
 
 * Standing G1: ``simulate_standing`` of packages/train/tests/test_standing_on_sand.py (sole collider 5 x 5, lowered
@@ -13,6 +13,7 @@ quoted in packages/contact/README.md ("At rest").
 
 from __future__ import annotations
 
+import argparse
 import importlib.util
 import sys
 import time
@@ -39,16 +40,32 @@ def _load_harness():  # noqa: ANN202
     return module
 
 
-OPTIONS: dict[str, dict] = {
+OPTIONS: dict[str, dict] = {  # rows before the static friction measured with the viscous crater friction
     "none (published 3D-RFT)": {"at_rest": "none"},
     "ema (Choi S16, c_r 0.5)": {"at_rest": "ema"},
-    "unloading r=1 damping 1 ms (old default)": {"unloading_speed": 0.0},
-    "unloading r=5": {"unloading_ratio": 5.0, "unloading_damping": 0.0, "unloading_speed": 0.0},
-    "unloading r=20": {"unloading_ratio": 20.0, "unloading_damping": 0.0, "unloading_speed": 0.0},
-    "unloading r=5 damping 5 ms": {"unloading_ratio": 5.0, "unloading_damping": 0.005, "unloading_speed": 0.0},
-    "unloading r=1 + impact damping u0 0.3": {"unloading_speed": 0.3},
-    "unloading r=1 + impact damping u0 0.2": {"unloading_speed": 0.2},
-    "unloading r=1 + impact damping u0 0.15 (default)": {},
+    "unloading r=1 damping 1 ms (first default)": {"unloading_speed": 0.0, "static_friction": False},
+    "unloading r=5": {
+        "unloading_ratio": 5.0,
+        "unloading_damping": 0.0,
+        "unloading_speed": 0.0,
+        "static_friction": False,
+    },
+    "unloading r=20": {
+        "unloading_ratio": 20.0,
+        "unloading_damping": 0.0,
+        "unloading_speed": 0.0,
+        "static_friction": False,
+    },
+    "unloading r=5 damping 5 ms": {
+        "unloading_ratio": 5.0,
+        "unloading_damping": 0.005,
+        "unloading_speed": 0.0,
+        "static_friction": False,
+    },
+    "unloading r=1 + impact damping u0 0.3": {"unloading_speed": 0.3, "static_friction": False},
+    "unloading r=1 + impact damping u0 0.2": {"unloading_speed": 0.2, "static_friction": False},
+    "r=1 + impact damping u0 0.15, viscous crater friction (previous default)": {"static_friction": False},
+    "r=1 + impact damping u0 0.15 + static friction s0 2 mm (default)": {},
 }
 
 
@@ -84,10 +101,15 @@ def box_rebound(options: dict, media: tuple[str, ...] = BOX_MEDIA, duration: flo
 
 
 def main() -> None:
-    """Run every option and print standing and box statistics."""
+    """Run every option (or those whose name contains ``--only``) and print standing and box statistics."""
+    parser = argparse.ArgumentParser(description=__doc__)
+    parser.add_argument("--only", default="", help="run only the options whose name contains this text")
+    args = parser.parse_args()
     wp.config.quiet = True
     harness = _load_harness()
     for name, options in OPTIONS.items():
+        if args.only not in name:
+            continue
         t0 = time.perf_counter()
         cols = []
         for material in STANDING_MEDIA:
