@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import replace
+from pathlib import Path
 
 import numpy as np
 
@@ -74,3 +75,32 @@ def test_episode_specs_batches_summary_and_tables() -> None:
     header, body = table_speeds(rows)
     # v = 1: episodes 0 (success) and 2 (fail) -> 50 %; v = 2: episode 1 (fail) -> 0 %
     assert header[2:] == ["v=1 m/s", "v=2 m/s"] and body[0][2:] == [50.0, 0.0]
+
+
+def test_episode_mcap_round_trip(tmp_path: Path) -> None:
+    """A hand-made 1 s episode written as MCAP reads back: joints reordered to the SDK order, contact, odometry."""
+    from gmloco.deploy.logs import G1_JOINT_NAMES, read_log
+    from gmloco.eval.g1_eval_record import write_episode_mcap
+
+    n, dt = 50, 0.02
+    names = list(reversed(G1_JOINT_NAMES))  # policy order differs from the SDK order
+    jq = np.tile(np.arange(29, dtype=float) * 0.01, (n, 1))  # joint names[i] at 0.01 i rad
+    force = np.zeros((n, 2, 3))
+    force[:, 0, 2] = 300.0  # left foot loaded above the 40 N threshold, right foot in the air
+    log = _log(np.stack([np.arange(n) * dt, np.zeros(n)], 1), np.tile([1.0, 0.0], (n, 1)), np.full(n, 0.7), dt)
+    ep = {**log, "joint_q": jq, "joint_qd": np.zeros((n, 29)), "target": jq, "action": np.zeros((n, 29)),
+          "foot_force": force, "foot_sinkage": np.full((n, 2), 0.01), "command": (1.0, 0.0, 0.0),
+          "joint_names": names, "kp": np.full(29, 40.0), "kd": np.full(29, 2.0)}  # fmt: skip
+    path = write_episode_mcap(tmp_path / "ep.mcap", ep, {"policy": "p", "material": "dry_sand"})
+    lg = read_log(path)
+    t, q = lg.signal("lowstate.q", names[3])
+    np.testing.assert_allclose(t[:2], [0.0, dt], atol=1e-9)
+    np.testing.assert_allclose(q, 0.03)
+    _, contact = lg.signal("sim.in_contact")
+    assert contact[:, 0].all() and not contact[:, 1].any()
+    _, pos = lg.signal("odom.position")
+    np.testing.assert_allclose(pos[-1, :2], [(n - 1) * dt, 0.0], atol=1e-9)
+    # at constant velocity the specific force is gravity: +9.81 m/s^2 on the IMU z axis
+    _, acc = lg.signal("imu.accelerometer")
+    np.testing.assert_allclose(acc[:, 2], 9.81, atol=1e-6)
+    assert lg.metadata.contact_model == "mpm" and lg.metadata.material == "dry_sand"
