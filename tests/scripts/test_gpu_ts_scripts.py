@@ -102,6 +102,8 @@ def test_eval_ts_scores_held_out_materials_presets_baseline_and_adaptation(chunk
     assert [r["group"] for r in summary["materials"]] == ["held_out", "held_out", "presets", "presets"]
     assert [r["material"] for r in summary["adaptation"]] == ["basalt", "dry_sand", "poppy_seed"]
     if baseline.exists():
-        assert [r["cell"] for r in summary["comparison"]] == ["dry_sand/v1", "poppy_seed/v1", "presets"]
+        cells = [r["cell"] for r in summary["comparison"]]
+        assert cells[2:] == ["dry_sand/v1", "poppy_seed/v1", "held_out", "presets", "all"]
+        assert cells[0].startswith("held_out_rho") and summary["comparison"][-1]["baseline_success_rate"] is not None
     for name in ("summary.json", "materials.csv", "adaptation.png", "adaptation_env0.json"):
         assert (out / name).exists(), name

@@ -12,8 +12,8 @@ One :func:`evaluate_teacher_student` call rebuilds the student (with its frozen 
 * **student vs teacher**: mean squared action difference per joint on the student's states (DAgger's error);
 * **walking**: success (no fall for ``duration_s``; pelvis < 0.2 m above the sand or |roll|, |pitch| > pi/4 is a
   fall, GM-Loco's rules as in :mod:`gmloco.train.evaluation`) and velocity / yaw-rate tracking error, per cell;
-  the PPO baseline (an mjlab ONNX export) is scored on the named presets with :func:`gmloco.train.evaluate_policy`
-  under the same floor, commands, duration and failure rules;
+  the PPO baseline (an mjlab ONNX export) is scored on the same cells (held-out materials included) with the env
+  builder and rollout of :mod:`gmloco.train.evaluation`, under the same floor, commands, duration and failure rules;
 * **adaptation** (:func:`adaptation_rollout`): a course basalt -> dry sand -> poppy seed along each robot's initial
   heading. The training simulator's material is per env, so each env's material is switched when its pelvis crosses
   an edge (the contact package's per-point material field is not wired into the training env); decoded eta and the
@@ -340,18 +340,21 @@ def _material_rows(cells: list[_Cell], raw: dict[str, np.ndarray], warmup: int) 
     return rows
 
 
-def _baseline(cfg: TsEvalCfg) -> dict[str, float]:
-    """Score the PPO baseline on the presets with ``evaluate_policy`` under the same conditions."""
-    from gmloco.train.evaluation import EvalCfg, evaluate_policy
+def _baseline(cfg: TsEvalCfg, cells: list[_Cell]) -> dict[str, float]:
+    """Score the PPO baseline (mjlab ONNX, stacked actor frames) on the same cells, floor, commands and rules.
+
+    Uses the env builder and rollout of :mod:`gmloco.train.evaluation` (the baseline's observation layout comes from
+    its metadata) with this evaluation's per-env materials, so held-out materials are scored too.
+    """
+    import onnxruntime as ort
+
+    from gmloco.train import evaluation as ev
 
     assert cfg.baseline_policy is not None
-    ev = EvalCfg(
+    ev_cfg = ev.EvalCfg(
         policy_path=cfg.baseline_policy,
         contact_model=cfg.contact_model,
         terrain=cfg.terrain,
-        materials=cfg.presets,
-        speeds=cfg.speeds,
-        repeats=cfg.repeats,
         duration_s=cfg.duration_s,
         min_base_height=cfg.min_base_height,
         max_tilt=cfg.max_tilt,
@@ -359,19 +362,38 @@ def _baseline(cfg: TsEvalCfg) -> dict[str, float]:
         device=cfg.device,
         seed=cfg.seed,
     )
-    return evaluate_policy(ev)
+    env = ev._build_env(ev_cfg, ev._read_metadata(cfg.baseline_policy), len(cells))
+    try:
+        _pin_materials(env, [c.rho_c for c in cells], [c.mu_int for c in cells], [c.mu_surf for c in cells])
+        commands = torch.tensor([[c.speed, 0.0, 0.0] for c in cells], dtype=torch.float32, device=env.device)
+        session = ort.InferenceSession(cfg.baseline_policy, providers=["CPUExecutionProvider"])
+        raw = ev._rollout(env, session, commands, round(cfg.duration_s / env.step_dt))
+    finally:
+        env.close()
+    return _walk_table(cells, raw)
 
 
-def _comparison(cfg: TsEvalCfg, student: dict[str, float], baseline: dict[str, float]) -> list[dict[str, Any]]:
-    """Rows ``preset, speed, student/baseline success and velocity error`` plus an ``all presets`` row."""
+def _walk_table(cells: list[_Cell], raw: dict[str, np.ndarray]) -> dict[str, float]:
+    """Walking metrics per group (``held_out``, ``presets``, ``all``) and per ``<material>/v<speed>`` cell."""
+    held = np.array([c.group == "held_out" for c in cells])
+    metrics: dict[str, float] = {}
+    for name, mask in {"held_out": held, "presets": ~held, "all": np.ones(len(cells), dtype=bool)}.items():
+        if mask.any():
+            metrics |= _walk_metrics(raw, mask, name)
+    for key in dict.fromkeys((c.label, c.speed) for c in cells):
+        metrics |= _walk_metrics(raw, np.array([(c.label, c.speed) == key for c in cells]), f"{key[0]}/v{key[1]:g}")
+    return metrics
+
+
+def _comparison(cells: list[_Cell], student: dict[str, float], baseline: dict[str, float]) -> list[dict[str, Any]]:
+    """Rows ``cell, student/baseline success and tracking errors`` per cell, then per group."""
+    keys = [f"{label}/v{speed:g}" for label, speed in dict.fromkeys((c.label, c.speed) for c in cells)]
     rows = []
-    keys = [f"{m}/v{s:g}" for m in cfg.presets for s in cfg.speeds] + ["presets"]
-    for key in keys:
-        base_key = "all" if key == "presets" else key
+    for key in [*keys, "held_out", "presets", "all"]:
         row: dict[str, Any] = {"cell": key}
         for name in ("success_rate", "vel_error", "yaw_rate_error"):
             row[f"student_{name}"] = student.get(f"{key}/{name}")
-            row[f"baseline_{name}"] = baseline.get(f"{base_key}/{name}")
+            row[f"baseline_{name}"] = baseline.get(f"{key}/{name}")
         rows.append(row)
     return rows
 
@@ -535,9 +557,8 @@ def evaluate_teacher_student(cfg: TsEvalCfg) -> dict[str, Any]:
         groups = {"held_out": np.array([c.group == "held_out" for c in cells]), "all": np.ones(len(cells), bool)}
         groups["presets"] = ~groups["held_out"]
         for name, mask in groups.items():
-            metrics |= _eta_metrics(raw, mask, warmup, name) | _walk_metrics(raw, mask, name)
-        for c in dict.fromkeys((c.label, c.speed) for c in cells):
-            metrics |= _walk_metrics(raw, np.array([(x.label, x.speed) == c for x in cells]), f"{c[0]}/v{c[1]:g}")
+            metrics |= _eta_metrics(raw, mask, warmup, name)
+        metrics |= _walk_table(cells, raw)
         adaptation = adaptation_rollout(runner, cfg) if cfg.adaptation_duration_s > 0 else None
     finally:
         runner.env.close()
@@ -549,9 +570,9 @@ def evaluate_teacher_student(cfg: TsEvalCfg) -> dict[str, Any]:
         "cfg": json.loads(json.dumps(asdict(cfg), default=str)),
     }
     if cfg.baseline_policy is not None:
-        baseline = _baseline(cfg)
+        baseline = _baseline(cfg, cells)
         summary["baseline"] = baseline
-        summary["comparison"] = _comparison(cfg, metrics, baseline)
+        summary["comparison"] = _comparison(cells, metrics, baseline)
     if cfg.out_dir is not None:
         _write(cfg, summary, adaptation)
     return summary
