@@ -58,7 +58,13 @@ def task_cfg(section: DictConfig) -> Any:
     from gmloco.train import g1_granular_task
 
     task = g1_granular_task(str(section.contact_model.value), str(section.terrain.value))  # type: ignore[arg-type]
-    return replace(task, policy_history_length=int(section.policy_history_length))
+    clearance = section.get("foot_clearance", "penalty")
+    return replace(
+        task,
+        policy_history_length=int(section.policy_history_length),
+        curriculum_scale=float(section.get("curriculum_scale", 1.0)),
+        foot_clearance=str(getattr(clearance, "value", clearance)),  # type: ignore[arg-type]
+    )
 
 
 def ppo_cfg(section: DictConfig) -> Any:

@@ -129,6 +129,13 @@ class TrainAlgorithm(str, Enum):
     """GM-Loco teacher: PPO with the VAE terrain encoder and eta decoder (``TeacherPPO``, ``+exp=gm_loco``)."""
 
 
+class FootClearanceForm(str, Enum):
+    """Form of the swing-height term (``gmloco.train.GranularTaskCfg.foot_clearance``)."""
+
+    penalty = "penalty"
+    reward = "reward"
+
+
 class TerrainName(str, Enum):
     """Sand beds of ``gmloco.train.g1_granular_task``."""
 
@@ -199,6 +206,11 @@ class TrainTeacherCfg(PolicyTrainingCfg):
     """Sand bed: flat soft sand, sinusoidal rough surface, or a 30 cm deep loose bed."""
     policy_history_length: int = 5
     """Actor frames stacked into o_t (1 for the teacher-student: the history goes through the encoders)."""
+    curriculum_scale: float = 1.0
+    """Multiplier on the command-stage steps and tracking-ramp length (1.0: GM-Loco's, stages at 10k and 15k
+    iterations; 0.1 fits a ~2k-iteration budget). See ``gmloco.train.GranularTaskCfg.curriculum_scale``."""
+    foot_clearance: FootClearanceForm = FootClearanceForm.penalty
+    """Swing-height term: the project page's L2 penalty or the public code's exp reward (pays standing still)."""
     hidden_dims: list[int] = field(default_factory=lambda: [512, 256, 128])
     """Actor and critic MLP widths (GM-Loco: 512, 256, 128)."""
     latent_dim: int = 16
