@@ -101,6 +101,8 @@ class G1MpmSceneCfg:
     """mjlab's actuator natural frequency: joint armature = kp / (2 pi f)^2 [Hz]."""
     seed: int = 0
     """Seed of the sand jitter."""
+    robots_as_worlds: bool | None = None
+    """One MuJoCo world per robot through mujoco_warp (else all robots in one MuJoCo C world); None = on CUDA."""
     use_cuda_graph: bool = True
     """Capture one frame in a CUDA graph (CUDA, fixed-capacity grid and an even substep count only)."""
     device: str | None = None
@@ -186,7 +188,8 @@ class G1MpmScene:
         self.bodies_per_robot, self.coords_per_robot = rb.body_count, rb.joint_coord_count
         self.dofs_per_robot = rb.joint_dof_count
         builder = newton.ModelBuilder()
-        self.as_worlds = self.device.is_cuda
+        as_worlds = self.cfg.robots_as_worlds
+        self.as_worlds = self.device.is_cuda if as_worlds is None else as_worlds
         if self.as_worlds:
             for _ in range(self.cfg.num_robots):
                 builder.add_world(rb)
@@ -271,9 +274,11 @@ class G1MpmScene:
                                 body_inv_inertia=self.eff_inv_inertia)  # fmt: skip
         per_world = 1 if self.as_worlds else self.cfg.num_robots
         self.rigid = newton.solvers.SolverMuJoCo(
-            self.model, use_mujoco_cpu=not self.device.is_cuda, use_mujoco_contacts=False,
+            self.model, use_mujoco_cpu=not self.as_worlds, use_mujoco_contacts=False,
             njmax=64 * per_world, nconmax=64 * per_world,
         )  # fmt: skip
+        # mujoco_warp without MuJoCo contacts still reads Newton contacts: an empty set (the robots touch only sand)
+        self.contacts = None if not self.as_worlds else newton.Contacts(0, 0, device=self.device)
         st = make_coupled_states(newton, wp, self.model, self.sand_model)
         self.state_0, self.state_1, self.control = st.state_0, st.state_1, st.control
         self.sand_state, self.sand_wrench = st.sand_state, st.sand_wrench
@@ -351,7 +356,7 @@ class G1MpmScene:
                                 self.state_0.joint_qd, self.targets, self.control.joint_f)  # fmt: skip
             self.state_0.clear_forces()
             wp.copy(self.state_0.body_f, self.sand_wrench)
-            self.rigid.step(self.state_0, self.state_1, self.control, None, self.sim_dt)
+            self.rigid.step(self.state_0, self.state_1, self.control, self.contacts, self.sim_dt)
             self.state_0, self.state_1 = self.state_1, self.state_0
         self.window.advance(self.state_0.body_q)
         wp.copy(self.sand_state.body_q, self.state_0.body_q)
