@@ -390,7 +390,7 @@ def _defaults(argv: Sequence[str]) -> list[str]:
         exps = loaded.get("exps") if isinstance(loaded, DictConfig) else None
         args.insert(0, f"+exp={(exps or AblationCfg().exps)[0]}")
     if not any(a.startswith(("run_dir=", "run_name=")) for a in args):
-        args.append("run_dir=${paths.runs_dir}/ablation/${run_name}")
+        args.insert(0, "run_dir=${paths.runs_dir}/ablation/${run_name}")
     return args
 
 

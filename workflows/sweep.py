@@ -628,10 +628,13 @@ def write_report(
     return summary
 
 
-def _default_experiment(argv: Sequence[str]) -> list[str]:
-    """Add ``+exp=<sweep.experiment>`` when the command line chooses no experiment."""
+def _defaults(argv: Sequence[str]) -> list[str]:
+    """Add ``+exp=<sweep.experiment>`` and ``run_dir=<runs>/<exp>/sweep-<time>`` when the command line has none."""
+    args = list(argv)
+    if not any(a.startswith(("run_dir=", "run_name=")) for a in args):
+        args.insert(0, "run_dir=${paths.runs_dir}/${exp_name}/sweep-${run_name}")
     if any(a.lstrip("+").startswith("exp=") for a in argv):
-        return list(argv)
+        return args
     from config_errors import CONF_DIR
     from schemas import SweepCfg
 
@@ -641,7 +644,7 @@ def _default_experiment(argv: Sequence[str]) -> list[str]:
     loaded = OmegaConf.load(path) if path is not None and path.is_file() else None
     if isinstance(loaded, DictConfig):
         exp = str(loaded.get("experiment", exp))
-    return [f"+exp={exp}", *argv]
+    return [f"+exp={exp}", *args]
 
 
 def _task(cfg: DictConfig) -> int:
@@ -653,7 +656,7 @@ def main() -> None:
     """Command-line entry (Hydra)."""
     from hydra_entry import hydra_entry
 
-    sys.argv = [sys.argv[0], *_default_experiment(sys.argv[1:])]
+    sys.argv = [sys.argv[0], *_defaults(sys.argv[1:])]
     hydra_entry(_task, only_stage="train_teacher")
 
 

@@ -312,3 +312,58 @@ def test_sweep_command_runs_two_real_trials_on_cpu(tmp_path: Path) -> None:
         assert (tmp_path / row["run_dir"] / "train_teacher" / "model_2.pt").is_file() or row["state"] == "pruned"
         assert len(row["intermediate"]) >= 1
     assert (tmp_path / "figures" / "sweep.png").is_file() and (tmp_path / "trials.csv").is_file()
+
+
+def test_eval_objective_scores_each_chunk_on_the_fixed_evaluation(
+    compose: Callable[..., DictConfig],
+    fake_training: Callable[..., FakeTraining],
+    monkeypatch: pytest.MonkeyPatch,
+    tmp_path: Path,
+) -> None:
+    """``eval/all/vel_error``: evaluate_policy runs on the chunk's policy.onnx with ``sweep.eval``; minimized."""
+    import gmloco.train
+
+    fake_training()
+    monkeypatch.setattr(policy_training, "vanilla_ppo_overrides", lambda section: {})
+    calls: list[Any] = []
+
+    def fake_evaluate(cfg: Any) -> dict[str, float]:
+        """Velocity error = distance of the trial's mu_int low end from 0.25 (read from its resolved config)."""
+        calls.append(cfg)
+        trial_cfg = OmegaConf.load(Path(cfg.policy_path).parents[1] / "config.yaml")
+        mu_low = trial_cfg.sweep.trial_params.params[MU_KEY]
+        return {"all/vel_error": abs(mu_low - 0.25), "all/success_rate": 1.0}
+
+    monkeypatch.setattr(gmloco.train, "evaluate_policy", fake_evaluate, raising=False)
+    cfg = compose(
+        "+exp=ppo_rft3d",
+        "+sweep=optuna_ppo_dr",
+        "+scale=smoke",
+        f"run_dir={tmp_path}",
+        "device=cpu",
+        "tracking.wandb=disabled",
+        "train_teacher.max_iterations=4",
+    )
+    cfg.sweep.params = {MU_KEY: {"type": "float", "low": 0.1, "high": 0.4}}
+    cfg.sweep.smoke_trials = 3
+    summary = sweep.run_sweep(cfg)
+    assert summary["direction"] == "minimize" and summary["finished"] == 3
+    for call in calls:
+        assert call.materials == ("dry_sand", "poppy_seed") and call.speeds == (1.0,) and call.repeats == 4
+        assert Path(call.policy_path).name == "policy.onnx" and Path(call.policy_path).parent.name == "train_teacher"
+        assert Path(call.out_path).name.startswith("iteration_")
+    for row in summary["trials"]:
+        expected = abs(row["params"][MU_KEY] - 0.25)
+        assert all(v == pytest.approx(expected) for v in row["intermediate"].values())
+        if row["state"] == "complete":
+            assert row["value"] == pytest.approx(expected)
+    assert summary["best"]["value"] == min(r["value"] for r in summary["trials"] if r["state"] == "complete")
+
+
+def test_eval_objective_is_refused_for_the_vae_teacher(compose: Callable[..., DictConfig], tmp_path: Path) -> None:
+    """The teacher exports no ONNX policy, so an eval/ objective is bad input naming sweep.metric."""
+    cfg = _sweep_cfg(compose, tmp_path, 2)
+    cfg.sweep.metric = "eval/all/vel_error"
+    with pytest.raises(PipelineConfigError) as info:
+        sweep.run_sweep(cfg)
+    assert info.value.key == "sweep.metric" and not (tmp_path / "config.yaml").exists()
