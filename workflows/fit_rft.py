@@ -39,7 +39,7 @@ def main() -> None:
     p.add_argument("--gammas", type=float, nargs="+", default=None, help="intrusion angles [deg]")
     p.add_argument("--betas", type=float, nargs="+", default=None, help="plate tilts [deg]")
     p.add_argument("--psis", type=float, nargs="+", default=None, help="tilt headings [deg]")
-    p.add_argument("--ridge", type=float, default=1e-3)
+    p.add_argument("--ridge", type=float, default=0.03)
     p.add_argument("--batch", type=int, default=1, help="plate runs per MPM solve (GPU: ~9)")
     p.add_argument("--max-minutes", type=float, default=60.0)
     p.add_argument("--device", default=None)
