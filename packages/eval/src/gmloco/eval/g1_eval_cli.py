@@ -1,0 +1,71 @@
+# SPDX-License-Identifier: Apache-2.0
+"""Command line of the MPM evaluation without Hydra (the GPU machine): ``python -m gmloco.eval.g1_eval_cli``.
+
+    python -m gmloco.eval.g1_eval_cli --out results/mpm_eval/ppo_rft3d --terrains dry_sand --num-episodes 100
+        --robots-per-batch 50 --voxel 0.05 --max-minutes 8.5
+
+Time-boxed and resumable (rerun with the same ``--out``); prints the summary metrics as JSON.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+from dataclasses import replace
+
+from gmloco.eval.g1_eval import G1EvalCfg, run
+from gmloco.eval.mpm.window import SandWindowCfg
+
+__all__ = ["main"]
+
+
+def _parse(argv: list[str] | None) -> argparse.Namespace:
+    p = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    p.add_argument("--out", required=True)
+    p.add_argument("--policy", default=G1EvalCfg.policy_path)
+    p.add_argument("--terrains", nargs="+", default=["dry_sand"])
+    p.add_argument("--scenarios", nargs="+", default=["straight"], choices=["straight", "circle"])
+    p.add_argument("--speeds", type=float, nargs="+", default=[1.0, 1.5, 2.0, 2.5])
+    p.add_argument("--num-episodes", type=int, default=100)
+    p.add_argument("--episode-s", type=float, default=10.0)
+    p.add_argument("--voxel", type=float, default=0.05)
+    p.add_argument("--robots-per-batch", type=int, default=25)
+    p.add_argument("--static-bed", action="store_true", help="naive baseline: a bed covering the course")
+    p.add_argument("--window-length", type=float, default=1.6)
+    p.add_argument("--window-width", type=float, default=1.0)
+    p.add_argument("--no-mcap", action="store_true")
+    p.add_argument("--max-minutes", type=float, default=None)
+    p.add_argument("--fresh", action="store_true", help="discard episodes.jsonl instead of resuming")
+    p.add_argument("--device", default=None)
+    p.add_argument("--seed", type=int, default=0)
+    return p.parse_args(argv)
+
+
+def main(argv: list[str] | None = None) -> None:
+    """Run the evaluation from command-line arguments."""
+    a = _parse(argv)
+    base = G1EvalCfg()
+    cfg = replace(
+        base,
+        policy_path=a.policy,
+        out_dir=a.out,
+        terrains=tuple(a.terrains),
+        scenarios=tuple(a.scenarios),
+        speeds=tuple(a.speeds),
+        num_episodes=a.num_episodes,
+        episode_s=a.episode_s,
+        window=SandWindowCfg(moving=not a.static_bed, length=a.window_length, width=a.window_width),
+        robots_per_batch=a.robots_per_batch,
+        solver=replace(base.solver, voxel_size=a.voxel),
+        record_mcap=not a.no_mcap,
+        max_minutes=a.max_minutes,
+        resume=not a.fresh,
+        device=a.device,
+        seed=a.seed,
+    )
+    metrics, complete = run(cfg)
+    print(json.dumps({"complete": complete, **{k: v for k, v in metrics.items() if "/v" not in k}}, indent=1))
+
+
+if __name__ == "__main__":
+    main()
