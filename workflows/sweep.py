@@ -34,7 +34,14 @@ from omegaconf import DictConfig, OmegaConf
 from manifest import StageStatus
 from pipeline_report import console
 from pipeline_run import EXIT_FAILED, EXIT_INCOMPLETE, EXIT_OK, run_pipeline
-from run_dir import atomic_write_json, atomic_write_text, atomic_write_yaml, seed_everything, write_git_state
+from run_dir import (
+    atomic_write_json,
+    atomic_write_text,
+    atomic_write_yaml,
+    read_json,
+    seed_everything,
+    write_git_state,
+)
 from schemas import REPO_ROOT
 from stage_registry import StageSpec
 from stage_runner import PipelineConfigError, resolve_device
@@ -294,6 +301,9 @@ class TrialStage:
                 if self.trial.should_prune():
                     self.pruned = True
                     break
+        if not metrics:  # killed after its last chunk trained but before the report: that chunk's metrics
+            metrics = read_json(Path(section.out_dir) / "metrics.json", default={}) or {}
+            value = self.objective.value(cfg, metrics) if "iteration" in metrics else None
         return {**metrics, "objective": value, "pruned": float(self.pruned)}
 
 

@@ -367,3 +367,21 @@ def test_eval_objective_is_refused_for_the_vae_teacher(compose: Callable[..., Di
     with pytest.raises(PipelineConfigError) as info:
         sweep.run_sweep(cfg)
     assert info.value.key == "sweep.metric" and not (tmp_path / "config.yaml").exists()
+
+
+def test_trial_whose_training_finished_before_a_kill_reports_its_saved_metrics(
+    compose: Callable[..., DictConfig], fake_training: Callable[..., FakeTraining], tmp_path: Path
+) -> None:
+    """All chunks already trained (checkpoint at max_iterations): no training call; train's metrics.json is used."""
+    import optuna
+
+    fake = fake_training()
+    cfg = _sweep_cfg(compose, tmp_path, 2)
+    cfg.run_dir = str(tmp_path)
+    out = tmp_path / "train_teacher"
+    out.mkdir()
+    (out / "model_8.pt").write_text("checkpoint")
+    (out / "metrics.json").write_text(json.dumps({"iteration": 8.0, "mean_reward": 1.5}))
+    trial = optuna.create_study().ask()
+    result = sweep.TrialStage(trial, sweep.Objective.parse("train_teacher/mean_reward"), {})(cfg)
+    assert fake.calls == [] and result["objective"] == 1.5 and result["pruned"] == 0.0
