@@ -23,7 +23,10 @@ from gmloco.eval.mpm.box_scene import MpmSolverCfg
 from gmloco.eval.rom_box import ROM_MODELS, RomBoxCfg, simulate_rom_box
 from gmloco.eval.study_io import StudyRecords
 
-__all__ = ["BoxStudyCfg", "box_study_smoke_cfg", "run", "sample_media"]
+__all__ = ["MEDIA_DRAWS", "BoxStudyCfg", "box_study_smoke_cfg", "run", "sample_media"]
+
+MEDIA_DRAWS = 1024
+"""Draws per medium parameter from the study seed; trial t uses draw t whatever the number of trials."""
 
 
 @dataclass(frozen=True)
@@ -90,10 +93,17 @@ def box_study_smoke_cfg(out_dir: str, **overrides: Any) -> BoxStudyCfg:
 
 
 def sample_media(cfg: BoxStudyCfg) -> dict[str, np.ndarray]:
-    """Sample the trials' media, each [num_trials]: bulk_density, packing, rho_c, mu_int, mu_surf."""
+    """Sample the trials' media, each [num_trials]: bulk_density, packing, rho_c, mu_int, mu_surf.
+
+    Trial t's medium does not depend on ``num_trials`` (the first ``MEDIA_DRAWS`` draws per parameter are
+    sliced), so studies of different sizes with one seed share their first trials (convergence and size checks).
+    """
     rng = np.random.default_rng(cfg.seed)
     n = cfg.num_trials
-    media = {k: rng.uniform(*getattr(cfg, k), size=n) for k in ("bulk_density", "packing", "mu_int", "mu_surf")}
+    if n > MEDIA_DRAWS:
+        raise ValueError(f"num_trials={n} > {MEDIA_DRAWS}")
+    keys = ("bulk_density", "packing", "mu_int", "mu_surf")
+    media = {k: rng.uniform(*getattr(cfg, k), size=MEDIA_DRAWS)[:n] for k in keys}
     media["rho_c"] = media["packing"] * media["bulk_density"]
     return media
 
