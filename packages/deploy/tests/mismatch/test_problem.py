@@ -11,15 +11,15 @@ from gmloco.deploy.mismatch.problem import group_balance
 
 def test_group_balance_gives_each_group_equal_weight() -> None:
     """Every active group gets total weight N / G; the total null energy stays N; inactive columns stay 0."""
-    act = np.ones(93)
+    act = np.ones(96)
     w = group_balance(act) ** 2
-    assert np.isclose(w.sum(), 93.0)
-    for o, n in ((0, 29), (29, 29), (58, 29), (87, 3), (90, 3)):
-        assert np.isclose(w[o : o + n].sum(), 93.0 / 5)
-    act[58:87] = 0.0  # no torque estimates logged
+    assert np.isclose(w.sum(), 96.0)
+    for o, n in ((0, 29), (29, 29), (58, 29), (87, 3), (90, 3), (93, 3)):
+        assert np.isclose(w[o : o + n].sum(), 96.0 / 6)
+    act[58:87] = 0.0  # no torque estimates logged: 67 active columns in 5 groups
     w = group_balance(act) ** 2 * act
-    assert np.isclose(w.sum(), 64.0) and np.all(w[58:87] == 0.0)
-    assert np.isclose(w[87:90].sum(), 16.0)
+    assert np.isclose(w.sum(), 67.0) and np.all(w[58:87] == 0.0)
+    assert np.isclose(w[87:90].sum(), 67.0 / 5)
 
 
 def test_bootstrap_gain_bound_is_below_the_weakest_block() -> None:

@@ -66,7 +66,7 @@ class EffectSpec:
     phases: tuple[str, ...]
     """Gait phases where it can act (``swing``, ``touchdown``, ``stance``, ``liftoff``, ``any``)."""
     signals: tuple[str, ...]
-    """Signals it changes (``q``, ``dq``, ``tau_est``, ``gyro``, ``acc``)."""
+    """Signals it changes (``q``, ``dq``, ``tau_est``, ``gyro``, ``acc``, ``gyro_att``)."""
     confusables: tuple[str, ...]
     """Effect ids with similar signatures."""
     excitation: str
@@ -130,7 +130,7 @@ EFFECTS: tuple[EffectSpec, ...] = (
     EffectSpec(
         "actuator.torque_speed",
         "Torque-speed saturation (DC-motor envelope)",
-        (ParamSpec("droop", "s/rad", 1, 0.0, 0.2, 0.01, 0.01, "Torque limit lost per rad/s of joint speed."),),
+        (ParamSpec("droop", "s/rad", 1, 0.0, 0.5, 0.01, 0.01, "Torque limit lost per rad/s of joint speed."),),
         "|tau| <= tau_max (1 - droop |dq|) (Isaac Lab DCMotor envelope); tau_max from mjlab's G1 constants.",
         "tau_est plateaus while the PD torque grows: push-off, fast swing, deep stance.",
         ("stance", "liftoff", "swing"),
@@ -196,9 +196,9 @@ EFFECTS: tuple[EffectSpec, ...] = (
         "Gyroscope bias",
         (ParamSpec("bias", "rad/s", 3, -0.2, 0.2, 0.01, 0.006, "Additive gyro bias.", ("x", "y", "z")),),
         "gyro_meas = omega + b (IMU frame).",
-        "Constant gyro offset in every phase.",
+        "Constant gyro offset in every phase; the gyro disagrees with the rate of the logged attitude (gyro_att).",
         ("any",),
-        ("gyro",),
+        ("gyro", "gyro_att"),
         ("imu.misalignment",),
         "Any recording.",
     ),

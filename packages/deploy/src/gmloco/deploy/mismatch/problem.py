@@ -14,7 +14,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from gmloco.deploy.mismatch.replay import CHANNEL_GROUPS, Replayer
+from gmloco.deploy.mismatch.replay import CHANNEL_GROUPS, N_CHANNELS, Replayer
 
 __all__ = ["FloorCfg", "Problem", "effective_samples", "group_balance"]
 
@@ -24,11 +24,11 @@ class FloorCfg:
     """Per-signal model floors (``sigma_model_g``), for leg odometry and for logged odometry."""
 
     leg_odometry: dict[str, float] = field(
-        default_factory=lambda: {"q": 1.2e-3, "dq": 0.05, "tau_est": 0.4, "gyro": 0.03, "acc": 0.35}
+        default_factory=lambda: {"q": 1.2e-3, "dq": 0.05, "tau_est": 0.4, "gyro": 0.03, "acc": 0.35, "gyro_att": 0.003}
     )
     """Floors [rad, rad/s, N*m, rad/s, m/s^2] when the base state comes from leg odometry."""
     odometry: dict[str, float] = field(
-        default_factory=lambda: {"q": 6e-4, "dq": 0.03, "tau_est": 0.25, "gyro": 0.012, "acc": 0.22}
+        default_factory=lambda: {"q": 6e-4, "dq": 0.03, "tau_est": 0.25, "gyro": 0.012, "acc": 0.22, "gyro_att": 0.003}
     )
     """Floors when base odometry is logged."""
     exclude_arms: bool = False
@@ -96,11 +96,12 @@ class Problem:
         self.held = self.block % heldout_every == heldout_every - 1
         self.train = ~self.held
         self.y = replayer.measured(self.starts)
-        meas = np.concatenate([_meas_noise(a) for a in (rec.q, rec.dq, rec.tau_est, rec.imu_gyro, rec.imu_acc)])
+        sigs = (rec.q, rec.dq, rec.tau_est, rec.imu_gyro, rec.imu_acc, replayer.gyro_att)
+        meas = np.concatenate([_meas_noise(a) for a in sigs])
         model = floor.odometry if rec.has_odometry else floor.leg_odometry
         mf = np.concatenate([np.full(w, model[g]) for g, w in CHANNEL_GROUPS])
         self.sigma = np.sqrt(meas**2 + mf**2)
-        self.weight = np.ones(93)
+        self.weight = np.ones(N_CHANNELS)
         if np.allclose(rec.tau_est, 0.0):
             self.weight[58:87] = 0.0
         if floor.exclude_arms:
@@ -110,11 +111,11 @@ class Problem:
             self.weight = self.weight * group_balance(self.weight)
 
     def simulate(self, params: dict[str, np.ndarray], mask: np.ndarray | None = None) -> np.ndarray:
-        """Simulate the segments selected by ``mask`` (all by default), shape [S', P, 93]."""
+        """Simulate the segments selected by ``mask`` (all by default), shape [S', P, N_CHANNELS]."""
         st = self.starts if mask is None else self.starts[mask]
         return self.rp.simulate(params, st)
 
     def resid(self, params: dict[str, np.ndarray], mask: np.ndarray | None = None) -> np.ndarray:
-        """Normalised residual on the selected segments, shape [S', P, 93]."""
+        """Normalised residual on the selected segments, shape [S', P, N_CHANNELS]."""
         m = np.ones(len(self.starts), bool) if mask is None else mask
         return (self.y[m] - self.simulate(params, m)) / self.sigma * self.weight

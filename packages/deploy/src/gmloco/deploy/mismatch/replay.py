@@ -11,7 +11,7 @@ sensor, model edits) or in :mod:`gmloco.deploy.mismatch.terrain`, and all are ex
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 
@@ -22,12 +22,53 @@ from gmloco.deploy.mismatch.g1model import G1_ARMATURE, G1_EFFORT_LIMIT, SOLE_PO
 from gmloco.deploy.mismatch.recording import Recording
 from gmloco.deploy.mismatch.terrain import TerrainCfg, TerrainParams, sole_forces
 
-__all__ = ["CHANNEL_GROUPS", "ReplayCfg", "Replayer", "channel_names"]
+__all__ = ["CHANNEL_GROUPS", "N_CHANNELS", "ReplayCfg", "Replayer", "attitude_rate_residual", "channel_names"]
 
-CHANNEL_GROUPS: tuple[tuple[str, int], ...] = (("q", 29), ("dq", 29), ("tau_est", 29), ("gyro", 3), ("acc", 3))
-"""Compared signals and their widths, in output-column order."""
+CHANNEL_GROUPS: tuple[tuple[str, int], ...] = (
+    ("q", 29),
+    ("dq", 29),
+    ("tau_est", 29),
+    ("gyro", 3),
+    ("acc", 3),
+    ("gyro_att", 3),
+)
+"""Compared signals and their widths, in output-column order. ``gyro_att`` is the gyro minus the attitude rate
+(the angular velocity implied by the logged IMU quaternion), a sensor-consistency signal: zero for a consistent
+IMU, whatever the dynamics (:func:`attitude_rate_residual`)."""
+
+N_CHANNELS: int = sum(w for _, w in CHANNEL_GROUPS)
+"""Number of output columns."""
 
 _REF_EFFORT = 88.0  # N*m: friction/damping parameters are quoted for an 88 N*m joint (7520-14 motor)
+
+
+def attitude_rate_residual(quat: np.ndarray, gyro: np.ndarray, dt: float, half: int) -> np.ndarray:
+    """Gyro minus the attitude rate of the logged quaternion, per sample [rad/s], shape [N, 3].
+
+    Over a window of ``2 half`` samples, the rotation ``q(k - half)^-1 q(k + half)`` (IMU frame) has the
+    rotation vector ``integral(omega) dt``; its mean rate is compared with the mean gyro over the same window, so
+    the difference is zero for any motion when the gyro and the quaternion agree (no curvature error), and equals
+    an additive gyro bias otherwise. A constant IMU mounting rotation cancels (both signals live in the IMU frame).
+    The quaternion noise sets the floor: ``sqrt(2) sigma_quat / (2 half dt)``. Edges use the nearest full window.
+
+    Args:
+        quat: IMU orientation (w, x, y, z), shape [N, 4].
+        gyro: IMU angular velocity [rad/s], shape [N, 3].
+        dt: Sample period [s].
+        half: Half window [samples].
+    """
+    n = len(quat)
+    k = np.clip(np.arange(n), half, max(n - 1 - half, half))
+    rel = quat_mul(quat_conj(quat[k - half]), quat[np.minimum(k + half, n - 1)])
+    rel = rel * np.where(rel[:, :1] < 0.0, -1.0, 1.0)
+    vec = rel[:, 1:]
+    sn = np.linalg.norm(vec, axis=1, keepdims=True)
+    ang = 2.0 * np.arctan2(sn[:, 0], rel[:, 0])[:, None]
+    rotvec = np.where(sn > 1e-12, vec / np.maximum(sn, 1e-300) * ang, 2.0 * vec)
+    csum = np.concatenate([np.zeros((1, 3)), np.cumsum(gyro, axis=0)])
+    lo, hi = k - half, np.minimum(k + half, n - 1)
+    mean_gyro = (csum[hi] - csum[lo]) / np.maximum(hi - lo, 1)[:, None]
+    return mean_gyro - rotvec / ((hi - lo)[:, None] * dt)
 
 
 def channel_names(joint_names: tuple[str, ...]) -> list[str]:
@@ -54,6 +95,8 @@ class ReplayCfg:
     """Leg-odometry settings (used when the log has no odometry)."""
     terrain: TerrainCfg = field(default_factory=TerrainCfg)
     """Terrain effect constants."""
+    attitude_half_window: int = 8
+    """Half window of the gyro-vs-attitude-rate channel [samples] (16 ms at 500 Hz)."""
 
 
 @dataclass
@@ -117,6 +160,8 @@ class Replayer:
         self._w = G1_EFFORT_LIMIT / _REF_EFFORT
         self.offsets = np.arange(self.cfg.stride, self.cfg.horizon + 1, self.cfg.stride)
         self._base_cache: dict[tuple, BaseTrajectory] = {}
+        self._sink_cache: dict[tuple, float] = {}
+        self.gyro_att = attitude_rate_residual(rec.imu_quat, rec.imu_gyro, rec.dt, self.cfg.attitude_half_window)
 
     # ----------------------------------------------------------------------------------------------- data
     def segment_starts(self, spacing: int | None = None) -> np.ndarray:
@@ -129,10 +174,12 @@ class Replayer:
         return starts[bad[starts + h + 1] - bad[starts] == 0]
 
     def measured(self, starts: np.ndarray) -> np.ndarray:
-        """Logged measurements at the compare points, shape [S, P, 93]."""
+        """Logged measurements at the compare points, shape [S, P, N_CHANNELS]."""
         r = self.rec
         idx = starts[:, None] + self.offsets[None, :]
-        return np.concatenate([r.q[idx], r.dq[idx], r.tau_est[idx], r.imu_gyro[idx], r.imu_acc[idx]], axis=-1)
+        return np.concatenate(
+            [r.q[idx], r.dq[idx], r.tau_est[idx], r.imu_gyro[idx], r.imu_acc[idx], self.gyro_att[idx]], axis=-1
+        )
 
     def base(self, params: dict[str, np.ndarray], starts: np.ndarray) -> BaseTrajectory:
         """Base state at the segment starts under the sensor hypotheses of ``params`` (cached)."""
@@ -141,6 +188,7 @@ class Replayer:
             tuple(np.round(h.offset[:12], 9)),
             tuple(np.round(h.mis, 9)),
             tuple(np.round(h.gyro_bias, 9)),
+            self._load_key(h),
             starts.tobytes(),
         )
         if key not in self._base_cache:
@@ -167,7 +215,52 @@ class Replayer:
         qm = quat_from_roll_pitch(float(h.mis[0]), float(h.mis[1]))
         quat = quat_mul(r.imu_quat[starts], quat_conj(qm))
         omega = (r.imu_gyro[starts] - h.gyro_bias) @ quat_to_mat(qm).T
-        return estimate_base(self.model, q_true, r.dq[starts], quat, omega, self.cfg.base)
+        # Sinkage is not observable from proprioception: the assumed support-foot penetration follows the
+        # static sinkage of the hypothesis (terrain laws and body mass change it), relative to the nominal one.
+        sink = self._static_sinkage(h) - self._static_sinkage(_unpack({}))
+        base_cfg = replace(self.cfg.base, penetration=self.cfg.base.penetration + sink)
+        return estimate_base(self.model, q_true, r.dq[starts], quat, omega, base_cfg)
+
+    @staticmethod
+    def _load_key(h: _Hyp) -> tuple[float, ...]:
+        """Parameters that change the static sinkage (terrain laws, body mass)."""
+        t = h.terrain
+        return tuple(round(float(v), 9) for v in (t.zeta, t.kappa, t.cohesion, h.dmass))
+
+    def _static_sinkage(self, h: _Hyp) -> float:
+        """Sinkage of the lowest sole points of the G1 standing straight under hypothesis ``h`` [m] (cached).
+
+        A settle simulation: zero joint pose held by stiff PD, 0.5 s on the ground with the hypothesis's terrain
+        law and body mass, averaged over the last 0.1 s.
+        """
+        import mujoco
+
+        key = self._load_key(h)
+        if key in self._sink_cache:
+            return self._sink_cache[key]
+        m, d = self.model, self.data
+        saved = m.body_mass[self._torso], m.body_inertia[self._torso].copy()
+        m.body_mass[self._torso] = self._mass0 + h.dmass
+        m.body_inertia[self._torso] = self._inertia0 * (self._mass0 + h.dmass) / self._mass0
+        mujoco.mj_resetData(m, d)
+        d.qpos[3] = 1.0
+        mujoco.mj_kinematics(m, d)
+        d.qpos[2] -= min(float((d.xpos[b] + SOLE_POINTS @ d.xmat[b].reshape(3, 3).T)[:, 2].min()) for b in self._feet)
+        m.dof_damping[6:] = 20.0
+        n, depth = round(0.5 / m.opt.timestep), []
+        for k in range(n):
+            mujoco.mj_step1(m, d)
+            d.qfrc_applied[6:] = -500.0 * d.qpos[7:]
+            if h.terrain.active():
+                self._terrain(h.terrain)
+            mujoco.mj_step2(m, d)
+            if k >= n - round(0.1 / m.opt.timestep):
+                soles = [d.xpos[b] + SOLE_POINTS @ d.xmat[b].reshape(3, 3).T for b in self._feet]
+                depth.append(-min(float(p[:, 2].min()) for p in soles))
+        m.body_mass[self._torso], m.body_inertia[self._torso] = saved
+        d.xfrc_applied[:] = 0.0
+        self._sink_cache[key] = float(np.mean(depth))
+        return self._sink_cache[key]
 
     # ----------------------------------------------------------------------------------------- simulate
     def _set_model(self, h: _Hyp) -> None:
@@ -192,7 +285,7 @@ class Replayer:
         return lerp(r.q_cmd), lerp(r.dq_cmd), lerp(r.tau_ff)
 
     def simulate(self, params: dict[str, np.ndarray], starts: np.ndarray) -> np.ndarray:
-        """Simulated measurements at the compare points, shape [S, P, 93].
+        """Simulated measurements at the compare points, shape [S, P, N_CHANNELS].
 
         Args:
             params: ``{effect_id: flat parameter vector}``; missing ids are nominal.
@@ -201,13 +294,13 @@ class Replayer:
         h = _unpack(params)
         self._set_model(h)
         base = self.base(params, starts)
-        out = np.zeros((len(starts), len(self.offsets), 93))
+        out = np.zeros((len(starts), len(self.offsets), N_CHANNELS))
         for s, k0 in enumerate(starts):
             self._segment(h, base, s, int(k0), out[s])
         return out
 
     def _segment(self, h: _Hyp, base: BaseTrajectory, s: int, k0: int, out: np.ndarray) -> None:
-        """Reset to the real state at ``k0`` and simulate one shooting segment into ``out`` [P, 93]."""
+        """Reset to the real state at ``k0`` and simulate one shooting segment into ``out`` [P, N_CHANNELS]."""
         import mujoco
 
         m, d, r, cfg = self.model, self.data, self.rec, self.cfg
@@ -223,7 +316,7 @@ class Replayer:
         tmax = G1_EFFORT_LIMIT
         bj = h.b * self._w
         terrain = h.terrain.active()
-        p = 0
+        p, w_imu = 0, np.zeros(3)
         for j in range(cfg.horizon + 1):
             k = k0 + j
             kp, kd = r.kp[k], r.kd[k]
@@ -231,6 +324,8 @@ class Replayer:
                 # Damping enters qfrc_passive in mj_step1 and the implicit Euler update in mj_step2: set it first.
                 m.dof_damping[6:] = h.gain * kd + bj
                 mujoco.mj_step1(m, d)
+                at_compare = sub == 0 and p < len(self.offsets) and j == self.offsets[p]
+                w_imu = d.qvel[3:6].copy() if at_compare else w_imu  # angular velocity the gyro sensor saw
                 qm = d.qpos[7:] + h.offset
                 v = d.qvel[6:]
                 tau = h.gain * (kp * (qc[j] - qm) + kd * (dqc[j] - v)) + tff[j]
@@ -241,12 +336,14 @@ class Replayer:
                 if terrain:
                     self._terrain(h.terrain)
                 mujoco.mj_step2(m, d)
-                if sub == 0 and p < len(self.offsets) and j == self.offsets[p]:
+                if at_compare:
                     out[p, :29] = qm
                     out[p, 29:58] = v
                     out[p, 58:87] = tau
                     out[p, 87:90] = rmis_t @ d.sensordata[0:3] + h.gyro_bias
                     out[p, 90:93] = rmis_t @ d.sensordata[6:9]
+                    # simulated gyro output minus the simulated IMU frame's own angular velocity
+                    out[p, 93:96] = out[p, 87:90] - rmis_t @ w_imu
                     p += 1
 
     def _terrain(self, tp: TerrainParams) -> None:

@@ -11,7 +11,7 @@
 * ``mismatch``: ``{nominal_energy_ratio, explained_fraction, cells: [...], windows: [...]}``; a cell is
   ``{signal, joint, phase, energy_ratio, q_fdr, n}``, a window ``{signal, t: [t0, t1], energy_ratio, q_fdr}``.
 * ``hypotheses``: ranked list, each ``{id, rank, testable, dbic_screen, confirmed, dbic, heldout_gain,
-  heldout_gain_lo, p_boot, passed, corr_max, weight, params: {name: {value, ci95, unit}}, confusables, explanation}``;
+  heldout_gain_lo, heldout_gain_lo_signals, p_boot, passed, corr_max, weight, params: {name: {value, ci95, unit}}, confusables, explanation}``;
   followed by ``{id: "none"}`` and ``{id: "unexplained"}`` entries with their weights.
 * ``untested``: ``[{id, reason, needs}]`` effects this recording cannot test, and what would make them testable.
 * ``before_after``: held-out ``{nrmse_nominal, nrmse_fitted}`` per signal group.
@@ -102,6 +102,7 @@ def build_report(
                 dbic=float(h.dbic),
                 heldout_gain=h.heldout_gain,
                 heldout_gain_lo=float(h.gain_lo),
+                heldout_gain_lo_signals=float(h.gain_lo_signals),
                 p_boot=h.p_boot,
                 passed=h.passed,
                 corr_max=h.corr_max,

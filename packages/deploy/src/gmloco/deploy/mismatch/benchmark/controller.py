@@ -64,8 +64,9 @@ class MotionCfg:
     """Standing with arm motion, stepping in place, or slow forward stepping."""
     period: float = 0.9
     """Gait cycle [s]."""
-    lift: float = 0.15
-    """Swing flexion amplitude [rad] (hip/ankle -lift, knee +2 lift)."""
+    lift: float = 0.1
+    """Swing flexion amplitude [rad] (hip/ankle -lift, knee +2 lift). 0.1 keeps the truth robot standing for
+    15 s on every benchmark seed and effect tried; 0.15 (the first setting) fell 4-6 s in on some seeds."""
     sway: float = 0.1
     """Hip/ankle roll sway amplitude [rad]."""
     stride: float = 0.12

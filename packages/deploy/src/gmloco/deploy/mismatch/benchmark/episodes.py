@@ -31,7 +31,7 @@ OOL: dict[str, dict[str, list[float]]] = {"ool.shank_length": {"dl": [0.03]}, "o
 """Out-of-library effects (the right answer is ``unexplained``)."""
 
 
-def episode_list(seeds: int = 2, nulls: int = 8, strengths: tuple[str, ...] = ("mid",)) -> list[dict]:
+def episode_list(seeds: int = 1, nulls: int = 20, strengths: tuple[str, ...] = ("mid",)) -> list[dict]:
     """Return episode dicts ``{name, effect, params, strength, seed}``."""
     eps = []
     for s in strengths:
@@ -42,7 +42,8 @@ def episode_list(seeds: int = 2, nulls: int = 8, strengths: tuple[str, ...] = ("
                     {"name": f"{eid}-{s}-{seed}", "effect": eid, "params": scaled, "strength": s, "seed": 100 + seed}
                 )
     for seed in range(nulls):
-        eps.append({"name": f"none-{seed}", "effect": "none", "params": {}, "strength": "none", "seed": 200 + seed})
+        # Seeds 1000+ are disjoint from the nulls (200-211) that set the floors and ``weak_gain_min``.
+        eps.append({"name": f"none-{seed}", "effect": "none", "params": {}, "strength": "none", "seed": 1000 + seed})
     for eid, p in OOL.items():
         for seed in range(max(1, seeds)):
             eps.append({"name": f"{eid}-{seed}", "effect": eid, "params": p, "strength": "mid", "seed": 300 + seed})

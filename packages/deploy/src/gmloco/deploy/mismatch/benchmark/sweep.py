@@ -11,6 +11,8 @@ from __future__ import annotations
 
 import argparse
 import json
+import os
+import sys
 import time
 from multiprocessing import Pool
 from pathlib import Path
@@ -50,6 +52,11 @@ def run_episode(ep: dict, out: str, duration: float = 8.0, keep_before_fall: flo
     if "kept_s" in key:
         row["trimmed"] = {"fell_at_s": key["fell_at_s"], "kept_s": key["kept_s"]}
     row["untested"] = [u["id"] for u in rep["untested"]]
+    row["nominal_energy_ratio"] = rep.get("mismatch", {}).get("nominal_energy_ratio")
+    keys_h = ("passed", "dbic", "heldout_gain", "heldout_gain_lo", "heldout_gain_lo_signals", "p_boot")
+    row["confirmed"] = [
+        {"id": h["id"], **{k: h.get(k) for k in keys_h}} for h in rep["hypotheses"] if h.get("confirmed")
+    ]
     hyp = next((h for h in rep["hypotheses"] if h["id"] == ep["effect"] and h.get("confirmed")), None)
     if hyp is not None:
         row["fit"] = {k: [v["value"], *v["ci95"]] for k, v in hyp["params"].items()}
@@ -76,16 +83,54 @@ def _star(args: tuple) -> dict:
         return {**args[0], "error": repr(exc)}
 
 
+def _git_commit() -> dict:
+    """Commit and dirty flag of the checkout (best effort)."""
+    import subprocess
+
+    def git(*a: str) -> str:
+        return subprocess.run(["git", *a], capture_output=True, text=True, check=False).stdout.strip()
+
+    return {"commit": git("rev-parse", "HEAD"), "dirty_paths": git("status", "--porcelain", "--", ".").count("\n")}
+
+
+def _manifest(out: Path, argv: list[str], eps: list[dict], wall: float, cpu: float) -> None:
+    """Write ``manifest.json``: commit, command line, configuration and timing of the sweep."""
+    import os
+    import platform
+    from dataclasses import asdict
+
+    from gmloco.deploy.mismatch.benchmark.controller import MotionCfg
+    from gmloco.deploy.mismatch.benchmark.generator import EpisodeCfg
+    from gmloco.deploy.mismatch.pipeline import AnalysisCfg
+
+    ep_cfg = asdict(EpisodeCfg())
+    ep_cfg.pop("effect")
+    man = {
+        "git": _git_commit(),
+        "command": "python -m gmloco.deploy.mismatch.benchmark.sweep " + " ".join(argv),
+        "episode_cfg": ep_cfg,
+        "motion": asdict(MotionCfg()),
+        "analysis_cfg": asdict(AnalysisCfg()),
+        "episodes": [e["name"] for e in eps],
+        "wall_s": wall,
+        "cpu_s_children": cpu,
+        "cpus": os.cpu_count(),
+        "load_avg_at_end": os.getloadavg(),
+        "python": platform.python_version(),
+    }
+    (out / "manifest.json").write_text(json.dumps(man, indent=2, default=str))
+
+
 def main(argv: list[str] | None = None) -> None:
-    """Run the sweep and write ``summary.json``."""
+    """Run the sweep and write ``summary.json`` and ``manifest.json``."""
     from gmloco.deploy.mismatch.benchmark.episodes import episode_list
     from gmloco.deploy.mismatch.benchmark.scorer import score
 
     p = argparse.ArgumentParser()
     p.add_argument("--out", type=Path, required=True)
     p.add_argument("--workers", type=int, default=2)
-    p.add_argument("--seeds", type=int, default=2)
-    p.add_argument("--nulls", type=int, default=8)
+    p.add_argument("--seeds", type=int, default=1)
+    p.add_argument("--nulls", type=int, default=20)
     p.add_argument("--duration", type=float, default=8.0)
     p.add_argument("--strengths", default="mid")
     p.add_argument(
@@ -96,6 +141,8 @@ def main(argv: list[str] | None = None) -> None:
     )
     p.add_argument("--only", default=None, help="comma-separated episode-name prefixes")
     p.add_argument("--score-only", action="store_true", help="score the rows already under OUT/rows and exit")
+    p.add_argument("--resume", action="store_true", help="skip episodes whose row already exists under OUT/rows")
+    argv = list(sys.argv[1:] if argv is None else argv)
     a = p.parse_args(argv)
     if a.score_only:
         rows = [json.loads(f.read_text()) for f in sorted((a.out / "rows").glob("*.json"))]
@@ -107,10 +154,18 @@ def main(argv: list[str] | None = None) -> None:
     if a.only:
         eps = [e for e in eps if any(e["name"].startswith(s) for s in a.only.split(","))]
     a.out.mkdir(parents=True, exist_ok=True)
+    todo = [e for e in eps if not (a.resume and (a.out / "rows" / f"{e['name']}.json").exists())]
+    t0 = time.time()
     with Pool(a.workers) as pool:
-        rows = pool.map(_star, [(e, str(a.out), a.duration, a.keep_before_fall) for e in eps], chunksize=1)
+        fresh = pool.map(_star, [(e, str(a.out), a.duration, a.keep_before_fall) for e in todo], chunksize=1)
+    cpu = sum(os.times()[2:4])
+    names = {e["name"] for e in eps}
+    by_name = {r["name"]: r for r in fresh}
+    rows = [by_name.get(n) or json.loads((a.out / "rows" / f"{n}.json").read_text()) for n in sorted(names)]
     (a.out / "rows.json").write_text(json.dumps(rows, indent=1, default=float))
-    (a.out / "summary.json").write_text(json.dumps(score(rows), indent=2, default=float))
+    summary = {**score(rows), "episodes_scored": len(rows), "wall_s": time.time() - t0}
+    (a.out / "summary.json").write_text(json.dumps(summary, indent=2, default=float))
+    _manifest(a.out, argv, eps, time.time() - t0, cpu)
 
 
 if __name__ == "__main__":

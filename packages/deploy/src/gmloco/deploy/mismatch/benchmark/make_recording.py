@@ -1,0 +1,50 @@
+# SPDX-License-Identifier: Apache-2.0
+"""Write one concealed-effect recording as MCAP, with its truth key in a separate file.
+
+Usage::
+
+    python -m gmloco.deploy.mismatch.benchmark.make_recording --effect imu.gyro_bias
+        --params '{"bias": [0.03, -0.02, 0.015]}' --out real.mcap --key /elsewhere/key.json
+
+Without ``--params`` the benchmark's mid strength is used. Only the channels a G1 logs are written (LowState,
+LowCmd, IMU; no odometry unless ``--odometry``). Give the MCAP to ``gmloco-mismatch --real``; keep the key away
+from it.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+from pathlib import Path
+
+__all__ = ["main"]
+
+
+def main(argv: list[str] | None = None) -> None:
+    """Generate the recording and write the MCAP and the key."""
+    from gmloco.deploy.mismatch.benchmark.episodes import MID, OOL
+    from gmloco.deploy.mismatch.benchmark.generator import EpisodeCfg, generate
+    from gmloco.deploy.mismatch.benchmark.truth import TruthEffect
+    from gmloco.deploy.mismatch.io import write_recording
+
+    p = argparse.ArgumentParser(prog="make_recording", description=__doc__)
+    p.add_argument("--effect", default="none", help="effect id, 'none', or an ool.* id")
+    p.add_argument("--params", default=None, help="JSON dict of parameter lists (default: mid strength)")
+    p.add_argument("--duration", type=float, default=9.0, help="recording length [s]")
+    p.add_argument("--seed", type=int, default=100)
+    p.add_argument("--odometry", action="store_true", help="also log ground-truth base odometry")
+    p.add_argument("--out", type=Path, required=True, help="MCAP to write")
+    p.add_argument("--key", type=Path, required=True, help="truth key JSON (keep it where the tool cannot read it)")
+    a = p.parse_args(argv)
+    params = json.loads(a.params) if a.params else {**MID, **OOL}.get(a.effect, {})
+    rec, key = generate(
+        EpisodeCfg(effect=TruthEffect(a.effect, params), duration=a.duration, seed=a.seed, odometry=a.odometry)
+    )
+    write_recording(rec, a.out, controller="scripted_step", overwrite=True)
+    a.key.parent.mkdir(parents=True, exist_ok=True)
+    a.key.write_text(json.dumps(key, indent=2))
+    print(json.dumps({"mcap": str(a.out), "key": str(a.key), "duration_s": rec.n * rec.dt}))
+
+
+if __name__ == "__main__":
+    main()
