@@ -59,6 +59,10 @@ def task_cfg(section: DictConfig) -> Any:
 
     task = g1_granular_task(str(section.contact_model.value), str(section.terrain.value))  # type: ignore[arg-type]
     clearance = section.get("foot_clearance", "penalty")
+    if str(getattr(section.get("algorithm", ""), "value", "")) == "vae_teacher":
+        from gmloco.train.teacher_student.heldout import with_held_out
+
+        task = with_held_out(task)  # the materials eval_ts scores as never seen in training
     return replace(
         task,
         policy_history_length=int(section.policy_history_length),

@@ -44,6 +44,11 @@ class MaterialRangeCfg:
     """Uniform range of the cone models' flank stress per depth [N/m^3] (cone models only)."""
     preset: str | None = None
     """Name in ``gmloco.contact.MATERIAL_PRESETS``; when set every env uses it and nothing is drawn."""
+    held_out_rho_c: tuple[float, float] | None = None
+    """rho_c range [kg/m^3] of a (rho_c, mu_int) rectangle the DR never draws: materials held out for evaluation
+    (``gmloco.train.teacher_student.heldout``); None (or ``held_out_mu_int`` None): no hole."""
+    held_out_mu_int: tuple[float, float] | None = None
+    """mu_int range [-] of the held-out rectangle; must lie inside ``mu_int``."""
 
 
 @dataclass

@@ -89,6 +89,12 @@ class MaterialWriter:
         """Zero-copy torch views of the model's per-world parameter arrays, each [W]."""
         self.pinned: dict[str, torch.Tensor] | None = None
         """Per-env (rho_c, mu_int, mu_surf) used instead of drawing, set by :meth:`pin`."""
+        self.held_out = None
+        """(rho_c, mu_int) rectangle the uniform draw avoids (``ranges.held_out_*``), or None."""
+        if ranges.held_out_rho_c is not None and ranges.held_out_mu_int is not None:
+            from gmloco.train.teacher_student.heldout import HeldOutRegionCfg
+
+            self.held_out = HeldOutRegionCfg(rho_c=ranges.held_out_rho_c, mu_int=ranges.held_out_mu_int)
 
     def pin(self, rho_c: torch.Tensor, mu_int: torch.Tensor, mu_surf: torch.Tensor) -> None:
         """Fix every env's material (each tensor [W]); later resets keep it instead of drawing."""
@@ -110,8 +116,14 @@ class MaterialWriter:
             v["mu_int"][env_ids] = float(self.preset.mu_int)
             v["mu_surf"][env_ids] = float(self.preset.mu_surf)
         else:
-            v["rho_c"][env_ids] = self._uniform(r.packing, n) * self._uniform(r.bulk_density, n)
-            v["mu_int"][env_ids] = self._uniform(r.mu_int, n)
+            rho_c = self._uniform(r.packing, n) * self._uniform(r.bulk_density, n)
+            mu_int = self._uniform(r.mu_int, n)
+            if self.held_out is not None:
+                from gmloco.train.teacher_student.heldout import redraw_outside
+
+                mu_int = redraw_outside(self.held_out, rho_c, mu_int, r.mu_int)
+            v["rho_c"][env_ids] = rho_c
+            v["mu_int"][env_ids] = mu_int
             v["mu_surf"][env_ids] = self._uniform(r.mu_surf, n)
         for name in ("sigma_flat", "sigma_cone"):
             if name in v:
