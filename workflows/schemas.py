@@ -285,7 +285,7 @@ class EvalMpmCfg(StageCfg):
     """Sand depth [m] (the deep terrain has its own 0.30 m)."""
     moving_window: bool = True
     """Sand window moving with each robot (False: a static bed covering the course, the naive baseline)."""
-    window_length: float = 1.6
+    window_length: float = 1.8
     """Moving window size along x [m]."""
     window_width: float = 1.0
     """Moving window size along y [m]."""
@@ -343,6 +343,10 @@ class SweepEvalCfg:
     """Envs per (material, speed) cell."""
     duration_s: float = 10.0
     """Episode duration that counts as success [s]."""
+    smoke_repeats: int = 1
+    """``repeats`` at smoke scale."""
+    smoke_duration_s: float = 0.5
+    """``duration_s`` at smoke scale [s]."""
 
 
 @dataclass

@@ -382,6 +382,8 @@ def _prepare(cfg: DictConfig) -> DictConfig:
     if str(getattr(cfg.scale, "value", cfg.scale)) == "smoke":
         cfg.sweep.n_trials = min(int(cfg.sweep.n_trials), int(cfg.sweep.smoke_trials))
         cfg.sweep.task_overrides = {**cfg.sweep.task_overrides, **cfg.sweep.smoke_task_overrides}
+        ev = cfg.sweep.eval
+        ev.repeats, ev.duration_s = ev.smoke_repeats, ev.smoke_duration_s
         console.print(
             f"[yellow]sweep at smoke scale: {cfg.sweep.n_trials} trials, task {cfg.sweep.smoke_task_overrides}"
         )

@@ -349,7 +349,8 @@ def test_eval_objective_scores_each_chunk_on_the_fixed_evaluation(
     summary = sweep.run_sweep(cfg)
     assert summary["direction"] == "minimize" and summary["finished"] == 3
     for call in calls:
-        assert call.materials == ("dry_sand", "poppy_seed") and call.speeds == (1.0,) and call.repeats == 4
+        assert call.materials == ("dry_sand", "poppy_seed") and call.speeds == (1.0,)
+        assert (call.repeats, call.duration_s) == (1, 0.5)  # smoke_repeats, smoke_duration_s
         assert Path(call.policy_path).name == "policy.onnx" and Path(call.policy_path).parent.name == "train_teacher"
         assert Path(call.out_path).name.startswith("iteration_")
     for row in summary["trials"]:
