@@ -41,18 +41,26 @@ def _write_json(path: Path, data: Any) -> None:
 
 
 def _merge_curve(path: Path, new: dict[str, list[float]]) -> list[dict[str, float]]:
-    """Rows of the old curve plus the chunk's, the chunk winning on repeated iterations."""
+    """Rows of the old curve plus the chunk's, the chunk winning on repeated iterations.
+
+    Columns are the union of the old file's and the chunk's (e.g. the teacher's loss curves); a value a chunk did
+    not log is NaN.
+    """
     rows: dict[int, dict[str, float]] = {}
+    columns = list(_COLUMNS)
     if path.exists():
         with path.open() as f:
-            for r in csv.DictReader(f):
-                rows[int(float(r["iteration"]))] = {k: float(r[k]) for k in _COLUMNS}
+            reader = csv.DictReader(f)
+            columns += [c for c in reader.fieldnames or () if c not in columns]
+            for r in reader:
+                rows[int(float(r["iteration"]))] = {k: float(v) for k, v in r.items() if v not in ("", None)}
+    columns += [c for c in new if c not in columns]
     for i, it in enumerate(new["iteration"]):
-        rows[int(it)] = {k: float(new[k][i]) for k in _COLUMNS}
-    ordered = [rows[k] for k in sorted(rows)]
+        rows[int(it)] = {k: float(v[i]) if v[i] is not None else math.nan for k, v in new.items()}
+    ordered = [{k: rows[it].get(k, math.nan) for k in columns} for it in sorted(rows)]
     tmp = path.with_suffix(".csv.tmp")
     with tmp.open("w", newline="") as f:
-        w = csv.DictWriter(f, fieldnames=_COLUMNS)
+        w = csv.DictWriter(f, fieldnames=columns)
         w.writeheader()
         w.writerows(ordered)
     os.replace(tmp, path)
@@ -84,13 +92,17 @@ def main() -> None:
     summary = json.loads((args.chunk / "summary.json").read_text())
     dest = args.artifacts / args.run
     dest.mkdir(parents=True, exist_ok=True)
-    for name in ("checkpoint.pt", "policy.onnx"):
+    for name in ("checkpoint.pt", "policy.onnx", "policy.json"):
         if (args.chunk / name).exists():
             shutil.copy(args.chunk / name, dest / f"{name}.tmp")
             os.replace(dest / f"{name}.tmp", dest / name)
     _write_json(dest / "train_cfg.json", summary["train_cfg"])
     metrics = {k: (v if not isinstance(v, float) or math.isfinite(v) else None) for k, v in summary["metrics"].items()}
     _write_json(dest / "metrics.json", metrics)
+    if summary.get("checks"):
+        _write_json(dest / "checks.json", summary["checks"])  # teacher-student: eta R2, parity, action error
+    if summary.get("last_values"):
+        _write_json(dest / "last_values.json", summary["last_values"])  # per-term rewards, terminations, curricula
     rows = _merge_curve(dest / "curve.csv", summary["curve"])
     _plot(rows, dest / "learning_curve.png", args.run)
     manifest_path = dest / "manifest.json"
@@ -99,7 +111,7 @@ def main() -> None:
         {
             "commit": args.commit,
             "device": summary.get("device"),
-            "command": "python3 scripts/gpu/train_chunk.py "
+            "command": f"python3 {summary.get('script', 'scripts/gpu/train_chunk.py')} "
             + " ".join(f"--{k} {v}" for k, v in summary["args"].items()),
             "resumed_from_iteration": metrics.get("resumed_from_iteration"),
             "iteration": metrics.get("iteration"),
@@ -111,7 +123,8 @@ def main() -> None:
     manifest["iteration"] = metrics.get("iteration")
     manifest["gpu_minutes_total"] = sum(c["gpu_minutes"] for c in manifest["chunks"])
     manifest["train_cfg"] = "train_cfg.json"
-    manifest["produced_by"] = "scripts/gpu/train_chunk.py on the GPU machine, merged by scripts/gpu/collect_chunk.py"
+    script = summary.get("script", "scripts/gpu/train_chunk.py")
+    manifest["produced_by"] = f"{script} on the GPU machine, merged by scripts/gpu/collect_chunk.py"
     _write_json(manifest_path, manifest)
     print(f"{dest}: iteration {manifest['iteration']}, {manifest['gpu_minutes_total']:.1f} GPU-minutes in total")
 

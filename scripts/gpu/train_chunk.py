@@ -154,6 +154,7 @@ def main() -> None:
         shutil.copy(run_dir / "policy.onnx", args.out / "policy.onnx")
     commit = subprocess.run(["git", "rev-parse", "HEAD"], capture_output=True, text=True).stdout.strip()
     summary: dict[str, Any] = {
+        "script": "scripts/gpu/train_chunk.py",
         "run": args.run,
         "args": {k: str(v) for k, v in vars(args).items()},
         "seeded_from_artifact_iteration": seeded,

@@ -281,6 +281,7 @@ def main(argv: list[str] | None = None) -> dict[str, Any]:
     import torch
 
     summary: dict[str, Any] = {
+        "script": "scripts/gpu/train_ts_chunk.py",
         "run": run,
         "stage": args.stage,
         "args": {k: str(v) for k, v in vars(args).items()},
