@@ -3,25 +3,16 @@
 
 from __future__ import annotations
 
-import importlib.util
 import json
-import sys
 from pathlib import Path
 from types import ModuleType
 
-ROOT = Path(__file__).resolve().parents[2]
+from tests.contact.by_path import load_module
 
 
 def bench_module() -> ModuleType:
     """Import scripts/gpu/bench_contact.py by path."""
-    name = "bench_contact_script"
-    if name not in sys.modules:
-        spec = importlib.util.spec_from_file_location(name, ROOT / "scripts/gpu/bench_contact.py")
-        assert spec is not None and spec.loader is not None
-        module = importlib.util.module_from_spec(spec)
-        sys.modules[name] = module
-        spec.loader.exec_module(module)
-    return sys.modules[name]
+    return load_module("bench_contact_script", "scripts/gpu/bench_contact.py")
 
 
 def test_bench_writes_every_record_and_resumes(tmp_path: Path) -> None:

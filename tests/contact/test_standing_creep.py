@@ -12,10 +12,7 @@ load below mu F_n is held by a static offset of at most 2 mm, so the feet stop.
 
 from __future__ import annotations
 
-import importlib.util
-import sys
 from dataclasses import dataclass
-from pathlib import Path
 from types import ModuleType
 
 import mujoco
@@ -24,20 +21,12 @@ import pytest
 import warp as wp
 
 from gmloco.contact import ContactRFT3DCfg, MaterialCfg, g1_foot_box_cfg, g1_foot_collider, make_contact_model
-
-ROOT = Path(__file__).resolve().parents[2]
+from tests.contact.by_path import load_module
 
 
 def standing_harness() -> ModuleType:
     """Import packages/train/tests/test_standing_on_sand.py by path (its G1 model, pose, gains and inputs)."""
-    name = "standing_on_sand_harness"
-    if name not in sys.modules:
-        spec = importlib.util.spec_from_file_location(name, ROOT / "packages/train/tests/test_standing_on_sand.py")
-        assert spec is not None and spec.loader is not None
-        module = importlib.util.module_from_spec(spec)
-        sys.modules[name] = module
-        spec.loader.exec_module(module)
-    return sys.modules[name]
+    return load_module("standing_on_sand_harness", "packages/train/tests/test_standing_on_sand.py")
 
 
 @dataclass
