@@ -399,16 +399,20 @@ def _create_study(cfg: DictConfig) -> Any:
         Path(storage.removeprefix("sqlite:///")).parent.mkdir(parents=True, exist_ok=True)
     optuna.logging.set_verbosity(optuna.logging.WARNING)
     sweep = cfg.sweep
-    return optuna.create_study(
+    study = optuna.create_study(
         study_name=str(sweep.study_name),
         storage=storage,
-        sampler=optuna.samplers.TPESampler(seed=int(sweep.sampler_seed), n_startup_trials=int(sweep.n_startup_trials)),
         pruner=optuna.pruners.MedianPruner(
             n_startup_trials=int(sweep.pruner_startup_trials), n_warmup_steps=int(sweep.pruner_warmup_steps)
         ),
         direction="maximize" if str(sweep.direction) == "maximize" else "minimize",
         load_if_exists=True,
     )
+    # The sampler's RNG lives in this process: a resumed call seeded like the first would repeat its samples, so
+    # the seed is offset by the trials already stored (still reproducible from the study's history).
+    seed = int(sweep.sampler_seed) + len(study.get_trials(deepcopy=False))
+    study.sampler = optuna.samplers.TPESampler(seed=seed, n_startup_trials=int(sweep.n_startup_trials))
+    return study
 
 
 def _retry(study: Any, trial: Any) -> None:

@@ -202,7 +202,9 @@ def test_study_runs_trials_in_run_dirs_prunes_and_resumes(
     summary matches the storage.
     """
     fake = fake_training()
-    summary = sweep.run_sweep(_sweep_cfg(compose, tmp_path, 5))
+    first_cfg = _sweep_cfg(compose, tmp_path, 5)
+    first_cfg.sweep.n_startup_trials = 10  # random sampling throughout: the resume check below needs it
+    summary = sweep.run_sweep(first_cfg)
     assert summary["exit_code"] == 0 and summary["finished"] == 5
     assert (tmp_path / "study.db").is_file() and (tmp_path / "config.yaml").is_file() and (tmp_path / "git").is_dir()
     rows = {r["number"]: r for r in summary["trials"]}
@@ -233,9 +235,13 @@ def test_study_runs_trials_in_run_dirs_prunes_and_resumes(
     assert len((tmp_path / "trials.csv").read_text().splitlines()) == 6
     assert (tmp_path / "figures" / "sweep.png").stat().st_size > 10_000
     # A second call continues the study to 6 trials; the first 5 are kept as they were.
-    again = sweep.run_sweep(_sweep_cfg(compose, tmp_path, 6))
+    again_cfg = _sweep_cfg(compose, tmp_path, 6)
+    again_cfg.sweep.n_startup_trials = 10
+    again = sweep.run_sweep(again_cfg)
     assert again["finished"] == 6 and [r["number"] for r in again["trials"]] == list(range(6))
     assert [r["value"] for r in again["trials"][:5]] == [rows[n]["value"] for n in range(5)]
+    # The resumed call does not repeat the first call's samples (its sampler seed is offset by the stored trials).
+    assert len({r["params"][MU_KEY] for r in again["trials"]}) == 6
 
 
 def test_time_box_interrupts_a_trial_and_the_next_call_continues_it(
@@ -250,6 +256,8 @@ def test_time_box_interrupts_a_trial_and_the_next_call_continues_it(
     assert second["exit_code"] == 0 and second["finished"] == 3
     retry = next(r for r in second["trials"] if r["retry_of"] == 1)
     assert retry["number"] == 2 and retry["run_dir"] == "trials/0001"
+    fresh = next(r for r in second["trials"] if r["number"] == 3)
+    assert fresh["params"] != retry["params"] and fresh["run_dir"] == "trials/0003"
     interrupted = [c for c in fake.calls if c["trial"] == 1]
     continued = [c for c in fake.calls if c["trial"] == 2]
     assert interrupted == [{**interrupted[0], "start": 0, "end": 2}]
