@@ -24,6 +24,7 @@ from gmloco.contact.kernels_state import (
     at_rest_filter,
     elastic_depth,
     point_kernel_data,
+    rft_element_model,
 )
 
 __all__ = ["eval_heuristic_point_forces", "rft2d_alpha_z", "rft2d_angles"]
@@ -148,15 +149,7 @@ def eval_heuristic_point_forces(model: Any, inputs: tuple, nan_count_out: wp.arr
         inputs=[
             model.coeffs,
             model.dimensional,
-            model.points_b,
-            model.normals_b,
-            model.areas,
-            model.rho_c,
-            model.mu_int,
-            model.mu_surf,
-            model.terrain,
-            cfg.gravity,
-            cfg.v_eps,
+            *rft_element_model(model),
             cfg.k_f,
             model.rest,
             *point_kernel_data(model, inputs),

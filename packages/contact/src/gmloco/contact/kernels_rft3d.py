@@ -27,6 +27,7 @@ from gmloco.contact.kernels_state import (
     crater_friction,
     elastic_depth,
     point_kernel_data,
+    rft_element_model,
 )
 
 __all__ = [
@@ -246,21 +247,7 @@ def rft3d_point_force_kernel(
 
 def _rft3d_model_inputs(model: Any) -> list:
     """Return the ``# Model:`` arguments shared by the per-point and the fused 3D-RFT kernels."""
-    cfg = model.cfg
-    return [
-        model.coeffs,
-        model.points_b,
-        model.normals_b,
-        model.areas,
-        model.rho_c,
-        model.mu_int,
-        model.mu_surf,
-        model.terrain,
-        cfg.gravity,
-        cfg.v_eps,
-        int(cfg.sign_fix),
-        model.rest,
-    ]
+    return [model.coeffs, *rft_element_model(model), int(model.cfg.sign_fix), model.rest]
 
 
 def eval_rft3d_point_forces(model: Any, inputs: tuple, nan_count_out: wp.array) -> None:

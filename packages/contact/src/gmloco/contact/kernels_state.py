@@ -24,6 +24,7 @@ __all__ = [
     "eval_zero_wrench",
     "impact_damping",
     "point_kernel_data",
+    "rft_element_model",
     "unloading_depth",
 ]
 
@@ -191,6 +192,15 @@ def advance_stick_anchor(
     length = wp.length(s_t)
     if length > distance:
         anchor_out[w, f, p] = x - s_t * (distance / length)
+
+
+def rft_element_model(model: Any) -> list:
+    """Return the ``# Model:`` arguments the RFT element kernels share, in their order.
+
+    Collider points, normals and areas, per-world rho_c, mu_int, mu_surf, the terrain, gravity [m/s^2], v_eps [m/s].
+    """
+    pts = [model.points_b, model.normals_b, model.areas]
+    return [*pts, model.rho_c, model.mu_int, model.mu_surf, model.terrain, model.cfg.gravity, model.cfg.v_eps]
 
 
 def point_kernel_data(model: Any, inputs: tuple) -> list:
