@@ -48,3 +48,17 @@ def test_scores_by_hand() -> None:
     np.testing.assert_allclose(o["median_param_err_mid"], 0.125)
     np.testing.assert_allclose(o["ci_coverage_mid"], 0.0)
     np.testing.assert_allclose(s["per_effect"]["actuator.delay@mid"]["median_oracle_frac"], 0.875)
+
+
+def test_config_patch_round_trips_to_flat_parameters() -> None:
+    """A report's config patch maps back to the flat vector the replay takes (labels by component)."""
+    from gmloco.deploy.mismatch.effects import effect, params_from_patch
+
+    spec = effect("sensor.encoder_offset")
+    labels = spec.labels()
+    patch = {"sensor.encoder_offset": {labels[3]: 0.03, labels[6]: -0.03}, "actuator.delay": {"delay": 0.008}}
+    p = params_from_patch(patch)
+    expect = np.zeros(12)
+    expect[3], expect[6] = 0.03, -0.03
+    np.testing.assert_array_equal(p["sensor.encoder_offset"], expect)
+    np.testing.assert_array_equal(p["actuator.delay"], [0.008])

@@ -16,7 +16,17 @@ import numpy as np
 
 from gmloco.deploy.logs.g1 import G1_JOINT_NAMES
 
-__all__ = ["EFFECTS", "EFFECT_IDS", "LEG_JOINTS", "OUTCOME_IDS", "EffectSpec", "ParamSpec", "effect", "zero_params"]
+__all__ = [
+    "EFFECTS",
+    "EFFECT_IDS",
+    "LEG_JOINTS",
+    "OUTCOME_IDS",
+    "EffectSpec",
+    "ParamSpec",
+    "effect",
+    "params_from_patch",
+    "zero_params",
+]
 
 LEG_JOINTS: tuple[str, ...] = G1_JOINT_NAMES[:12]
 """Joints carrying per-joint effect parameters (encoder offsets): the two legs, hip to ankle."""
@@ -297,6 +307,27 @@ def effect(effect_id: str) -> EffectSpec:
         if e.id == effect_id:
             return e
     raise KeyError(f"unknown effect id {effect_id!r}; vocabulary: {EFFECT_IDS}")
+
+
+def params_from_patch(patch: dict[str, dict[str, float]]) -> dict[str, np.ndarray]:
+    """Turn a report's ``config_patch`` (``{effect_id: {label: value}}``) into the replay's flat parameters.
+
+    Labels are :meth:`EffectSpec.labels` (``name`` or ``name[component]``); missing components stay nominal (0).
+
+    Raises:
+        KeyError: Unknown effect id or label.
+    """
+    out = {}
+    for eid, values in patch.items():
+        spec = effect(eid)
+        labels = spec.labels()
+        theta = np.zeros(spec.size)
+        for lab, v in values.items():
+            if lab not in labels:
+                raise KeyError(f"effect {eid!r} has no parameter {lab!r}; labels: {labels}")
+            theta[labels.index(lab)] = float(v)
+        out[eid] = theta
+    return out
 
 
 def zero_params() -> dict[str, np.ndarray]:

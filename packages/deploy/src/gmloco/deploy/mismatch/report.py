@@ -15,7 +15,8 @@
   followed by ``{id: "none"}`` and ``{id: "unexplained"}`` entries with their weights.
 * ``untested``: ``[{id, reason, needs}]`` effects this recording cannot test, and what would make them testable.
 * ``before_after``: held-out ``{nrmse_nominal, nrmse_fitted}`` per signal group.
-* ``config_patch``: ``{effect_id: {param: value}}`` for the simulator (the replay accepts it as ``params``).
+* ``config_patch``: ``{effect_id: {param: value}}`` for the simulator
+  (``Replayer.simulate(effects.params_from_patch(patch), starts)`` replays with it).
 * ``runtime_s``.
 """
 
@@ -160,7 +161,10 @@ def build_report(
         ],
         "before_after": {
             "heldout": {
-                "nrmse_nominal": _group_nrmse(pb, pb.y - r0 * pb.sigma),
+                # r0 carries the group-balance weights: divide them out to recover the nominal simulation
+                "nrmse_nominal": _group_nrmse(
+                    pb, pb.y - np.divide(r0, pb.weight, out=np.zeros_like(r0), where=pb.weight > 0) * pb.sigma
+                ),
                 "nrmse_fitted": _group_nrmse(pb, fitted),
             }
         },
