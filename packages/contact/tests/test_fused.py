@@ -88,8 +88,8 @@ def run_both(cfg: object, seed: int, steps: int = 8, terrain: object = None) -> 
 
 @pytest.mark.parametrize("faces", ["sole", "box"])
 @pytest.mark.parametrize("at_rest", ["unloading", "none", "ema"])
-def test_rft3d_fused_equals_previous_kernels(device: str, faces: str, at_rest: str) -> None:
-    """Fused 3D-RFT compute + kinematic update_state = the previous kernels on random multi-substep sequences."""
+def test_rft3d_fused_equals_unfused(device: str, faces: str, at_rest: str) -> None:
+    """Fused 3D-RFT compute = per-point pass + per-foot loop on random multi-substep sequences (and same state)."""
     run_both(ContactRFT3DCfg(collider=g1_foot_box_cfg(faces, 5), at_rest=at_rest), seed=len(faces) + len(at_rest))
 
 
@@ -105,8 +105,8 @@ def test_rft3d_fused_on_terrain_field(device: str) -> None:
     [ContactHeuristicRFTCfg(collider=g1_foot_box_cfg("box", 4)), ContactConeMultiCfg(), ContactConeSingleCfg()],
     ids=["heuristic", "cone_multi", "cone_single"],
 )
-def test_other_models_fast_path_equals_previous(device: str, cfg: object) -> None:
-    """Tiled per-foot sum and kinematic update_state leave Heuristic-RFT and cone results unchanged."""
+def test_other_models_tiled_sum_equals_unfused(device: str, cfg: object) -> None:
+    """The tiled per-foot sum gives Heuristic-RFT and cone the same element outputs and wrenches as the loop."""
     run_both(cfg, seed=5)
 
 
