@@ -58,7 +58,10 @@ def test_main_command_runs_every_implemented_stage(tmp_path: Path) -> None:
     export = rows["export"]["metrics"]
     assert export["onnx_max_abs_diff"] <= 1e-5 and export["rollout_onnx_max_abs_diff"] <= 1e-5
     assert rows["train_teacher"]["metrics"]["iteration"] == 2 and rows["distill"]["metrics"]["iteration"] == 2
-    assert rows["analyze_logs"]["metrics"]["recordings"] == len(SAMPLE_LOGS)
+    # the sample recordings plus the MPM evaluation's own (one per episode group, found in the run directory)
+    eval_mcaps = list((tmp_path / "eval_mpm").rglob("*.mcap"))
+    assert len(eval_mcaps) == 1
+    assert rows["analyze_logs"]["metrics"]["recordings"] == len(SAMPLE_LOGS) + len(eval_mcaps)
     assert rows["mismatch"]["metrics"]["verdict"] in {"no_mismatch", "explained", "unexplained", "invalid_input"}
 
 

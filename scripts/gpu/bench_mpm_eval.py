@@ -49,7 +49,7 @@ def _parse() -> argparse.Namespace:
     p.add_argument("--max-minutes", type=float, default=8.5)
     p.add_argument("--tol", type=float, default=0.15, help="relative tolerance of the convergence check")
     p.add_argument("--device", default=None)
-    p.add_argument("--window-length", type=float, default=1.6)
+    p.add_argument("--window-length", type=float, default=1.8)
     p.add_argument("--window-width", type=float, default=1.0)
     return p.parse_args()
 

@@ -31,7 +31,7 @@ def _parse(argv: list[str] | None) -> argparse.Namespace:
     p.add_argument("--voxel", type=float, default=0.05)
     p.add_argument("--robots-per-batch", type=int, default=25)
     p.add_argument("--static-bed", action="store_true", help="naive baseline: a bed covering the course")
-    p.add_argument("--window-length", type=float, default=1.6)
+    p.add_argument("--window-length", type=float, default=1.8)
     p.add_argument("--window-width", type=float, default=1.0)
     p.add_argument("--no-mcap", action="store_true")
     p.add_argument("--max-minutes", type=float, default=None)

@@ -32,11 +32,11 @@ class SandWindowCfg:
 
     moving: bool = True
     """Recentre the window on the robot every frame (recycling columns); False = a static bed."""
-    length: float = 1.6
-    """Window size along x [m]."""
+    length: float = 1.8
+    """Window size along x [m] (default: the rear wall 0.7 m behind the pelvis, beyond a trailing foot's reach)."""
     width: float = 1.0
     """Window size along y [m]."""
-    lead: float = 0.25
+    lead: float = 0.2
     """Window centre ahead of the pelvis along its heading [m] (static: at the start)."""
     offset_y: float = 0.0
     """Window centre left of the pelvis heading [m] (static beds around a circular course)."""
