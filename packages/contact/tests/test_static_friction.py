@@ -92,3 +92,62 @@ def test_static_friction_off_in_other_modes(device: str) -> None:
     for mode in ("none", "ema"):
         model = make_contact_model(ContactRFT3DCfg(at_rest=mode), 1, 1, "cpu")
         assert model.rest.stick_distance == 0.0
+
+
+def test_stateful_sequence_matches_float64_reference(device: str) -> None:
+    """Kernel forces and anchors over a sliding, pressing and lifting sequence = the float64 reference's own state.
+
+    The reference keeps its own z_max and anchors (``advance_stick_anchors``, z_max = max(z_max, d) in contact,
+    0 out of it) from the float32-rounded inputs, so the whole stateful chain is compared, not one step. Impact
+    damping is off (its gate needs the EMA reversal counter, which the reference does not model). Elements within
+    1 um of a branch boundary (d = 0, d = z_max, |s_t| = s0) are skipped: float32 may take the other branch.
+    """
+    from gmloco.contact.reference import advance_stick_anchors, rft3d_unloading_forces
+
+    rng = np.random.default_rng(4)
+    n_feet, mat = 4, MATERIAL_PRESETS["dry_sand"]
+    cfg = ContactRFT3DCfg(collider=g1_foot_box_cfg("box", 3), unloading_speed=0.0)
+    model = make_contact_model(cfg, 1, n_feet, "cpu")
+    col = model.collider
+    rot = np.stack([np.eye(3)] * n_feet) @ np.linalg.qr(np.eye(3) + 0.05 * rng.normal(size=(n_feet, 3, 3)))[0]
+    rot *= np.sign(np.linalg.det(rot))[:, None, None]  # proper rotations, tilted a few degrees
+    pos = np.column_stack([rng.uniform(-0.3, 0.3, (n_feet, 2)), np.full(n_feet, 0.03539 - 0.012)])
+    depth_max = np.zeros((n_feet, col.num_points))
+    anchors = np.zeros((n_feet, col.num_points, 3))
+    checked = {"elastic": 0, "slipping": 0}
+    for step in range(14):
+        pos = pos + np.column_stack([rng.uniform(-1.5e-3, 1.5e-3, (n_feet, 2)), rng.uniform(-1e-3, 1e-3, n_feet)])
+        vel = rng.normal(scale=0.05, size=(n_feet, 3))
+        arrays = (pos, rot, vel, np.zeros((n_feet, 3)), pos)
+        inputs = tuple(
+            wp.array(a[None].astype(np.float32), dtype=t, device="cpu")
+            for a, t in zip(arrays, (wp.vec3, wp.mat33, wp.vec3, wp.vec3, wp.vec3), strict=True)
+        )
+        out = wp.zeros((1, n_feet), dtype=wp.spatial_vectorf, device="cpu")
+        model.compute(*inputs, out)
+        forces = model.point_force.numpy()[0].astype(np.float64)
+        model.update_state(*inputs)
+        for f in range(n_feet):
+            p32, r32, v32 = (np.asarray(a[f], dtype=np.float32).astype(np.float64) for a in (pos, rot, vel))
+            x, n, v = p32 + col.points @ r32.T, col.normals @ r32.T, np.tile(v32, (col.num_points, 1))
+            depth = -x[:, 2]
+            ref = rft3d_unloading_forces(
+                x, n, v, col.areas, depth_max[f], rho_c=mat.rho_c, mu_int=mat.mu_int, mu_surf=mat.mu_surf,
+                ratio=cfg.unloading_ratio, tangential_damping=cfg.tangential_damping, damping=cfg.unloading_damping,
+                anchors=anchors[f], stick_distance=cfg.stick_distance,
+            )  # fmt: skip
+            s_t = (x - anchors[f]) - np.sum((x - anchors[f]) * n, -1, keepdims=True) * n
+            slip = np.linalg.norm(s_t, axis=-1)
+            ok = (np.abs(depth) > 1e-6) & (np.abs(depth - depth_max[f]) > 1e-6) & (np.abs(slip - 0.002) > 1e-6)
+            scale = max(np.abs(ref).max(), 1e-9)
+            np.testing.assert_allclose(forces[f][ok], ref[ok], atol=1e-4 * scale, err_msg=f"step {step} foot {f}")
+            elastic = ok & (depth > 0.0) & (depth < depth_max[f])
+            checked["elastic"] += int(elastic.sum())
+            checked["slipping"] += int((elastic & (slip > 0.002)).sum())
+            new_anchors = advance_stick_anchors(x, n, anchors[f], depth_max[f], cfg.stick_distance)
+            anchors[f] = np.where((depth > 0.0)[:, None], new_anchors, anchors[f])
+            depth_max[f] = np.where(depth > 0.0, np.maximum(depth_max[f], depth), 0.0)
+            sub = depth > 0.0
+            np.testing.assert_allclose(model.anchor.numpy()[0, f][sub], anchors[f][sub], atol=2e-6)
+            np.testing.assert_allclose(model.depth_max.numpy()[0, f], depth_max[f], atol=1e-7)
+    assert checked["elastic"] > 50 and checked["slipping"] > 10, checked  # both crater regimes were exercised

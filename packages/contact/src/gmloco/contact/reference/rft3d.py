@@ -275,9 +275,10 @@ def advance_stick_anchors(
 ) -> np.ndarray:
     """Return the stick anchors after one substep [m], [N, 3] (Cundall-Strack spring with a Coulomb slider).
 
-    ``depth_max`` is z_max before this substep's update. Emerged elements keep their anchor (never read); at
-    touch-down (z_max = 0) the anchor is the element's position; otherwise it slides after the element just
-    enough that the tangential offset |s_t| <= ``stick_distance``.
+    ``depth_max`` is z_max before this substep's update. Emerged elements keep their anchor (never read); an
+    element at touch-down or loading (depth >= z_max: the plastic branch, whose tangential force is plain RFT) is
+    re-anchored at its position; inside its crater the anchor slides after the element just enough that the
+    tangential offset |s_t| <= ``stick_distance``.
     """
     x = np.asarray(points, dtype=np.float64)
     a = np.asarray(anchors, dtype=np.float64)
@@ -285,7 +286,7 @@ def advance_stick_anchors(
     s_t = _tangential(x - a, np.asarray(normals, dtype=np.float64))
     length = np.linalg.norm(s_t, axis=-1, keepdims=True)
     slid = np.where(length > stick_distance, x - s_t * stick_distance / np.maximum(length, 1e-300), a)
-    new = np.where((np.asarray(depth_max) <= 0.0)[:, None], x, slid)
+    new = np.where((depth >= np.asarray(depth_max))[:, None], x, slid)
     return np.where((depth > 0.0)[:, None], new, a)
 
 
