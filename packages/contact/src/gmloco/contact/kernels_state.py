@@ -1,5 +1,9 @@
 # SPDX-License-Identifier: Apache-2.0
-"""At-rest regularization: elastic unloading depth, EMA filter, and the once-per-substep state update."""
+"""At-rest regularization, the structs every kernel shares, and the once-per-substep state update.
+
+Elastic unloading, impact damping, crater friction with stick anchors and the EMA filter; ``AtRestParams`` and
+``ElementState``; the state update and reset kernels.
+"""
 
 from __future__ import annotations
 
