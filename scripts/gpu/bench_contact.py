@@ -1,6 +1,6 @@
 """Contact-kernel cost per launch and its share of one G1 MuJoCo Warp physics step, measured in one run.
 
-    source scripts/gpu/env.sh && python3 scripts/gpu/bench_contact.py --num-worlds 4096 --out $OUT/bench_contact
+    source scripts/gpu/env.sh && python3 scripts/gpu/bench_contact.py --num-worlds 4096 --out runs/bench_contact
 
 For every contact model and collider size (sole 5x5 = 25 points, six-face 5x5 = 150 points per foot) it times
 ``model.compute`` (the stateless part that runs inside the passive callback) and, for stateful models,
