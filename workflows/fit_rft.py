@@ -30,7 +30,7 @@ def main() -> None:
     p.add_argument("--out-dir", default="results/rft_fit")
     p.add_argument("--material", default="dry_sand", help="gmloco.contact.MATERIAL_PRESETS name")
     p.add_argument("--voxel-size", type=float, default=0.02)
-    p.add_argument("--max-iterations", type=int, default=50, help="rheology iterations (>= 25)")
+    p.add_argument("--max-iterations", type=int, default=250, help="rheology iterations (>= 25)")
     p.add_argument("--plate-size", type=float, default=0.1)
     p.add_argument("--speed", type=float, default=0.5, help="plate speed [m/s]")
     p.add_argument("--bed", type=float, nargs=3, default=[0.7, 0.7, 0.35], help="bed x, y, depth [m]")
