@@ -43,6 +43,7 @@ def main() -> None:
     p.add_argument("--batch", type=int, default=1, help="plate runs per MPM solve (GPU: ~9)")
     p.add_argument("--max-minutes", type=float, default=60.0)
     p.add_argument("--device", default=None)
+    p.add_argument("--no-figure", action="store_true", help="skip fig_rft_fit.png (no matplotlib on the GPU image)")
     p.add_argument("--smoke", action="store_true", help="CPU smoke: 2 plate runs, tiny bed")
     a = p.parse_args()
     if a.smoke:
@@ -54,7 +55,7 @@ def main() -> None:
         plate = replace(base.plate, plate_size=a.plate_size, speed=a.speed, bed=bed, solver=solver, device=a.device,
                         depth_range=tuple(a.depth_range), travel_before_sampling=a.lead_in)  # fmt: skip
         cfg = replace(base, out_dir=a.out_dir, material=a.material, plate=plate, ridge=a.ridge,
-                      max_minutes=a.max_minutes, batch=a.batch)  # fmt: skip
+                      max_minutes=a.max_minutes, batch=a.batch, make_figure=not a.no_figure)  # fmt: skip
         for name, value in (("gamma_deg", a.gammas), ("beta_deg", a.betas), ("psi_deg", a.psis)):
             if value:
                 cfg = replace(cfg, **{name: tuple(value)})

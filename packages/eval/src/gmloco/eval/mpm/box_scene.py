@@ -275,7 +275,11 @@ class MpmBoxScene:
         return self.frame / max(self.wall_time, 1e-9)
 
     def test_final(self) -> None:
-        """Assert physical sanity: finite state, boxes above the floor, sand inside the containers."""
+        """Assert physical sanity: finite state, boxes above the floor, sand inside the containers.
+
+        Also ask Newton whether the sparse grid ever ran out of capacity (it reports that only when asked).
+        """
+        self.mpm.check_sparse_grid_rebuild_status()
         q = np.asarray(self.body_q_all[-1])
         assert np.all(np.isfinite(q)), "box state is not finite"
         assert np.all(q[:, 2] > -self.cfg.bed.depth), f"a box fell through the bed (z = {q[:, 2].min():.3f} m)"

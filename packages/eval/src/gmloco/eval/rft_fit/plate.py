@@ -221,6 +221,7 @@ def run_plate_intrusions(
             force[:, k] = wrench.numpy()[bodies][:, :3]
             depth[:, k] = -(q_np[bodies, 2] + 0.5 * qd_np[bodies, 2] * s.frame_dt)  # centroid depth at mid-step
         loop_s = time.perf_counter() - t_loop
+        mpm.check_sparse_grid_rebuild_status()  # raises if the sparse grid ran out of capacity
     wall = (time.perf_counter() - t0) / len(bodies)
     runs = []
     for i, ((n, _), v, (_, duration)) in enumerate(zip(directions, vels, paths, strict=True)):
