@@ -48,6 +48,10 @@ def test_convergence_verdicts() -> None:
     assert [r["voxel"] for r in rows] == [0.03, 0.04, 0.05]
     assert [r["accepted"] for r in rows] == [None, True, False]
     assert rows[2]["sinkage_m_change"] == pytest.approx(0.010)
+    # the same numbers with a foot on the floor (14 cm of a 15 cm bed) give no acceptance
+    res["multi/v0.04"].update(max_sinkage_m=0.14, depth_m=0.15)
+    rows = bench._convergence(res, 0.15)["multi"]["rows"]
+    assert rows[1]["floor_reached"] and rows[1]["accepted"] is False
 
 
 @pytest.mark.slow

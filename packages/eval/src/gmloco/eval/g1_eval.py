@@ -193,8 +193,8 @@ def run_batch(batch: list[EpisodeSpec], cfg: G1EvalCfg, policy: Any) -> list[dic
             break  # every robot has fallen: the rest cannot change any outcome
     if solver.max_active_cell_count > 0 and solver.grid_type == "sparse":
         scene.mpm.check_sparse_grid_rebuild_status()
-    arr = {name: np.asarray(getattr(scene, name)) for name in
-           ("base_q", "base_qd", "foot_force", "sinkage", "foot_sinkage", "joint_q", "joint_qd", "target", "action")}  # fmt: skip
+    names = ("base_q", "base_qd", "foot_force", "sinkage", "foot_sinkage", "joint_q", "joint_qd", "target", "action")
+    arr = {name: np.asarray(getattr(scene, name)) for name in names}
     logs = []
     for r, spec in enumerate(batch):
         q = arr["base_q"][:, r]

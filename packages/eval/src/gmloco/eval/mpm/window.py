@@ -121,7 +121,8 @@ class SandWindow:
         """
         s, m, mm = sand_state.mpm, sand_model.mpm, mpm_solver._mpm_model
         self._state_arrays = (sand_state.particle_q, sand_state.particle_qd, s.particle_qd_grad,
-                              s.particle_elastic_strain, s.particle_Jp, s.particle_stress, s.particle_transform)  # fmt: skip
+                              s.particle_elastic_strain, s.particle_Jp, s.particle_stress,
+                              s.particle_transform)  # fmt: skip
         self._model_arrays = (sand_model.particle_mass, sand_model.particle_radius, m.friction,
                               mm.particle_volume, mm.particle_density, mm.material_particle_volume)  # fmt: skip
         self._sand_state = sand_state
