@@ -22,12 +22,21 @@ import numpy as np
 __all__ = ["main", "run_episode"]
 
 
-def run_episode(ep: dict, out: str, duration: float = 8.0, keep_before_fall: float | None = None) -> dict:
-    """Generate, analyse and score-prepare one episode; returns a JSON-ready row."""
+def run_episode(
+    ep: dict,
+    out: str,
+    duration: float = 8.0,
+    keep_before_fall: float | None = None,
+    effects: tuple[str, ...] | None = None,
+) -> dict:
+    """Generate, analyse and score-prepare one episode; returns a JSON-ready row.
+
+    ``effects`` limits the tool's screening to a subset of the library (quick checks); None screens all.
+    """
     from gmloco.deploy.mismatch.benchmark.generator import EpisodeCfg, generate
     from gmloco.deploy.mismatch.benchmark.truth import TruthEffect
     from gmloco.deploy.mismatch.effects import EFFECT_IDS
-    from gmloco.deploy.mismatch.pipeline import analyze
+    from gmloco.deploy.mismatch.pipeline import AnalysisCfg, analyze
 
     t0 = time.time()
     eff = TruthEffect(ep["effect"], ep["params"])
@@ -40,7 +49,9 @@ def run_episode(ep: dict, out: str, duration: float = 8.0, keep_before_fall: flo
     keys = Path(out) / "keys"
     keys.mkdir(parents=True, exist_ok=True)
     (keys / f"{ep['name']}.json").write_text(json.dumps(key))
-    res = analyze(rec)
+    cfg = AnalysisCfg()
+    cfg.attribution.effects = effects
+    res = analyze(rec, cfg)
     rep = res.report
     row = {
         **ep,
@@ -93,7 +104,9 @@ def _git_commit() -> dict:
     return {"commit": git("rev-parse", "HEAD"), "dirty_paths": git("status", "--porcelain", "--", ".").count("\n")}
 
 
-def _manifest(out: Path, argv: list[str], eps: list[dict], wall: float, cpu: float) -> None:
+def _manifest(
+    out: Path, argv: list[str], eps: list[dict], todo: list[dict], wall: float, cpu: float, git: dict
+) -> None:
     """Write ``manifest.json``: commit, command line, configuration and timing of the sweep."""
     import os
     import platform
@@ -106,14 +119,15 @@ def _manifest(out: Path, argv: list[str], eps: list[dict], wall: float, cpu: flo
     ep_cfg = asdict(EpisodeCfg())
     ep_cfg.pop("effect")
     man = {
-        "git": _git_commit(),
+        "git": git,
+        "episodes_run_by_this_invocation": [e["name"] for e in todo],
         "command": "python -m gmloco.deploy.mismatch.benchmark.sweep " + " ".join(argv),
         "episode_cfg": ep_cfg,
         "motion": asdict(MotionCfg()),
         "analysis_cfg": asdict(AnalysisCfg()),
         "episodes": [e["name"] for e in eps],
-        "wall_s": wall,
-        "cpu_s_children": cpu,
+        "wall_s_this_invocation": wall,
+        "cpu_s_children_this_invocation": cpu,
         "cpus": os.cpu_count(),
         "load_avg_at_end": os.getloadavg(),
         "python": platform.python_version(),
@@ -142,6 +156,7 @@ def main(argv: list[str] | None = None) -> None:
     p.add_argument("--only", default=None, help="comma-separated episode-name prefixes")
     p.add_argument("--score-only", action="store_true", help="score the rows already under OUT/rows and exit")
     p.add_argument("--resume", action="store_true", help="skip episodes whose row already exists under OUT/rows")
+    p.add_argument("--effects", default=None, help="comma-separated effect ids the tool screens (default: all)")
     argv = list(sys.argv[1:] if argv is None else argv)
     a = p.parse_args(argv)
     if a.score_only:
@@ -155,9 +170,10 @@ def main(argv: list[str] | None = None) -> None:
         eps = [e for e in eps if any(e["name"].startswith(s) for s in a.only.split(","))]
     a.out.mkdir(parents=True, exist_ok=True)
     todo = [e for e in eps if not (a.resume and (a.out / "rows" / f"{e['name']}.json").exists())]
-    t0 = time.time()
+    t0, git = time.time(), _git_commit()
+    effects = tuple(a.effects.split(",")) if a.effects else None
     with Pool(a.workers) as pool:
-        fresh = pool.map(_star, [(e, str(a.out), a.duration, a.keep_before_fall) for e in todo], chunksize=1)
+        fresh = pool.map(_star, [(e, str(a.out), a.duration, a.keep_before_fall, effects) for e in todo], chunksize=1)
     cpu = sum(os.times()[2:4])
     names = {e["name"] for e in eps}
     by_name = {r["name"]: r for r in fresh}
@@ -165,7 +181,7 @@ def main(argv: list[str] | None = None) -> None:
     (a.out / "rows.json").write_text(json.dumps(rows, indent=1, default=float))
     summary = {**score(rows), "episodes_scored": len(rows), "wall_s": time.time() - t0}
     (a.out / "summary.json").write_text(json.dumps(summary, indent=2, default=float))
-    _manifest(a.out, argv, eps, time.time() - t0, cpu)
+    _manifest(a.out, argv, eps, todo, time.time() - t0, cpu, git)
 
 
 if __name__ == "__main__":
