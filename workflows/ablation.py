@@ -274,6 +274,16 @@ def _figure(path: Path, arms: Sequence[Arm], settings: dict[str, Any]) -> None:
     plt.close(fig)
 
 
+def _figure_or_note(path: Path, arms: Sequence[Arm], settings: dict[str, Any]) -> str:
+    """Draw the figure and return its name, or say why not (the GPU image may lack matplotlib)."""
+    try:
+        import matplotlib  # noqa: F401
+    except ImportError:
+        return "not drawn: matplotlib is not installed; rerun the same command where it is (evaluations are reused)"
+    _figure(path, arms, settings)
+    return path.name
+
+
 def write_report(arms: Sequence[Arm], cfg: DictConfig, root: Path, git: dict[str, Any], code: int) -> dict:
     """Write ``ablation.md``, ``ablation.csv``, ``figures/ablation.png`` and ``summary.json``; return the summary."""
     settings = eval_settings(cfg)
@@ -281,8 +291,8 @@ def write_report(arms: Sequence[Arm], cfg: DictConfig, root: Path, git: dict[str
     rows = table_rows(arms, settings)
     atomic_write_text(root / "ablation.md", markdown_table(rows, settings, header))
     atomic_write_text(root / "ablation.csv", _csv(rows))
-    _figure(root / "figures" / "ablation.png", arms, settings)
     summary = {
+        "figure": _figure_or_note(root / "figures" / "ablation.png", arms, settings),
         "source": str(getattr(cfg.ablation.source, "value", cfg.ablation.source)),
         "settings": settings,
         **header,

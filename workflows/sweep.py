@@ -608,6 +608,16 @@ def _figure(
     plt.close(fig)
 
 
+def _figure_or_note(path: Path, *args: Any) -> str:
+    """Draw ``figures/sweep.png`` and return its name, or say why not (the GPU image may lack matplotlib)."""
+    try:
+        import matplotlib  # noqa: F401
+    except ImportError:
+        return "not drawn: matplotlib is not installed; rerun the same command where it is to draw it"
+    _figure(path, *args)
+    return path.name
+
+
 def write_report(
     study: Any, cfg: DictConfig, root: Path, git: dict[str, Any], trials: Sequence[Any], code: int
 ) -> dict:
@@ -638,9 +648,9 @@ def write_report(
         "trials": rows,
         "exit_code": code,
     }
+    summary["figure"] = _figure_or_note(root / "figures" / "sweep.png", rows, importances, why, cfg)
     atomic_write_json(root / "study_summary.json", summary)
     _write_csv(root / "trials.csv", rows)
-    _figure(root / "figures" / "sweep.png", rows, importances, why, cfg)
     return summary
 
 

@@ -218,3 +218,21 @@ def test_ablation_trains_two_experiments_at_smoke_scale(tmp_path: Path) -> None:
         assert arm["status"] == "evaluated" and arm["iteration"] == 2.0
         assert arm["trained_on"] == arm["exp"].removeprefix("ppo_")
         assert (tmp_path / "train" / arm["exp"] / "train_teacher" / "policy.onnx").is_file()
+
+
+@needs_artifact
+def test_without_matplotlib_the_tables_are_written_and_the_figure_is_named_missing(
+    compose: Callable[..., DictConfig],
+    fake_evaluate: Callable[..., FakeEvaluate],
+    artifacts: Path,
+    tmp_path: Path,
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    """On a machine without matplotlib (the GPU image may lack it) the report says so instead of failing."""
+    import sys
+
+    fake_evaluate()
+    monkeypatch.setitem(sys.modules, "matplotlib", None)  # makes ``import matplotlib`` raise ImportError
+    summary = ablation.run_ablation(_cfg(compose, tmp_path, artifacts), arm_overrides=[])
+    assert summary["exit_code"] == 0 and summary["figure"].startswith("not drawn: matplotlib is not installed")
+    assert (tmp_path / "ablation.md").is_file() and not (tmp_path / "figures" / "ablation.png").exists()

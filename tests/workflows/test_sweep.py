@@ -233,7 +233,7 @@ def test_study_runs_trials_in_run_dirs_prunes_and_resumes(
     assert summary["best"]["number"] == best["number"]
     assert _load_study(tmp_path).best_trial.number == best["number"]
     assert len((tmp_path / "trials.csv").read_text().splitlines()) == 6
-    assert (tmp_path / "figures" / "sweep.png").stat().st_size > 10_000
+    assert (tmp_path / "figures" / "sweep.png").stat().st_size > 10_000 and summary["figure"] == "sweep.png"
     # A second call continues the study to 6 trials; the first 5 are kept as they were.
     again_cfg = _sweep_cfg(compose, tmp_path, 6)
     again_cfg.sweep.n_startup_trials = 10
@@ -394,3 +394,19 @@ def test_trial_whose_training_finished_before_a_kill_reports_its_saved_metrics(
     trial = optuna.create_study().ask()
     result = sweep.TrialStage(trial, sweep.Objective.parse("train_teacher/mean_reward"), {})(cfg)
     assert fake.calls == [] and result["objective"] == 1.5 and result["pruned"] == 0.0
+
+
+def test_without_matplotlib_the_summary_is_written_and_the_figure_is_named_missing(
+    compose: Callable[..., DictConfig],
+    fake_training: Callable[..., FakeTraining],
+    tmp_path: Path,
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    """On a machine without matplotlib the study summary says the figure was not drawn; the sweep still succeeds."""
+    import sys
+
+    fake_training()
+    monkeypatch.setitem(sys.modules, "matplotlib", None)  # makes ``import matplotlib`` raise ImportError
+    summary = sweep.run_sweep(_sweep_cfg(compose, tmp_path, 2))
+    assert summary["exit_code"] == 0 and summary["figure"].startswith("not drawn: matplotlib is not installed")
+    assert (tmp_path / "study_summary.json").is_file() and not (tmp_path / "figures" / "sweep.png").exists()
