@@ -109,3 +109,15 @@ def test_voxel_convergence_hand_values(tmp_path: Path) -> None:
     np.testing.assert_allclose(res["levels"][0]["travel_rel_diff_to_finest"], 1 / 3)
     assert res["converged"] is True  # 0.05 <= 0.1 and 2 mm <= 5 mm
     assert voxel_convergence([d5, d2])["converged"] is False
+
+
+def test_roll_variant_geometry() -> None:
+    """Rolled 15 deg about x: quaternion (cos 7.5, sin 7.5, 0, 0); lowest edge drop_height above the surface."""
+    from gmloco.eval.box import BoxCfg, box_roll_variant
+
+    box = box_roll_variant(BoxCfg(), 15.0)
+    c, s = np.cos(np.radians(7.5)), np.sin(np.radians(7.5))
+    np.testing.assert_allclose(box.initial_quat_wxyz, [c, s, 0.0, 0.0], atol=1e-12)
+    # lowest point: hy sin 15 + hz cos 15 = 0.15 * 0.2588 + 0.1 * 0.9659 = 0.13541 m below the CoM
+    np.testing.assert_allclose(box.initial_pos[2], 0.1 + 0.13541, atol=1e-5)
+    np.testing.assert_allclose(BoxCfg().initial_pos, [0.0, 0.0, 0.2])  # unrotated box unchanged

@@ -8,7 +8,7 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 
-__all__ = ["BoxCfg", "box_lateral_variant", "box_size_variant"]
+__all__ = ["BoxCfg", "box_lateral_variant", "box_roll_variant", "box_size_variant"]
 
 
 @dataclass(frozen=True)
@@ -30,6 +30,8 @@ class BoxCfg:
     """Initial horizontal velocity (v_x, v_y) in the world frame [m/s]."""
     yaw: float = 0.0
     """Initial yaw of the box about world z [rad]; a non-zero yaw gives a velocity along the box's own y axis."""
+    roll: float = 0.0
+    """Initial roll of the box about its own x axis (after the yaw) [rad]: the bottom face tilts sideways."""
     duration: float = 1.0
     """Simulated time after release [s]."""
 
@@ -46,13 +48,27 @@ class BoxCfg:
 
     @property
     def initial_pos(self) -> np.ndarray:
-        """Initial CoM position [m], [3]: x = y = 0, bottom drop_height above z = 0."""
-        return np.array([0.0, 0.0, self.drop_height + 0.5 * self.size[2]])
+        """Initial CoM position [m], [3]: x = y = 0, lowest point drop_height above z = 0."""
+        rot_z = self._rotation()[2]  # world z row of the box rotation
+        return np.array([0.0, 0.0, self.drop_height + float(np.abs(rot_z) @ self.half_extents)])
 
     @property
     def initial_quat_wxyz(self) -> np.ndarray:
-        """Initial orientation, unit quaternion (w, x, y, z), [4]."""
-        return np.array([math.cos(0.5 * self.yaw), 0.0, 0.0, math.sin(0.5 * self.yaw)])
+        """Initial orientation, unit quaternion (w, x, y, z), [4]: yaw about world z, then roll about box x."""
+        cy, sy, cr, sr = (
+            math.cos(0.5 * self.yaw),
+            math.sin(0.5 * self.yaw),
+            math.cos(0.5 * self.roll),
+            math.sin(0.5 * self.roll),
+        )
+        return np.array([cy * cr, cy * sr, sy * sr, sy * cr])  # q_yaw * q_roll
+
+    def _rotation(self) -> np.ndarray:
+        """Initial rotation matrix R = R_z(yaw) R_x(roll), [3, 3]."""
+        cy, sy, cr, sr = math.cos(self.yaw), math.sin(self.yaw), math.cos(self.roll), math.sin(self.roll)
+        r_z = np.array([[cy, -sy, 0.0], [sy, cy, 0.0], [0.0, 0.0, 1.0]])
+        r_x = np.array([[1.0, 0.0, 0.0], [0.0, cr, -sr], [0.0, sr, cr]])
+        return r_z @ r_x
 
     @property
     def initial_velocity(self) -> np.ndarray:
@@ -67,6 +83,15 @@ def box_lateral_variant(box: BoxCfg | None = None, yaw_deg: float = 30.0) -> Box
     perpendicular to the motion appears only in models that resolve the faces' orientation (3D-RFT, MPM).
     """
     return replace(box or BoxCfg(), yaw=math.radians(yaw_deg))
+
+
+def box_roll_variant(box: BoxCfg | None = None, roll_deg: float = 15.0) -> BoxCfg:
+    """Return the box rolled by ``roll_deg`` about its x axis (its launch direction): a sideways-tilted bottom.
+
+    3D-RFT gives a tilted leading face moving along x a force along y (spec 5.1 case I: G_y = -0.17 for a 30 deg
+    tilt); the vertical-plane models (Heuristic-RFT, cones) cannot, so this variant isolates the lateral force.
+    """
+    return replace(box or BoxCfg(), roll=math.radians(roll_deg))
 
 
 def box_size_variant(box: BoxCfg | None = None, scale: float = 1.5) -> BoxCfg:

@@ -16,7 +16,7 @@ from typing import Any, Literal
 
 import numpy as np
 
-from gmloco.eval.box import BoxCfg, box_lateral_variant, box_size_variant
+from gmloco.eval.box import BoxCfg, box_lateral_variant, box_roll_variant, box_size_variant
 from gmloco.eval.metrics.box import metric_lateral_force, metric_sinkage, metric_travel
 from gmloco.eval.mpm.bed import SandBedCfg
 from gmloco.eval.mpm.box_scene import MpmSolverCfg
@@ -48,7 +48,8 @@ class BoxStudyCfg:
     mu_surf: tuple[float, float] = (0.1, 1.0)
     """Uniform range of mu_surf [-] (GM-Loco DR)."""
     variants: tuple[str, ...] = ("forward", "lateral")
-    """Launch variants: ``forward`` (box aligned with its velocity), ``lateral`` (box yawed 30 deg), and for the
+    """Launch variants: ``forward`` (box aligned with its velocity), ``lateral`` (box yawed 30 deg), ``roll`` (box
+    rolled 15 deg about its launch direction: the lateral-force case only 3D models resolve), and for the
     box-size check ``size_x<scale>`` (e.g. ``size_x0.7``: the forward box with its footprint scaled, same mass)."""
     models: tuple[str, ...] = ("mpm", *ROM_MODELS)
     """Models to run; ``rft3d_fitted`` is added automatically when ``rft3d_fitted_coeffs`` is set."""
@@ -116,6 +117,8 @@ def _variant_box(cfg: BoxStudyCfg, variant: str) -> BoxCfg:
         return cfg.box
     if variant == "lateral":
         return box_lateral_variant(cfg.box)
+    if variant == "roll":
+        return box_roll_variant(cfg.box)
     if variant.startswith("size_x"):
         try:
             scale = float(variant.removeprefix("size_x"))
@@ -123,7 +126,9 @@ def _variant_box(cfg: BoxStudyCfg, variant: str) -> BoxCfg:
             scale = -1.0
         if scale > 0.0:
             return box_size_variant(cfg.box, scale)
-    raise ValueError(f"variant={variant!r}: expected 'forward', 'lateral' or 'size_x<scale>' (e.g. 'size_x0.7')")
+    raise ValueError(
+        f"variant={variant!r}: expected 'forward', 'lateral', 'roll' or 'size_x<scale>' (e.g. 'size_x0.7')"
+    )
 
 
 def _record(
