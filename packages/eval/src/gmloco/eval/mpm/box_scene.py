@@ -16,18 +16,25 @@ medium's friction). A GPU step is dominated by launch overhead at these sizes, s
 from __future__ import annotations
 
 import time
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field, replace
 from typing import Any, Literal
 
 import numpy as np
 
 from gmloco.eval.box import BoxCfg
-from gmloco.eval.mpm.bed import SandBedCfg, add_bed_container, emit_sand_bed
+from gmloco.eval.mpm.bed import SandBedCfg, add_bed_container, bed_particle_positions
 from gmloco.eval.mpm.coupled_setup import make_coupled_states, make_mpm_solver
 from gmloco.eval.mpm.materials import GranularMaterial, MpmMaterialCfg, apply_mpm_material, mpm_material
 
-__all__ = ["MIN_RHEOLOGY_ITERATIONS", "MpmBoxScene", "MpmBoxSceneCfg", "MpmSolverCfg", "region_offsets"]
+__all__ = [
+    "MIN_RHEOLOGY_ITERATIONS",
+    "MpmBoxScene",
+    "MpmBoxSceneCfg",
+    "MpmSolverCfg",
+    "emit_bed_particles",
+    "region_offsets",
+]
 
 MIN_RHEOLOGY_ITERATIONS = 25
 """Newton 1.5.2's Gauss-Seidel ``solve_granularity``: the eager solver loop runs ``max_iterations // 25`` batches."""
@@ -183,7 +190,7 @@ class MpmBoxScene:
         ranges, start = [], 0
         for i, (off, mat) in enumerate(zip(self.offsets, self.mats, strict=True)):
             bed = replace(_shifted_bed(self.cfg.bed, off), seed=self.cfg.bed.seed + i)
-            n = emit_sand_bed(builder, bed, self.cfg.solver.voxel_size, mat.density)
+            n = emit_bed_particles(builder, bed, self.cfg.solver.voxel_size, mat.density)
             ranges.append(np.arange(start, start + n))
             start += n
         model = builder.finalize()
@@ -285,6 +292,24 @@ class MpmBoxScene:
         assert np.all(q[:, 2] > -self.cfg.bed.depth), f"a box fell through the bed (z = {q[:, 2].min():.3f} m)"
         z = self.sand_state.particle_q.numpy()[:, 2]
         assert np.all(z > -self.cfg.bed.depth - 2 * self.cfg.solver.voxel_size), "sand leaked through the floor"
+
+
+def emit_bed_particles(
+    builder: Any, bed: SandBedCfg, voxel_size: float, density: float,
+    keep: Callable[[np.ndarray], np.ndarray] | None = None,
+) -> int:  # fmt: skip
+    """Add a bed's particles as ``bed.emit_sand_bed`` does, from numpy arrays; return the particle count.
+
+    7x faster than lists (0.18 s vs 1.34 s for 254k particles); the batched scenes emit ~1M per solve.
+    """
+    pos, h = bed_particle_positions(bed, voxel_size)
+    if keep is not None:
+        pos = pos[keep(pos)]
+    n = len(pos)
+    # Newton: particle volume 8 r^3 = h^3 and density mass / volume = rho_c (as emit_sand_bed)
+    builder.add_particles(pos.astype(np.float32), np.zeros((n, 3), dtype=np.float32), np.full(n, density * h**3),
+                          np.full(n, 0.5 * h))  # fmt: skip
+    return n
 
 
 def region_offsets(cfg: MpmBoxSceneCfg, count: int) -> np.ndarray:

@@ -20,8 +20,8 @@ from typing import Any
 
 import numpy as np
 
-from gmloco.eval.mpm.bed import SandBedCfg, add_bed_container, emit_sand_bed
-from gmloco.eval.mpm.box_scene import MpmSolverCfg
+from gmloco.eval.mpm.bed import SandBedCfg, add_bed_container
+from gmloco.eval.mpm.box_scene import MpmSolverCfg, emit_bed_particles
 from gmloco.eval.mpm.coupled_setup import make_mpm_solver
 from gmloco.eval.mpm.materials import GranularMaterial, MpmMaterialCfg, apply_mpm_material, mpm_material
 
@@ -199,7 +199,7 @@ def run_plate_intrusions(
         for i, off in enumerate(offsets):
             bed = replace(cfg.bed, center_x=cfg.bed.center_x + off[0], center_y=cfg.bed.center_y + off[1],
                           seed=cfg.bed.seed + i)  # fmt: skip
-            count += emit_sand_bed(sand, bed, s.voxel_size, mat.density, keep=outside_plates)
+            count += emit_bed_particles(sand, bed, s.voxel_size, mat.density, keep=outside_plates)
         model = sand.finalize()
         apply_mpm_material(model, mat)
         mpm = make_mpm_solver(newton, model, s, mat)
