@@ -36,5 +36,6 @@ def test_sweep_subset_writes_rows_summary_manifest_and_a_separate_key(tmp_path: 
     summary = json.loads((tmp_path / "summary.json").read_text())
     assert summary["overall"]["top1_mid_macro"] == 1.0
     manifest = json.loads((tmp_path / "manifest.json").read_text())
-    assert manifest["episodes"] == ["imu.gyro_bias-mid-0"] and "commit" in manifest["git"]
+    inv = manifest["invocations"][-1]
+    assert inv["episodes"] == ["imu.gyro_bias-mid-0"] and "commit" in inv["git"]
     assert (tmp_path / "keys" / "imu.gyro_bias-mid-0.json").exists()

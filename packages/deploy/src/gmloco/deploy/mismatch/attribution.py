@@ -27,7 +27,7 @@ from gmloco.deploy.mismatch.effects import EFFECTS, EffectSpec
 from gmloco.deploy.mismatch.problem import Problem, effective_samples
 from gmloco.deploy.mismatch.replay import CHANNEL_GROUPS
 
-__all__ = ["AttributionCfg", "Hypothesis", "confirm", "decide", "screen", "signal_columns"]
+__all__ = ["AttributionCfg", "Hypothesis", "confirm", "decide", "screen", "second_round", "signal_columns"]
 
 
 @dataclass
@@ -36,6 +36,8 @@ class AttributionCfg:
 
     top_k: int = 3
     """Effects confirmed by a nonlinear fit."""
+    top_k_extra: int = 3
+    """Effects fitted in a second round when the first leaves the mismatch unexplained (:func:`second_round`)."""
     max_iter: int = 4
     """Levenberg-Marquardt iterations per fit."""
     bic_min: float = 10.0
@@ -75,6 +77,8 @@ class Hypothesis:
     """Whether a tolerance-sized change is visible above the noise."""
     dbic_lin: float = -np.inf
     """Linearised Delta-BIC from screening."""
+    energy_lin: float = 0.0
+    """Training residual energy the linearised fit removes (normalised units)."""
     theta_lin: np.ndarray | None = None
     """Linearised estimate, clipped to bounds."""
     theta: np.ndarray | None = None
@@ -145,6 +149,7 @@ def screen(
         rss1 = float(fit_r @ fit_r)
         rss0 = float(rt @ rt)
         hyp.theta_lin = theta
+        hyp.energy_lin = rss0 - rss1
         # n_eff of the *fitted* residual: a large systematic mismatch makes the nominal residual nearly rank one,
         # and its n_eff (a handful) would then penalise exactly the effect that explains it.
         ne = max(n_eff, effective_samples(fit_r.reshape(r0[pb.train].shape)))
@@ -206,12 +211,31 @@ def _boot_p(
     return float((np.sum(means <= 0) + 1) / (n_boot + 1)), float(np.quantile(gains, 0.05))
 
 
+def second_round(hyps: list[Hypothesis], ranked: list[Hypothesis], cfg: AttributionCfg) -> list[Hypothesis]:
+    """Testable effects not yet fitted, by the residual energy their linearised fit removes (no BIC penalty).
+
+    When a large mismatch has no explanation among the first ``top_k``, the linearised Delta-BIC may have
+    ranked the true effect low: with a nearly rank-one residual, n_eff is small and the ``k log n_eff`` term
+    punishes effects with many parameters (12 encoder offsets). The second round fits the ``top_k_extra``
+    effects whose linear fit removes the most energy.
+    """
+    done = {h.spec.id for h in ranked}
+    rest = [h for h in hyps if h.testable and h.spec.id not in done]
+    return sorted(rest, key=lambda h: -h.energy_lin)[: cfg.top_k_extra]
+
+
 def confirm(
-    pb: Problem, hyps: list[Hypothesis], r0: np.ndarray, cfg: AttributionCfg, progress: Any = None
+    pb: Problem,
+    hyps: list[Hypothesis],
+    r0: np.ndarray,
+    cfg: AttributionCfg,
+    progress: Any = None,
+    candidates: list[Hypothesis] | None = None,
 ) -> list[Hypothesis]:
-    """Fit the top-k testable effects and score them on held-out segments; returns them ranked."""
+    """Fit the top-k testable effects (or ``candidates``) and score them on held-out segments; return them ranked."""
     rng = np.random.default_rng(cfg.seed)
-    cand = sorted([h for h in hyps if h.testable], key=lambda h: -h.dbic_lin)[: cfg.top_k]
+    cand = candidates if candidates is not None else sorted([h for h in hyps if h.testable], key=lambda h: -h.dbic_lin)
+    cand = cand[: cfg.top_k] if candidates is None else cand
     e0_seg = np.sum(r0[pb.held] ** 2, axis=(1, 2))
     for hyp in cand:
         theta, r, J = _lm(pb, hyp, cfg)

@@ -9,7 +9,7 @@ from dataclasses import dataclass, field, replace
 
 import numpy as np
 
-from gmloco.deploy.mismatch.attribution import AttributionCfg, confirm, decide, screen
+from gmloco.deploy.mismatch.attribution import AttributionCfg, confirm, decide, screen, second_round
 from gmloco.deploy.mismatch.contract import ContractCfg, ContractError, ContractIssue, check_recording
 from gmloco.deploy.mismatch.effects import EFFECTS
 from gmloco.deploy.mismatch.localize import localize
@@ -130,6 +130,11 @@ def analyze(
     say("confirmatory fits", 0.6)
     ranked = confirm(pb, hyps, r0, cfg.attribution, lambda: say("confirmatory fits", 0.8))
     decision = decide(pb, r0, ranked, cfg.attribution)
+    if decision["verdict"] == "unexplained" and cfg.attribution.top_k_extra > 0:
+        say("second-round fits", 0.8)
+        extra = confirm(pb, hyps, r0, cfg.attribution, candidates=second_round(hyps, ranked, cfg.attribution))
+        ranked = sorted(ranked + extra, key=lambda h: (not h.passed, -h.heldout_gain))
+        decision = decide(pb, r0, ranked, cfg.attribution)
     say("localisation", 0.9)
     base_all = rp.base({}, np.arange(rec.n))
     phases_all = segment_phases(base_all.foot_height, rec.dt, cfg.segmentation)

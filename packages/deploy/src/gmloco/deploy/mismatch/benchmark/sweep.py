@@ -107,7 +107,7 @@ def _git_commit() -> dict:
 def _manifest(
     out: Path, argv: list[str], eps: list[dict], todo: list[dict], wall: float, cpu: float, git: dict
 ) -> None:
-    """Write ``manifest.json``: commit, command line, configuration and timing of the sweep."""
+    """Append this invocation to ``manifest.json``: commit, command line, configuration and timing."""
     import os
     import platform
     from dataclasses import asdict
@@ -132,7 +132,11 @@ def _manifest(
         "load_avg_at_end": os.getloadavg(),
         "python": platform.python_version(),
     }
-    (out / "manifest.json").write_text(json.dumps(man, indent=2, default=str))
+    # Every invocation (a first run, --resume, a re-run of some episodes with --only) is kept in order.
+    path = out / "manifest.json"
+    old = json.loads(path.read_text()) if path.exists() else {"invocations": []}
+    runs = old.get("invocations", [old])  # a single-invocation manifest of an older sweep becomes the first entry
+    path.write_text(json.dumps({"invocations": [*runs, man]}, indent=2, default=str))
 
 
 def main(argv: list[str] | None = None) -> None:
