@@ -128,7 +128,8 @@ def _run_case(case: dict[str, Any], args: argparse.Namespace) -> dict[str, Any]:
     q, qd = np.asarray(scene.base_q), np.asarray(scene.base_qd)
     half = len(q) // 2
     return {
-        **case, "particles": scene.particle_count, "graph": scene.graph is not None, "build_s": build_s,
+        **case, "particles": scene.particle_count, "graph": scene.graph is not None,
+        "capture_error": scene.capture_error, "build_s": build_s,
         "capture_s": capture_s, "frames": scene.frame, "frames_per_s": fps,
         "robot_frames_per_s": fps * case["robots"], "batch_episode_s": episode_s,
         "episodes_per_min": 60.0 * case["robots"] / episode_s,

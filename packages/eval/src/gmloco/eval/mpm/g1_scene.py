@@ -145,6 +145,7 @@ class G1MpmScene:
         self.frame = 0
         self.wall_time = 0.0
         self.graph = None
+        self.capture_error: str | None = None  # why a frame could not be captured as a CUDA graph
         self.last_action = np.zeros((n, len(self.spec.joint_names)))
         self.base_q: list[np.ndarray] = []
         self.base_qd: list[np.ndarray] = []
@@ -380,9 +381,12 @@ class G1MpmScene:
         if not (self.cfg.use_cuda_graph and self.device.is_cuda and fixed and s.rigid_substeps % 2 == 0):
             return
         self.simulate()  # warm-up: lazily built inner graphs and kernels
-        with wp.ScopedDevice(self.device), wp.ScopedCapture() as cap:
-            self.simulate()
-        self.graph = cap.graph
+        try:
+            with wp.ScopedDevice(self.device), wp.ScopedCapture() as cap:
+                self.simulate()
+            self.graph = cap.graph
+        except Exception as exc:  # a step that cannot be captured still runs eagerly; the reason is kept
+            self.graph, self.capture_error = None, repr(exc)
 
     def step(self) -> None:
         """Advance one frame; at the policy rate log every robot and set new PD targets first."""
