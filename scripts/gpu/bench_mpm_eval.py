@@ -48,6 +48,8 @@ def _parse() -> argparse.Namespace:
         "--naive-voxels", type=float, nargs="*", default=None, help="voxels of the naive case (default: coarsest)"
     )
     p.add_argument("--max-minutes", type=float, default=8.5)
+    p.add_argument("--iters", type=int, default=50, help="rheology iterations (the eval's default)")
+    p.add_argument("--iters-check", type=int, default=250, help="iterations of the iteration-convergence case")
     p.add_argument("--tol", type=float, default=0.15, help="relative tolerance of the convergence check")
     p.add_argument("--device", default=None)
     p.add_argument("--window-length", type=float, default=1.8)
@@ -74,12 +76,16 @@ def _cases(args: argparse.Namespace) -> list[dict[str, Any]]:
     for v in sorted(args.voxels, reverse=True):
         if v != coarse:
             cases += [{"mode": "multi", "voxel": v, "robots": args.robots}, {"mode": "window", "voxel": v, "robots": 1}]
+    # rheology iterations are a convergence dimension too (issue 5: plate forces): the coarse multi case again
+    cases += [{"mode": "multi", "voxel": coarse, "robots": args.robots, "iters": args.iters_check}]
     cases += [{"mode": "stand", "voxel": v, "robots": 4} for v in sorted(args.voxels, reverse=True)]
     return cases
 
 
 def _key(c: dict[str, Any]) -> str:
-    return f"{c['mode']}/v{c['voxel']:g}/r{c['robots']}"
+    """Case id in ``bench.json``: mode, voxel, robots (and rheology iterations when not the default)."""
+    iters = f"/it{c['iters']}" if "iters" in c else ""
+    return f"{c['mode']}/v{c['voxel']:g}/r{c['robots']}{iters}"
 
 
 def _scene_cfg(case: dict[str, Any], args: argparse.Namespace) -> Any:
@@ -100,7 +106,8 @@ def _scene_cfg(case: dict[str, Any], args: argparse.Namespace) -> Any:
     h = voxel / win.particles_per_voxel
     particles = int(np.ceil(win.length / h) * np.ceil(win.width / h) * round(terrain.depth / h)) * n
     solver = MpmSolverCfg(voxel_size=voxel, frame_dt=0.01, rigid_substeps=2,
-                          max_active_cell_count=int(3.0 * particles / 8) + 64)  # fmt: skip
+                          max_active_cell_count=int(3.0 * particles / 8) + 64,
+                          max_iterations=int(case.get("iters", args.iters)))  # fmt: skip
     cmds = ((0.0, 0.0, 0.0),) if case["mode"] == "stand" else tuple((v, 0.0, 0.0) for v in SPEEDS)
     return G1MpmSceneCfg(terrain=terrain, window=win, num_robots=n, lane_spacing=args.window_width + 2.0,
                          solver=solver, commands=cmds, device=args.device)  # fmt: skip
@@ -146,7 +153,8 @@ def _convergence(results: dict[str, dict[str, Any]], tol: float) -> dict[str, An
     """Metrics per voxel against the finest voxel measured (multi-robot walking and standing cases)."""
     out: dict[str, Any] = {}
     for mode, keys in (("multi", ("sinkage_m", "pelvis_z_m", "vx_mps")), ("stand", ("sinkage_m", "pelvis_z_m"))):
-        rs = sorted((r for r in results.values() if r.get("mode") == mode and "error" not in r),
+        rs = sorted((r for r in results.values() if r.get("mode") == mode and "error" not in r and "skipped" not in r
+                     and "iters" not in r),
                     key=lambda r: r["voxel"])  # fmt: skip
         if not rs:
             continue
@@ -168,6 +176,26 @@ def _convergence(results: dict[str, dict[str, Any]], tol: float) -> dict[str, An
             row["accepted"] = (bool(ok) and not floor) if r is not ref else None
             rows.append(row)
         out[mode] = {"reference_voxel": ref["voxel"], "rows": rows}
+    many = [r for r in results.values() if "iters" in r and "frames_per_s" in r]
+    for r in many:  # the same case with more rheology iterations is the reference
+        base = next(
+            (
+                b
+                for b in results.values()
+                if b.get("mode") == r["mode"]
+                and b.get("voxel") == r["voxel"]
+                and b.get("robots") == r["robots"]
+                and "iters" not in b
+                and "frames_per_s" in b
+            ),
+            None,
+        )
+        if base is not None:
+            out["iterations"] = {
+                "voxel": r["voxel"], "iterations": r["iters"],
+                **{f"{k}_change": abs(base[k] - r[k]) for k in ("sinkage_m", "pelvis_z_m", "vx_mps")},
+                **{f"{k}_at_{r['iters']}": r[k] for k in ("sinkage_m", "pelvis_z_m", "vx_mps")},
+            }  # fmt: skip
     return out
 
 

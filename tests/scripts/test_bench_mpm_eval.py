@@ -27,11 +27,12 @@ def _load() -> ModuleType:
 def test_cases_put_the_coarse_throughput_cases_first() -> None:
     """Coarsest window, multi and naive first; finer voxels next; the standing checks last."""
     bench = _load()
-    args = bench.replace(bench.Namespace(), voxels=[0.03, 0.05, 0.04], robots=8, naive_voxels=None)
+    args = bench.replace(bench.Namespace(), voxels=[0.03, 0.05, 0.04], robots=8, naive_voxels=None, iters_check=250)
     keys = [bench._key(c) for c in bench._cases(args)]
     assert keys[:3] == ["window/v0.05/r1", "multi/v0.05/r8", "naive/v0.05/r1"]
     assert keys[3:7] == ["multi/v0.04/r8", "window/v0.04/r1", "multi/v0.03/r8", "window/v0.03/r1"]
-    assert keys[7:] == ["stand/v0.05/r4", "stand/v0.04/r4", "stand/v0.03/r4"]
+    assert keys[7] == "multi/v0.05/r8/it250"
+    assert keys[8:] == ["stand/v0.05/r4", "stand/v0.04/r4", "stand/v0.03/r4"]
 
 
 def test_convergence_verdicts() -> None:
@@ -56,18 +57,19 @@ def test_convergence_verdicts() -> None:
 
 @pytest.mark.slow
 def test_tiny_cpu_run(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
-    """10 cm / 8 cm voxels, 2 robots, 4 frames on CPU: every case finishes and bench.json holds its numbers."""
+    """10 cm / 8 cm voxels, 2 robots, 4 frames on CPU: all 8 cases finish and bench.json holds their numbers."""
     if not POLICY.exists():
         pytest.skip(f"no exported policy at {POLICY}")
     bench = _load()
     argv = ["bench", "--out", str(tmp_path), "--policy", str(POLICY), "--voxels", "0.1", "0.08", "--robots", "2",
             "--frames", "4", "--stand-frames", "4", "--device", "cpu", "--window-length", "0.6",
-            "--window-width", "0.4", "--max-minutes", "8"]  # fmt: skip
+            "--window-width", "0.4", "--max-minutes", "8", "--iters-check", "75"]  # fmt: skip
     monkeypatch.setattr(sys, "argv", argv)
     bench.main()
     doc = json.loads((tmp_path / "bench.json").read_text())
     res = doc["results"]
-    assert len(res) == 7 and all("frames_per_s" in r for r in res.values()), res
+    assert len(res) == 8 and all("frames_per_s" in r for r in res.values()), res
+    assert set(doc["convergence"]["iterations"]) >= {"sinkage_m_change", "iterations"}
     assert res["naive/v0.1/r1"]["particles"] > res["window/v0.1/r1"]["particles"]
     assert res["multi/v0.1/r2"]["particles"] == 2 * res["window/v0.1/r1"]["particles"]
-    assert set(doc["convergence"]) == {"multi", "stand"}
+    assert set(doc["convergence"]) == {"multi", "stand", "iterations"}
