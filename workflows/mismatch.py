@@ -12,8 +12,9 @@ Run alone (works with plain ``python`` and ``PYTHONPATH=packages/*/src:workflows
     python workflows/mismatch.py +exp=gm_loco run_dir=runs/gm_loco/<name> mismatch.real=data/logs/robot.mcap
 
 Contract: ``run(cfg)`` reads ``cfg.mismatch``, writes every file under ``cfg.mismatch.out_dir`` and returns the
-verdict and its numbers. A 6 s recording with the whole library takes about 2 min on 2 CPU cores; the analysis
-cannot stop midway, so ``max_minutes`` is not checked inside it.
+verdict and its numbers. A 9 s recording with the whole library costs about 50-60 s of CPU time (one core);
+the analysis cannot stop midway, so ``max_minutes`` is not checked inside it. A worked example from the command
+line to the report is in ``docs/mismatch.md``.
 """
 
 from __future__ import annotations
