@@ -62,7 +62,7 @@ def _seed_run_dir(run_dir: Path, artifact: Path, weights_only: bool) -> tuple[in
     ckpt = torch.load(artifact / "checkpoint.pt", map_location="cpu", weights_only=False)
     it = int(ckpt["iter"])
     if weights_only:
-        ckpt["infos"] = {k: v for k, v in (ckpt.get("infos") or {}).items() if k != "common_step_counter"}
+        ckpt["infos"] = {k: v for k, v in (ckpt.get("infos") or {}).items() if k != "env_state"}
         init = run_dir.parent / f"{run_dir.name}_init.pt"
         torch.save(ckpt, init)
         return it, str(init)

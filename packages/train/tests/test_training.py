@@ -60,7 +60,7 @@ def test_checkpoint_carries_the_curriculum_step_counter(run_dir: Path) -> None:
     import torch
 
     ckpt = torch.load(run_dir / "model_3.pt", map_location="cpu", weights_only=False)
-    assert ckpt["infos"]["common_step_counter"] == 3 * 4
+    assert ckpt["infos"]["env_state"]["common_step_counter"] == 3 * 4
 
 
 def test_resume_refuses_a_changed_task(run_dir: Path) -> None:

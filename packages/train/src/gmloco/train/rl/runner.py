@@ -115,13 +115,8 @@ class GmlocoOnPolicyRunner(MjlabOnPolicyRunner):
 
     def save(self, path: str, infos: dict | None = None) -> None:
         """Write the checkpoint to ``path + '.tmp'`` then ``os.replace`` it (a kill never leaves half a file)."""
-        env = self.env.unwrapped
-        sand = getattr(env, "sand", None)
-        infos = {
-            **(infos or {}),
-            "sand_floor_level": None if sand is None else sand.floor_level.cpu(),
-            "common_step_counter": getattr(env, "common_step_counter", None),
-        }
+        sand = getattr(self.env.unwrapped, "sand", None)
+        infos = {**(infos or {}), "sand_floor_level": None if sand is None else sand.floor_level.cpu()}
         tmp = f"{path}.tmp"
         super().save(tmp, infos)
         os.replace(tmp, path)
@@ -129,15 +124,12 @@ class GmlocoOnPolicyRunner(MjlabOnPolicyRunner):
     def load(
         self, path: str, load_cfg: dict | None = None, strict: bool = True, map_location: str | None = None
     ) -> dict:
-        """Load a checkpoint, restoring the env step counter (curricula) and the floor levels."""
+        """Load a checkpoint, restoring the floor levels (mjlab's runner restores the env step counter)."""
         infos = super().load(path, load_cfg, strict, map_location or self.device)
         levels = (infos or {}).get("sand_floor_level")
         env = self.env.unwrapped
         if levels is not None and levels.shape[0] == env.num_envs:
             get_sand(env).floor_level.copy_(levels.to(env.device))
-        counter = (infos or {}).get("common_step_counter")
-        if counter is not None and hasattr(env, "common_step_counter"):
-            env.common_step_counter = int(counter)
         return infos
 
     def _prune(self) -> None:
