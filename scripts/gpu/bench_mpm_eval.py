@@ -10,7 +10,8 @@ Every case builds a ``G1MpmScene`` (dry sand, the policy walking at 1.0 / 1.5 / 
 captures a frame graph when it can, steps ``--frames`` frames and records frames/s. A 10 s episode is 1000 frames,
 so a batch of R robots takes build + capture + 1000 / fps seconds: episodes/min = 60 R / that. Cases run in
 priority order and are skipped when their predicted time would overrun the time box; ``bench.json`` is rewritten
-after each case (rerun with the same ``--out`` to resume: finished cases are kept).
+after each case (rerun with the same ``--out`` to resume: measured cases are kept, skipped and failed ones run
+again; each call first warms up, i.e. loads or compiles the kernels, apart from the timed cases).
 
 Convergence check (``convergence`` in the JSON): for each voxel size, the multi-robot case's mean sinkage of the
 feet over the last half of the run, the pelvis height and the mean forward velocity (over robots), plus a PD-only
@@ -34,6 +35,7 @@ from typing import Any
 import numpy as np
 
 SPEEDS = (1.0, 1.5, 2.0, 2.5)
+METRICS = ("sinkage_m", "pelvis_z_m", "vx_mps")
 
 
 def _parse() -> argparse.Namespace:
@@ -149,11 +151,17 @@ def _run_case(case: dict[str, Any], args: argparse.Namespace) -> dict[str, Any]:
     }  # fmt: skip
 
 
+def _measured(r: dict[str, Any], keys: tuple[str, ...] = ("frames_per_s",)) -> bool:
+    """True for a record holding the given numbers (a measured case), False for skipped or failed ones."""
+    return "error" not in r and "skipped" not in r and all(k in r for k in keys)
+
+
 def _convergence(results: dict[str, dict[str, Any]], tol: float) -> dict[str, Any]:
     """Metrics per voxel against the finest voxel measured (multi-robot walking and standing cases)."""
     out: dict[str, Any] = {}
     for mode, keys in (("multi", ("sinkage_m", "pelvis_z_m", "vx_mps")), ("stand", ("sinkage_m", "pelvis_z_m"))):
-        rs = sorted((r for r in results.values() if r.get("mode") == mode and "error" not in r and "skipped" not in r
+        # measured records only: a skipped or failed case carries no metrics (a partial bench.json holds both)
+        rs = sorted((r for r in results.values() if r.get("mode") == mode and _measured(r, keys)
                      and "iters" not in r),
                     key=lambda r: r["voxel"])  # fmt: skip
         if not rs:
@@ -176,7 +184,7 @@ def _convergence(results: dict[str, dict[str, Any]], tol: float) -> dict[str, An
             row["accepted"] = (bool(ok) and not floor) if r is not ref else None
             rows.append(row)
         out[mode] = {"reference_voxel": ref["voxel"], "rows": rows}
-    many = [r for r in results.values() if "iters" in r and "frames_per_s" in r]
+    many = [r for r in results.values() if "iters" in r and _measured(r, METRICS)]
     for r in many:  # the same case with more rheology iterations is the reference
         base = next(
             (
@@ -186,15 +194,15 @@ def _convergence(results: dict[str, dict[str, Any]], tol: float) -> dict[str, An
                 and b.get("voxel") == r["voxel"]
                 and b.get("robots") == r["robots"]
                 and "iters" not in b
-                and "frames_per_s" in b
+                and _measured(b, METRICS)
             ),
             None,
         )
         if base is not None:
             out["iterations"] = {
                 "voxel": r["voxel"], "iterations": r["iters"],
-                **{f"{k}_change": abs(base[k] - r[k]) for k in ("sinkage_m", "pelvis_z_m", "vx_mps")},
-                **{f"{k}_at_{r['iters']}": r[k] for k in ("sinkage_m", "pelvis_z_m", "vx_mps")},
+                **{f"{k}_change": abs(base[k] - r[k]) for k in METRICS},
+                **{f"{k}_at_{r['iters']}": r[k] for k in METRICS},
             }  # fmt: skip
     return out
 
@@ -212,15 +220,16 @@ def main() -> None:
     doc: dict[str, Any] = json.loads(path.read_text()) if path.exists() else {"results": {}}
     results: dict[str, dict[str, Any]] = doc["results"]
     t_start, budget = time.perf_counter(), 60.0 * args.max_minutes
-    if "warmup_s" not in doc:  # compile every kernel once, so no case's build time includes JIT compilation
+    todo = [c for c in _cases(args) if not _measured(results.get(_key(c), {}))]  # skipped / failed: run again
+    if todo:  # every process compiles / loads its kernels once, so no case's build time includes JIT compilation
         t0 = time.perf_counter()
         _run_case({"mode": "window", "voxel": max(args.voxels), "robots": 2}, replace(args, frames=3))
-        doc["warmup_s"] = time.perf_counter() - t0
-        print(f"[bench] warm-up (kernel compilation) {doc['warmup_s']:.0f} s", flush=True)
-    for case in _cases(args):
+        warm = time.perf_counter() - t0
+        doc.setdefault("warmup_s", warm)  # the first call's (cold cache); every call's in warmups_s
+        doc["warmups_s"] = [*doc.get("warmups_s", []), warm]
+        print(f"[bench] warm-up (kernel compilation / loading) {warm:.0f} s", flush=True)
+    for case in todo:
         key = _key(case)
-        if key in results and "error" not in results[key]:
-            continue
         left = budget - (time.perf_counter() - t_start)
         guess = _predict(case, results, args.stand_frames if case["mode"] == "stand" else args.frames)
         if guess > left:

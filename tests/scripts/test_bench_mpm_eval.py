@@ -8,6 +8,7 @@ import json
 import sys
 from pathlib import Path
 from types import ModuleType
+from typing import Any
 
 import pytest
 
@@ -73,3 +74,76 @@ def test_tiny_cpu_run(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
     assert res["naive/v0.1/r1"]["particles"] > res["window/v0.1/r1"]["particles"]
     assert res["multi/v0.1/r2"]["particles"] == 2 * res["window/v0.1/r1"]["particles"]
     assert set(doc["convergence"]) == {"multi", "stand", "iterations"}
+
+
+def _partial_h100_results() -> dict[str, dict[str, Any]]:
+    """The shape of the H100 run's bench.json (commit 9af447a) when ``_convergence`` raised ``KeyError: 'sinkage_m'``.
+
+    Five measured cases (numbers rounded from ``results/mpm_eval/bench_h100.json``; no ``capture_error`` key, which
+    that commit did not write) and the case the time box skipped: ``{**case, "skipped": ...}``, no metrics.
+    """
+
+    def rec(mode: str, voxel: float, n: int, parts: int, fps: float, sink: float, pz: float, vx: float) -> dict:
+        return {"mode": mode, "voxel": voxel, "robots": n, "particles": parts, "graph": True, "build_s": 1.0,
+                "capture_s": 0.1, "frames": 150, "frames_per_s": fps, "sinkage_m": sink, "max_sinkage_m": 3.0,
+                "depth_m": 0.15, "pelvis_z_m": pz, "vx_mps": vx, "fallen": n}  # fmt: skip
+
+    return {
+        "window/v0.05/r1": rec("window", 0.05, 1, 17280, 107.7, 1.058, -0.388, -0.268),
+        "multi/v0.05/r32": rec("multi", 0.05, 32, 552960, 30.8, 1.121, -0.426, -0.230),
+        "naive/v0.05/r1": rec("naive", 0.05, 1, 251520, 54.4, 1.381, -0.639, -0.358),
+        "multi/v0.04/r32": rec("multi", 0.04, 32, 1152000, 17.3, 0.897, -0.154, -0.146),
+        "window/v0.04/r1": rec("window", 0.04, 1, 36000, 105.1, 0.818, -0.107, -0.407),
+        "multi/v0.03/r32": {"mode": "multi", "voxel": 0.03, "robots": 32, "skipped": "predicted 131 s > 120 s left"},
+    }
+
+
+def test_convergence_ignores_skipped_and_failed_records() -> None:
+    """The partial H100 results (a skipped multi case, no metrics) give a verdict over the measured voxels only."""
+    bench = _load()
+    res = _partial_h100_results()
+    res["stand/v0.05/r4"] = {"mode": "stand", "voxel": 0.05, "robots": 4, "error": "RuntimeError('x')"}
+    conv = bench._convergence(res, 0.15)
+    assert set(conv) == {"multi"}
+    rows = conv["multi"]["rows"]
+    assert [r["voxel"] for r in rows] == [0.04, 0.05]
+    assert rows[1]["sinkage_m_change"] == pytest.approx(1.121 - 0.897)
+    assert rows[1]["floor_reached"] and rows[1]["accepted"] is False  # 3 m of sinkage on a 15 cm bed: no verdict
+
+
+def test_resume_from_the_partial_h100_bench_runs_the_rest(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    """Rerun with the same --out: measured cases kept, the skipped one and the missing ones run, convergence done.
+
+    ``_run_case`` (a GPU scene) is replaced by a recorder returning metrics that depend on the case, so this checks
+    the resume bookkeeping only; ``test_tiny_cpu_run`` runs the real scene.
+    """
+    bench = _load()
+    (tmp_path / "bench.json").write_text(json.dumps({"results": _partial_h100_results(), "warmup_s": 105.5}))
+    ran: list[str] = []
+
+    def fake_run(case: dict[str, Any], args: Any) -> dict[str, Any]:
+        ran.append(bench._key(case) if args.frames > 3 or case["mode"] == "stand" else "warm-up")
+        v = case["voxel"]
+        return {**case, "particles": int(1.0 / v**3) * case["robots"], "graph": True, "capture_error": None, "build_s": 1.0,
+                "capture_s": 0.1, "frames": args.frames, "frames_per_s": 2.0 / v, "episodes_per_min": 1.0,
+                "batch_episode_s": 60.0, "sinkage_m": 0.02 + v, "max_sinkage_m": 0.05, "depth_m": 0.15,
+                "pelvis_z_m": 0.7, "vx_mps": 1.0 + case.get("iters", 50) / 1e4}  # fmt: skip
+
+    monkeypatch.setattr(bench, "_run_case", fake_run)
+    argv = ["bench", "--out", str(tmp_path), "--voxels", "0.05", "0.04", "0.03", "--robots", "32",
+            "--max-minutes", "8"]  # fmt: skip
+    monkeypatch.setattr(sys, "argv", argv)
+    bench.main()
+    assert ran == ["warm-up", "multi/v0.03/r32", "window/v0.03/r1", "multi/v0.05/r32/it250",
+                   "stand/v0.05/r4", "stand/v0.04/r4", "stand/v0.03/r4"]  # fmt: skip
+    doc = json.loads((tmp_path / "bench.json").read_text())
+    assert doc["warmup_s"] == 105.5 and len(doc["warmups_s"]) == 1
+    assert doc["results"]["multi/v0.05/r32"]["frames_per_s"] == 30.8  # the measured H100 record is kept
+    assert set(doc["convergence"]) == {"multi", "stand", "iterations"}
+    assert [r["voxel"] for r in doc["convergence"]["multi"]["rows"]] == [0.03, 0.04, 0.05]
+    it = doc["convergence"]["iterations"]  # the 250-iteration rerun against the kept H100 record at 50
+    assert it["vx_mps_at_250"] == pytest.approx(1.025) and it["vx_mps_change"] == pytest.approx(1.025 + 0.230)
+    # a second rerun has nothing left: no warm-up, no case
+    ran.clear()
+    bench.main()
+    assert ran == []
