@@ -147,7 +147,9 @@ def _run_case(case: dict[str, Any], args: argparse.Namespace) -> dict[str, Any]:
         "max_sinkage_m": float(np.max(scene.sinkage)), "depth_m": cfg.terrain.depth,
         "pelvis_z_m": float(np.mean(q[half:, :, 2])), "vx_mps": float(np.mean(qd[half:, :, 0])),
         "support_ratio": float(np.mean(scene.support_ratio())),
-        "fallen": int(np.sum(q[-1, :, 2] < 0.2)), "device": str(scene.device),
+        "fallen": int(np.sum(q[-1, :, 2] < 0.2)),
+        # pelvis below the rigid floor (z = -depth): the robot went through bed and floor, the timing is not a walk's
+        "through_floor": int(np.sum(q[-1, :, 2] < -cfg.terrain.depth)), "device": str(scene.device),
     }  # fmt: skip
 
 
@@ -240,7 +242,8 @@ def main() -> None:
             results[key] = _run_case(case, args)
             r = results[key]
             print(f"[bench] {key}: {r['particles']} particles, {r['frames_per_s']:.1f} frames/s, "
-                  f"{r['episodes_per_min']:.1f} episodes/min, build {r['build_s']:.0f} s", flush=True)  # fmt: skip
+                  f"{r['episodes_per_min']:.1f} episodes/min, build {r['build_s']:.0f} s, fallen {r['fallen']}, "
+                  f"through the floor {r['through_floor']} of {r['robots']}", flush=True)  # fmt: skip
         except Exception as exc:  # one failing case must not lose the others
             results[key] = {**case, "error": repr(exc), "traceback": traceback.format_exc()[-2000:]}
             print(f"[bench] {key} failed: {exc!r}", flush=True)

@@ -73,6 +73,7 @@ def test_tiny_cpu_run(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
     assert set(doc["convergence"]["iterations"]) >= {"sinkage_m_change", "iterations"}
     assert res["naive/v0.1/r1"]["particles"] > res["window/v0.1/r1"]["particles"]
     assert res["multi/v0.1/r2"]["particles"] == 2 * res["window/v0.1/r1"]["particles"]
+    assert all(r["through_floor"] == 0 for r in res.values()), res  # on the CPU the robots stay above the floor
     assert set(doc["convergence"]) == {"multi", "stand", "iterations"}
 
 
@@ -124,10 +125,10 @@ def test_resume_from_the_partial_h100_bench_runs_the_rest(tmp_path: Path, monkey
     def fake_run(case: dict[str, Any], args: Any) -> dict[str, Any]:
         ran.append(bench._key(case) if args.frames > 3 or case["mode"] == "stand" else "warm-up")
         v = case["voxel"]
-        return {**case, "particles": int(1.0 / v**3) * case["robots"], "graph": True, "capture_error": None, "build_s": 1.0,
-                "capture_s": 0.1, "frames": args.frames, "frames_per_s": 2.0 / v, "episodes_per_min": 1.0,
+        return {**case, "particles": int(1.0 / v**3) * case["robots"], "graph": True, "capture_error": None,
+                "build_s": 1.0, "capture_s": 0.1, "frames": args.frames, "frames_per_s": 2.0 / v, "episodes_per_min": 1.0,
                 "batch_episode_s": 60.0, "sinkage_m": 0.02 + v, "max_sinkage_m": 0.05, "depth_m": 0.15,
-                "pelvis_z_m": 0.7, "vx_mps": 1.0 + case.get("iters", 50) / 1e4}  # fmt: skip
+                "pelvis_z_m": 0.7, "fallen": 0, "through_floor": 0, "vx_mps": 1.0 + case.get("iters", 50) / 1e4}  # fmt: skip
 
     monkeypatch.setattr(bench, "_run_case", fake_run)
     argv = ["bench", "--out", str(tmp_path), "--voxels", "0.05", "0.04", "0.03", "--robots", "32",
