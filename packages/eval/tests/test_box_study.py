@@ -121,3 +121,75 @@ def test_roll_variant_geometry() -> None:
     # lowest point: hy sin 15 + hz cos 15 = 0.15 * 0.2588 + 0.1 * 0.9659 = 0.13541 m below the CoM
     np.testing.assert_allclose(box.initial_pos[2], 0.1 + 0.13541, atol=1e-5)
     np.testing.assert_allclose(BoxCfg().initial_pos, [0.0, 0.0, 0.2])  # unrotated box unchanged
+
+
+def _impact_series(f_lat: list[float], weight: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """10 samples of 10 ms: airborne for 3, then 4 samples in contact (F_z = m g, F_y = f_lat), then at rest."""
+    time = 0.01 * np.arange(1, 11)
+    grf = np.zeros((10, 3))
+    grf[3:7, 2] = weight
+    grf[3:7, 1] = f_lat
+    x = 0.01 * np.minimum(np.arange(1, 11), 7)  # 1 m/s until sample 6, then at rest
+    pos = np.stack([x, np.zeros(10), np.zeros(10)], axis=-1)
+    return time, grf, pos
+
+
+def test_lateral_impact_hand_values() -> None:
+    """Peak and impulse of |F_lat| over the impact window; the time mean (old metric) and signed impulse are 0."""
+    from gmloco.eval.box_study_checks import impact_window, lateral_impact
+    from gmloco.eval.metrics.box import metric_lateral_force
+
+    weight = 35.0 * 9.81
+    time, grf, pos = _impact_series([50.0, -50.0, 50.0, -50.0], weight)
+    assert impact_window(time, grf, pos, weight) == (3, 7)
+    m = lateral_impact(time, grf, pos, (1.0, 0.0), weight)  # lateral axis e_z x e_x = +y
+    np.testing.assert_allclose(m["peak_lateral_over_mg"], 50.0 / weight)
+    np.testing.assert_allclose(m["lateral_impulse_abs"], 4 * 50.0 * 0.01)
+    np.testing.assert_allclose([m["lateral_impulse"], m["impact_duration"]], [0.0, 0.04], atol=1e-12)
+    assert metric_lateral_force(grf, (1.0, 0.0)) == 0.0
+    # launched along +y the lateral axis is -x: a force along -x is lateral, one along y is not
+    g2 = grf[:, [1, 0, 2]] * np.array([-1.0, 1.0, 1.0])
+    m2 = lateral_impact(time, g2, pos[:, [1, 0, 2]], (0.0, 1.0), weight)
+    np.testing.assert_allclose(m2["lateral_impulse_abs"], 2.0)
+    air = lateral_impact(time, np.zeros((10, 3)), pos, (1.0, 0.0), weight)
+    assert air["impact_duration"] == 0.0 and air["peak_lateral_over_mg"] == 0.0
+
+
+def test_lateral_impact_summary_scores_against_mpm(tmp_path: Path) -> None:
+    """Per-model medians and errors against MPM on matched trials; ties with the best are listed."""
+    from gmloco.eval.box_study_checks import lateral_impact_summary
+
+    weight = 35.0 * 9.81
+    rec = StudyRecords(tmp_path)
+    for model, f in (("mpm", 20.0), ("a", 20.0), ("b", 80.0), ("c", 0.0)):
+        time, grf, pos = _impact_series([f, -f, f, -f], weight)
+        row = {"variant": "lateral", "trial": 0, "model": model, "travel": 0.1, "sinkage": 0.01,
+               "lateral_force": 0.0, "peak_fz": weight, "wall_s": 1.0, "frames_per_s": 1.0, "particle_count": 0,
+               "voxel_size": 0.0}  # fmt: skip
+        rec.append(row, {"time": time, "grf": grf, "pos": pos})
+    out = lateral_impact_summary(rec, {"lateral": (1.0, 0.0)}, weight)["lateral"]
+    np.testing.assert_allclose(out["models"]["b"]["peak_lateral_err_median"], 60.0 / weight)
+    np.testing.assert_allclose(out["models"]["b"]["impulse_rel_err_median"], (3.2 - 0.8) / 0.8)
+    np.testing.assert_allclose(out["models"]["c"]["impulse_rel_err_median"], 1.0)
+    assert out["best"]["peak_lateral_err_median"] == "a" and out["models"]["a"]["peak_lateral_err_median"] == 0.0
+    assert out["within_1pct_of_best"]["drift_abs_err_median"] == ["a", "b", "c"]  # no model drifts sideways
+
+
+def test_voxel_convergence_lists_failed_level(tmp_path: Path) -> None:
+    """A level without MPM records (the solve failed) is listed with its log's error, the others compared."""
+    from gmloco.eval.box_study_checks import write_voxel_convergence
+
+    d5 = _fake_mpm_dir(tmp_path / "v5", 0.05, [0.30, 0.40], [0.020, 0.030])
+    d3 = _fake_mpm_dir(tmp_path / "v3", 0.03, [0.21, 0.32], [0.012, 0.022])
+    bad = tmp_path / "v2"
+    bad.mkdir()
+    (bad / "config.json").write_text(json.dumps({"mpm": {"voxel_size": 0.02, "max_iterations": 250}}))
+    (tmp_path / "v2.log").write_text("Traceback (most recent call last):\n  ...\nAssertionError: sand leaked\n")
+    res = write_voxel_convergence([d5, d3, bad], tmp_path / "out" / "convergence.json")
+    assert [lv["voxel_size"] for lv in res["levels"]] == [0.05, 0.03]
+    assert res["failed_levels"] == [
+        {"dir": str(bad), "voxel_size": 0.02, "max_iterations": 250, "error": "AssertionError: sand leaked"}
+    ]
+    assert json.loads((tmp_path / "out" / "convergence.json").read_text())["converged"] is False
+    with pytest.raises(ValueError, match="holds MPM trials"):
+        write_voxel_convergence([bad], tmp_path / "x.json")

@@ -111,3 +111,22 @@ def test_batched_regions_match_single_scenes() -> None:
     # same medium, same particles, separate region: equal up to the solver's global stopping test (measured 2e-6 m)
     np.testing.assert_allclose(q[:, 0], np.array(single.body_q)[:, :3], atol=1e-3)
     assert np.max(np.abs(q[:, 1] - q[:, 0])) > 2e-3  # poppy seed (rho_c 638, mu_int 0.51) is not dry sand
+
+
+def test_final_diagnostics_count_leaked_particles(resting_box: MpmBoxScene) -> None:
+    """No particle below the floor after the run; one moved 1 m down is counted, per region, and fails test_final."""
+    d = resting_box.diagnostics()
+    assert d["leaked_particles"] == 0 and d["leaked_per_region"] == [0] and d["nonfinite_particles"] == 0
+    q = resting_box.sand_state.particle_q
+    saved = q.numpy().copy()
+    moved = saved.copy()
+    moved[0, 2] = -1.0
+    try:
+        q.assign(moved)
+        d = resting_box.diagnostics()
+        assert d["leaked_particles"] == 1 and d["leaked_per_region"] == [1] and d["particle_z_min"] == -1.0
+        with pytest.raises(AssertionError, match="1 of"):
+            resting_box.test_final()
+    finally:
+        q.assign(saved)
+    resting_box.test_final()

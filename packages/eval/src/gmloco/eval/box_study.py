@@ -186,7 +186,13 @@ def _run_mpm_batch(
     scene_cfg = MpmBoxSceneCfg(box=box, bed=cfg.bed, solver=cfg.mpm, device=cfg.device, rigid_solver=cfg.rigid_solver)
     scene = MpmBoxScene(scene_cfg, mats)
     scene.run()
-    scene.test_final()
+    try:
+        scene.test_final()
+    except AssertionError:
+        # keep what a failed solve tells (which region, how far, how many particles) for the report
+        diag = {"trials": trials, "media": [asdict(m) for m in mats], **scene.diagnostics()}
+        (Path(cfg.out_dir) / "mpm_failure.json").write_text(json.dumps(diag, indent=1, default=float))
+        raise
     q_all, f_all = np.array(scene.body_q_all), np.array(scene.sand_force_all)  # [T, R, 7] (p, q_xyzw), [T, R, 3]
     timing = {"wall_s": (time.perf_counter() - t0) / len(trials), "frames_per_s": scene.frames_per_second,
               "particle_count": scene.particle_count // len(trials), "voxel_size": cfg.mpm.voxel_size}  # fmt: skip
@@ -230,10 +236,12 @@ def run(cfg: BoxStudyCfg) -> dict[str, Any]:
     complete = _run_mpm(cfg, records, media, t_start) if "mpm" in models else True
     # MPM is the reference of every score, also when this call only adds reduced-order models
     summary = summarize_study(records, cfg, models if "mpm" in models else ["mpm", *models])
-    if any(v.startswith("size_x") for v in cfg.variants):
-        from gmloco.eval.box_study_checks import size_sensitivity
+    from gmloco.eval.box_study_checks import lateral_impact_summary, size_sensitivity
 
+    if any(v.startswith("size_x") for v in cfg.variants):
         summary["size_sensitivity"] = size_sensitivity(summary)
+    velocities = {v: _variant_box(cfg, v).velocity for v in cfg.variants}
+    summary["lateral_impact"] = lateral_impact_summary(records, velocities, cfg.box.mass * 9.81)
     summary["complete"] = complete
     summary["wall_s_this_run"] = time.perf_counter() - t_start
     (Path(cfg.out_dir) / "summary.json").write_text(json.dumps(summary, indent=1))
@@ -241,4 +249,7 @@ def run(cfg: BoxStudyCfg) -> dict[str, Any]:
         from gmloco.eval.figures.fig_box_intrusion import fig_box_intrusion
 
         fig_box_intrusion(records, cfg.box.mass, Path(cfg.out_dir) / "fig_box_intrusion.png")
+        from gmloco.eval.box_study_checks import fig_lateral_impact
+
+        fig_lateral_impact(records, velocities, cfg.box.mass * 9.81, Path(cfg.out_dir) / "fig_lateral_impact.png")
     return summary
