@@ -36,6 +36,7 @@ import numpy as np
 
 SPEEDS = (1.0, 1.5, 2.0, 2.5)
 METRICS = ("sinkage_m", "pelvis_z_m", "vx_mps")
+_AS_WORLDS = {"auto": None, "yes": True, "no": False}
 
 
 def _parse() -> argparse.Namespace:
@@ -56,6 +57,12 @@ def _parse() -> argparse.Namespace:
     p.add_argument("--device", default=None)
     p.add_argument("--window-length", type=float, default=1.8)
     p.add_argument("--window-width", type=float, default=1.0)
+    p.add_argument(
+        "--robots-as-worlds",
+        choices=("auto", "yes", "no"),
+        default="auto",
+        help="one MuJoCo world per robot (auto: on CUDA); 'no' puts all robots in one world (diagnostics)",
+    )
     return p.parse_args()
 
 
@@ -112,7 +119,8 @@ def _scene_cfg(case: dict[str, Any], args: argparse.Namespace) -> Any:
                           max_iterations=int(case.get("iters", args.iters)))  # fmt: skip
     cmds = ((0.0, 0.0, 0.0),) if case["mode"] == "stand" else tuple((v, 0.0, 0.0) for v in SPEEDS)
     return G1MpmSceneCfg(terrain=terrain, window=win, num_robots=n, lane_spacing=args.window_width + 2.0,
-                         solver=solver, commands=cmds, device=args.device)  # fmt: skip
+                         solver=solver, commands=cmds, device=args.device,
+                         robots_as_worlds=_AS_WORLDS[getattr(args, "robots_as_worlds", "auto")])  # fmt: skip
 
 
 def _run_case(case: dict[str, Any], args: argparse.Namespace) -> dict[str, Any]:

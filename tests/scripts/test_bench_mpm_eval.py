@@ -148,3 +148,13 @@ def test_resume_from_the_partial_h100_bench_runs_the_rest(tmp_path: Path, monkey
     ran.clear()
     bench.main()
     assert ran == []
+
+
+def test_robots_as_worlds_flag_reaches_the_scene_cfg() -> None:
+    """--robots-as-worlds auto / yes / no -> G1MpmSceneCfg.robots_as_worlds None / True / False (GPU diagnostics)."""
+    bench = _load()
+    base = {"voxels": [0.05], "iters": 50, "window_length": 1.8, "window_width": 1.0, "device": "cpu"}
+    case = {"mode": "window", "voxel": 0.05, "robots": 2}
+    got = {f: bench._scene_cfg(case, bench.Namespace(**base, robots_as_worlds=f)).robots_as_worlds
+           for f in ("auto", "yes", "no")}  # fmt: skip
+    assert got == {"auto": None, "yes": True, "no": False}
