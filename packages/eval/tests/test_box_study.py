@@ -193,3 +193,27 @@ def test_voxel_convergence_lists_failed_level(tmp_path: Path) -> None:
     assert json.loads((tmp_path / "out" / "convergence.json").read_text())["converged"] is False
     with pytest.raises(ValueError, match="holds MPM trials"):
         write_voxel_convergence([bad], tmp_path / "x.json")
+
+
+def test_failed_mpm_solve_is_logged_and_skipped(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    """A solve failing its physical checks: diagnostics logged, its trials left out, the next batch still runs."""
+    from gmloco.eval.mpm.box_scene import MpmBoxScene
+
+    real = MpmBoxScene.test_final
+    calls = []
+
+    def fail_first(self: MpmBoxScene) -> None:
+        calls.append(1)
+        if len(calls) == 1:
+            raise AssertionError("sand leaked through the floor: test")
+        real(self)
+
+    monkeypatch.setattr(MpmBoxScene, "test_final", fail_first)
+    cfg = replace(box_study_smoke_cfg(str(tmp_path)), num_trials=2, mpm_batch=1, models=("mpm",),
+                  box=replace(box_study_smoke_cfg(str(tmp_path)).box, duration=0.05))  # fmt: skip
+    summary = run(cfg)
+    assert [r["trial"] for r in StudyRecords(tmp_path).rows()] == [1]
+    assert summary["complete"] is False
+    (fail,) = summary["mpm_failures"]
+    assert fail["trials"] == [0] and fail["variant"] == "forward" and fail["leaked_particles"] == 0
+    assert "test" in fail["error"] and fail["leaked_per_region"] == [0]

@@ -23,8 +23,10 @@ from gmloco.eval.mpm.box_scene import MpmSolverCfg
 from gmloco.eval.rom_box import ROM_MODELS, RomBoxCfg, simulate_rom_box
 from gmloco.eval.study_io import StudyRecords
 
-__all__ = ["MEDIA_DRAWS", "BoxStudyCfg", "box_study_smoke_cfg", "run", "sample_media"]
+__all__ = ["MEDIA_DRAWS", "MPM_FAILURES", "BoxStudyCfg", "box_study_smoke_cfg", "run", "sample_media"]
 
+MPM_FAILURES = "mpm_failures.jsonl"
+"""Per failed MPM solve: variant, trials, error and ``MpmBoxScene.diagnostics()`` (one JSON line each)."""
 MEDIA_DRAWS = 1024
 """Draws per medium parameter from the study seed; trial t uses draw t whatever the number of trials."""
 
@@ -170,9 +172,12 @@ def _run_rom(cfg: BoxStudyCfg, records: StudyRecords, media: dict[str, np.ndarra
 
 
 def _run_mpm_batch(
-    cfg: BoxStudyCfg, box: BoxCfg, media: dict[str, np.ndarray], trials: list[int]
+    cfg: BoxStudyCfg, variant: str, box: BoxCfg, media: dict[str, np.ndarray], trials: list[int]
 ) -> list[tuple[dict, dict]]:
     """Simulate trials in one MPM solve (one walled region per trial); return each trial's trajectory and timing.
+
+    A solve that fails its physical checks (``MpmBoxScene.test_final``) appends its diagnostics to
+    ``MPM_FAILURES`` in the output directory and re-raises.
 
     Timing per trial: ``wall_s`` = the batch's wall time / its trials, ``frames_per_s`` = the batch's frames per
     second, ``particle_count`` = particles of one region.
@@ -188,10 +193,12 @@ def _run_mpm_batch(
     scene.run()
     try:
         scene.test_final()
-    except AssertionError:
+    except AssertionError as e:
         # keep what a failed solve tells (which region, how far, how many particles) for the report
-        diag = {"trials": trials, "media": [asdict(m) for m in mats], **scene.diagnostics()}
-        (Path(cfg.out_dir) / "mpm_failure.json").write_text(json.dumps(diag, indent=1, default=float))
+        diag = {"variant": variant, "trials": trials, "error": str(e), "media": [asdict(m) for m in mats],
+                **scene.diagnostics()}  # fmt: skip
+        with (Path(cfg.out_dir) / MPM_FAILURES).open("a") as f:
+            f.write(json.dumps(diag, default=float) + "\n")
         raise
     q_all, f_all = np.array(scene.body_q_all), np.array(scene.sand_force_all)  # [T, R, 7] (p, q_xyzw), [T, R, 3]
     timing = {"wall_s": (time.perf_counter() - t0) / len(trials), "frames_per_s": scene.frames_per_second,
@@ -217,7 +224,11 @@ def _run_mpm(cfg: BoxStudyCfg, records: StudyRecords, media: dict[str, np.ndarra
                 return False
             batch = todo[i : i + cfg.mpm_batch]
             t0 = time.perf_counter()
-            for trial, (traj, timing) in zip(batch, _run_mpm_batch(cfg, box, media, batch), strict=True):
+            try:
+                results = _run_mpm_batch(cfg, variant, box, media, batch)
+            except AssertionError:
+                results = []  # logged in MPM_FAILURES; the other batches still run (use --mpm-batch 1 to isolate)
+            for trial, (traj, timing) in zip(batch if results else [], results, strict=True):
                 records.append(*_record(cfg, variant, trial, "mpm", media, traj, box, timing))
             last_batch_s = time.perf_counter() - t0
     return True
@@ -242,6 +253,16 @@ def run(cfg: BoxStudyCfg) -> dict[str, Any]:
         summary["size_sensitivity"] = size_sensitivity(summary)
     velocities = {v: _variant_box(cfg, v).velocity for v in cfg.variants}
     summary["lateral_impact"] = lateral_impact_summary(records, velocities, cfg.box.mass * 9.81)
+    failures = Path(cfg.out_dir) / MPM_FAILURES
+    if failures.exists():
+        lines = [json.loads(ln) for ln in failures.read_text().splitlines() if ln.strip()]
+        keys = ("variant", "trials", "error", "leaked_particles", "leaked_per_region", "particle_z_min", "box_z")
+        summary["mpm_failures"] = [{k: f.get(k) for k in keys} for f in lines]
+    if "mpm" in models:  # failed solves leave their trials without records
+        done = records.done()
+        complete = complete and all(
+            records.key(v, t, "mpm") in done for v in cfg.variants for t in range(cfg.num_trials)
+        )
     summary["complete"] = complete
     summary["wall_s_this_run"] = time.perf_counter() - t_start
     (Path(cfg.out_dir) / "summary.json").write_text(json.dumps(summary, indent=1))
