@@ -8,7 +8,9 @@ Resumable and time-boxed (call it again with the same ``--out-dir`` to continue)
 
 Box-size check: ``--variants forward size_x0.7 size_x1.4`` (same 35 kg, footprint scaled). Voxel convergence:
 run the same ``--seed``/``--num-trials`` into one directory per ``--voxel-size``, then
-``--convergence DIR_5cm DIR_3cm DIR_2cm`` writes ``<out-dir>/convergence.json``.
+``--convergence DIR_5cm DIR_3cm DIR_2cm`` writes ``<out-dir>/convergence.json`` (a level whose MPM solve failed is
+listed under ``failed_levels`` with the error of ``DIR.log``). A failed MPM solve is logged to
+``mpm_failures.jsonl`` and skipped; ``summary.json`` holds ``lateral_impact`` (peak / impulse of the lateral force).
 """
 
 from __future__ import annotations
