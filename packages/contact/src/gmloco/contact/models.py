@@ -101,6 +101,7 @@ class ContactConeSingle(ContactModel):
     _eval_points = staticmethod(eval_cone_point_forces)
     _vertical_only = 1
     _multi = False
+    fused = False  # one point per foot: the tiled sum costs more than it saves (H100: 12.4 vs 7.6 us compute)
     _always_stateful = True  # plastic unloading needs z_max
 
     def __init__(
@@ -128,6 +129,7 @@ class ContactConeMulti(ContactConeSingle):
     """Cone-RFT at every sole grid point, each with its own state (GM-Loco ConeDRFTMultiPoint)."""
 
     _multi = True
+    fused = True  # many points per foot: the tiled per-foot sum pays off
 
 
 class ContactRigid(ContactModel):
