@@ -23,21 +23,13 @@ import torch
 
 from gmloco.train.config import ContactModelName, SandFloorCfg, TerrainName
 
-__all__ = ["EvalCfg", "evaluate_policy"]
+__all__ = ["EvalCfg", "RolloutCriteriaCfg", "evaluate_policy"]
 
 
 @dataclass
-class EvalCfg:
-    """Evaluation of one ONNX policy in the granular simulator."""
+class RolloutCriteriaCfg:
+    """Commands, cells and the paper's failure rules shared by the granular-simulator evaluations."""
 
-    policy_path: str = "runs/train/ppo_rft3d/policy.onnx"
-    """Exported policy (``gmloco.train`` export: metadata gives history length and action scale)."""
-    contact_model: ContactModelName | None = None
-    """Contact model of the simulator; None: the one in the policy metadata (else rft3d)."""
-    terrain: TerrainName = "flat"
-    """Sand terrain."""
-    materials: tuple[str, ...] = ("dry_sand", "poppy_seed")
-    """Material presets (``gmloco.contact.MATERIAL_PRESETS``)."""
     speeds: tuple[float, ...] = (1.0,)
     """Commanded forward speeds [m/s]."""
     repeats: int = 2
@@ -52,6 +44,20 @@ class EvalCfg:
         default_factory=lambda: SandFloorCfg(enabled=False, depth_range=(0.3, 0.3), num_levels=1, curriculum=False)
     )
     """Hard floor: off for the feet by default (GM-Loco play terrain), 30 cm down for other bodies."""
+
+
+@dataclass
+class EvalCfg(RolloutCriteriaCfg):
+    """Evaluation of one ONNX policy in the granular simulator."""
+
+    policy_path: str = "runs/train/ppo_rft3d/policy.onnx"
+    """Exported policy (``gmloco.train`` export: metadata gives history length and action scale)."""
+    contact_model: ContactModelName | None = None
+    """Contact model of the simulator; None: the one in the policy metadata (else rft3d)."""
+    terrain: TerrainName = "flat"
+    """Sand terrain."""
+    materials: tuple[str, ...] = ("dry_sand", "poppy_seed")
+    """Material presets (``gmloco.contact.MATERIAL_PRESETS``)."""
     device: str = "cpu"
     """Torch / Warp device."""
     seed: int = 0

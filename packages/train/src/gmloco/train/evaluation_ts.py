@@ -33,15 +33,19 @@ from typing import Any
 import numpy as np
 import torch
 
-from gmloco.train.config import ContactModelName, SandFloorCfg, TerrainName
+from gmloco.train.config import ContactModelName, TerrainName
+from gmloco.train.evaluation import RolloutCriteriaCfg
 from gmloco.train.teacher_student.heldout import DEFAULT_HELD_OUT, HeldOutRegionCfg, r2_score
 
 __all__ = ["TsEvalCfg", "adaptation_rollout", "decoded_eta_check", "evaluate_teacher_student", "swing_apexes"]
 
 
 @dataclass
-class TsEvalCfg:
-    """Held-out evaluation of a distilled student (and its teacher) in the granular training simulator."""
+class TsEvalCfg(RolloutCriteriaCfg):
+    """Held-out evaluation of a distilled student (and its teacher) in the granular training simulator.
+
+    Commands, cells and failure rules: :class:`~gmloco.train.evaluation.RolloutCriteriaCfg` (as ``EvalCfg``).
+    """
 
     student_checkpoint: str = "artifacts/gm_loco_student/checkpoint.pt"
     """``StudentPPO`` checkpoint (holds the frozen teacher in ``teacher_state_dict``)."""
@@ -65,22 +69,8 @@ class TsEvalCfg:
     """Surface friction of the held-out materials [-] (mu_surf is not part of the region)."""
     presets: tuple[str, ...] = ("basalt", "dry_sand", "beach_sand", "poppy_seed")
     """Named presets (``gmloco.contact.MATERIAL_PRESETS``)."""
-    speeds: tuple[float, ...] = (1.0,)
-    """Commanded forward speeds [m/s]."""
-    repeats: int = 2
-    """Envs per (material, speed) cell."""
-    duration_s: float = 10.0
-    """Episode duration that counts as success [s]."""
     eta_warmup_s: float = 1.0
     """Steps before this time are left out of the eta metrics (history filling) [s]."""
-    min_base_height: float = 0.2
-    """Failure: pelvis below this height above the sand [m]."""
-    max_tilt: float = math.pi / 4
-    """Failure: |roll| or |pitch| above this [rad]."""
-    floor: SandFloorCfg = field(
-        default_factory=lambda: SandFloorCfg(enabled=False, depth_range=(0.3, 0.3), num_levels=1, curriculum=False)
-    )
-    """Hard floor: off for the feet (GM-Loco play terrain), 30 cm down for other bodies (as ``EvalCfg``)."""
     adaptation_materials: tuple[str, ...] = ("basalt", "dry_sand", "poppy_seed")
     """Materials of the adaptation course, in walking order."""
     adaptation_edges: tuple[float, ...] = (3.0, 6.0)
