@@ -102,7 +102,7 @@ def test_hardening_zeroes_strength_of_fresh_bed(yield_probe: YieldProbe) -> None
 
 @pytest.mark.slow
 def test_dense_grid_plate_is_stiffer_and_rate_independent() -> None:
-    """Diagnosis measurement (4 cm voxels, 50 iterations, dry sand, horizontal plate pushed down; ~30 s on CPU).
+    """Diagnosis measurement (4 cm voxels, 50 iterations, dry sand, horizontal plate pushed down; ~10 s on CPU).
 
     Measured 2026-11-22: sparse G_z 0.196 (0.5 m/s) / 0.154 (0.1 m/s); dense 0.311 / 0.305. The sparse grid's
     per-step re-allocation loses warm-start information each frame (slower plate = more frames = softer).
