@@ -167,12 +167,32 @@ def _make_recorders(cfg: EvalCfg, env: Any, meta: dict[str, str], cells: list[tu
     return recorders
 
 
+def tracking_stats(num_envs: int, device: Any) -> dict[str, torch.Tensor]:
+    """Zeroed accumulators of :func:`accumulate_tracking`: alive ``steps``, ``vel_err`` and ``yaw_err`` sums."""
+    return {k: torch.zeros(num_envs, device=device) for k in ("steps", "vel_err", "yaw_err")}
+
+
+def accumulate_tracking(stats: dict[str, torch.Tensor], data: Any, commands: torch.Tensor, alive: torch.Tensor) -> None:
+    """Add one step of the alive envs: |v_xy - v_cmd| in the yaw frame [m/s] and |w_z - w_cmd| [rad/s].
+
+    Args:
+        stats: Accumulators from :func:`tracking_stats` (updated in place).
+        data: The robot's mjlab entity data (root pose and velocities, world frame).
+        commands: Commanded (v_x, v_y, w_z) per env [m/s, m/s, rad/s], [N, 3].
+        alive: Envs that have not failed yet, [N] bool.
+    """
+    from mjlab.utils.lab_api.math import quat_apply_inverse, yaw_quat
+
+    v_yaw = quat_apply_inverse(yaw_quat(data.root_link_quat_w), data.root_link_lin_vel_w)
+    stats["steps"] += alive.float()
+    stats["vel_err"] += alive * torch.linalg.vector_norm(v_yaw[:, :2] - commands[:, :2], dim=1)
+    stats["yaw_err"] += alive * (data.root_link_ang_vel_w[:, 2] - commands[:, 2]).abs()
+
+
 def _rollout(
     env: Any, session: Any, commands: torch.Tensor, steps: int, recorders: list[Any] | None = None
 ) -> dict[str, np.ndarray]:
     """Run the policy; return per-env alive steps, summed velocity and yaw-rate errors, failure flags."""
-    from mjlab.utils.lab_api.math import quat_apply_inverse, yaw_quat
-
     term = env.command_manager.get_term("twist")
     env.reset()
     # Commands are never resampled (resampling time 1e9 s); backfill the history with the fixed command.
@@ -180,7 +200,7 @@ def _rollout(
     n = env.num_envs
     obs = env.observation_manager.compute(update_history=True, env_ids=torch.arange(n, device=env.device))
     alive = torch.ones(n, dtype=torch.bool, device=env.device)
-    stats = {k: torch.zeros(n, device=env.device) for k in ("steps", "vel_err", "yaw_err")}
+    stats = tracking_stats(n, env.device)
     name = session.get_inputs()[0].name
     robot = env.scene["robot"]
     for _ in range(steps):
@@ -192,12 +212,8 @@ def _rollout(
         obs, _, terminated, _, _ = env.step(torch.as_tensor(action, device=env.device))
         for rec in recorders or ():
             rec.after_step(terminated)
-        data = robot.data
-        v_yaw = quat_apply_inverse(yaw_quat(data.root_link_quat_w), data.root_link_lin_vel_w)
         alive &= ~terminated
-        stats["steps"] += alive.float()
-        stats["vel_err"] += alive * torch.linalg.vector_norm(v_yaw[:, :2] - commands[:, :2], dim=1)
-        stats["yaw_err"] += alive * (data.root_link_ang_vel_w[:, 2] - commands[:, 2]).abs()
+        accumulate_tracking(stats, robot.data, commands, alive)
     out = {k: v.cpu().numpy() for k, v in stats.items()}
     out["failed"] = (~alive).cpu().numpy()
     return out

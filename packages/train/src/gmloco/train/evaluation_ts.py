@@ -34,7 +34,7 @@ import numpy as np
 import torch
 
 from gmloco.train.config import ContactModelName, TerrainName
-from gmloco.train.evaluation import RolloutCriteriaCfg
+from gmloco.train.evaluation import RolloutCriteriaCfg, accumulate_tracking, tracking_stats
 from gmloco.train.teacher_student.heldout import DEFAULT_HELD_OUT, HeldOutRegionCfg, r2_score
 
 __all__ = ["TsEvalCfg", "adaptation_rollout", "decoded_eta_check", "evaluate_teacher_student", "swing_apexes"]
@@ -194,7 +194,6 @@ def _policy_step(runner: Any, obs: Any) -> dict[str, torch.Tensor]:
 
 def _rollout(runner: Any, commands: torch.Tensor, steps: int) -> dict[str, np.ndarray]:
     """Run the student; return per-step ``[T, W]`` signals and per-env tracking sums and failure flags."""
-    from mjlab.utils.lab_api.math import quat_apply_inverse, yaw_quat
     from tensordict import TensorDict
 
     env = runner.env.unwrapped
@@ -204,7 +203,7 @@ def _rollout(runner: Any, commands: torch.Tensor, steps: int) -> dict[str, np.nd
     alive = torch.ones(n, dtype=torch.bool, device=env.device)
     keys = ("eta_true", "eta_student", "eta_teacher", "action_sq", "alive")
     trace: dict[str, list[torch.Tensor]] = {k: [] for k in keys}
-    stats = {k: torch.zeros(n, device=env.device) for k in ("steps", "vel_err", "yaw_err")}
+    stats = tracking_stats(n, env.device)
     robot = env.scene["robot"]
     for _ in range(steps):
         out = _policy_step(runner, obs)
@@ -214,12 +213,8 @@ def _rollout(runner: Any, commands: torch.Tensor, steps: int) -> dict[str, np.nd
         trace["alive"].append(alive.clone())
         obs_dict, _, terminated, _, _ = env.step(out["actions"])
         obs = TensorDict(obs_dict, batch_size=[n])
-        data = robot.data
-        v_yaw = quat_apply_inverse(yaw_quat(data.root_link_quat_w), data.root_link_lin_vel_w)
         alive &= ~terminated
-        stats["steps"] += alive.float()
-        stats["vel_err"] += alive * torch.linalg.vector_norm(v_yaw[:, :2] - commands[:, :2], dim=1)
-        stats["yaw_err"] += alive * (data.root_link_ang_vel_w[:, 2] - commands[:, 2]).abs()
+        accumulate_tracking(stats, robot.data, commands, alive)
     result = {k: torch.stack(v).cpu().numpy() for k, v in trace.items()}
     result |= {k: v.cpu().numpy() for k, v in stats.items()}
     result["failed"] = (~alive).cpu().numpy()
