@@ -72,36 +72,18 @@ def _seed_run_dir(run_dir: Path, artifact: Path, weights_only: bool) -> tuple[in
     return it, None
 
 
-def _curve(run_dir: Path) -> dict[str, list[float]]:
-    """Learning curve of this machine's TensorBoard events: iteration, reward, episode length, fps."""
-    from tensorboard.backend.event_processing.event_accumulator import EventAccumulator
-
-    tags = {
-        "Train/mean_reward": "mean_reward",
-        "Train/mean_episode_length": "mean_episode_length",
-        "Perf/total_fps": "env_steps_per_s",
-    }
-    series: dict[int, dict[str, float]] = {}
-    for events in sorted(run_dir.rglob("events.out.tfevents.*")):
-        acc = EventAccumulator(str(events), size_guidance={"scalars": 0})
-        acc.Reload()
-        for tag, name in tags.items():
-            if tag in acc.Tags()["scalars"]:
-                for ev in acc.Scalars(tag):
-                    series.setdefault(ev.step, {})[name] = ev.value
-    its = sorted(series)
-    out: dict[str, list[float]] = {"iteration": [float(i) for i in its]}
-    for name in tags.values():
-        out[name] = [series[i].get(name, float("nan")) for i in its]
-    return out
-
-
+_CURVE_TAGS = {
+    "Train/mean_reward": "mean_reward",
+    "Train/mean_episode_length": "mean_episode_length",
+    "Perf/total_fps": "env_steps_per_s",
+}
+"""TensorBoard tags of the learning curve and their column names."""
 _LAST_VALUE_PREFIXES = ("Episode_Reward/", "Episode_Termination/", "Curriculum/", "Metrics/", "Loss/", "Policy/")
 """TensorBoard tag families whose last-10-iteration means go into the summary (per-term diagnosis)."""
 
 
-def _last_values(run_dir: Path, window: int = 10) -> dict[str, float]:
-    """Mean of the last ``window`` logged values of every per-term tag (reward terms, terminations, curricula)."""
+def _scalars(run_dir: Path) -> dict[str, dict[int, float]]:
+    """Every scalar of this machine's TensorBoard events, ``{tag: {step: value}}`` (one read of the files)."""
     from tensorboard.backend.event_processing.event_accumulator import EventAccumulator
 
     values: dict[str, dict[int, float]] = {}
@@ -109,12 +91,26 @@ def _last_values(run_dir: Path, window: int = 10) -> dict[str, float]:
         acc = EventAccumulator(str(events), size_guidance={"scalars": 0})
         acc.Reload()
         for tag in acc.Tags()["scalars"]:
-            if tag.startswith(_LAST_VALUE_PREFIXES):
-                values.setdefault(tag, {}).update({ev.step: ev.value for ev in acc.Scalars(tag)})
+            values.setdefault(tag, {}).update({ev.step: ev.value for ev in acc.Scalars(tag)})
+    return values
+
+
+def _curve(scalars: dict[str, dict[int, float]]) -> dict[str, list[float]]:
+    """Learning curve: iteration, reward, episode length, fps (NaN where a tag was not logged)."""
+    its = sorted({step for tag in _CURVE_TAGS for step in scalars.get(tag, {})})
+    out: dict[str, list[float]] = {"iteration": [float(i) for i in its]}
+    for tag, name in _CURVE_TAGS.items():
+        out[name] = [scalars.get(tag, {}).get(i, float("nan")) for i in its]
+    return out
+
+
+def _last_values(scalars: dict[str, dict[int, float]], window: int = 10) -> dict[str, float]:
+    """Mean of the last ``window`` logged values of every per-term tag (reward terms, terminations, curricula)."""
     out = {}
-    for tag, series in sorted(values.items()):
-        last = [series[k] for k in sorted(series)[-window:]]
-        out[tag] = sum(last) / len(last)
+    for tag, series in sorted(scalars.items()):
+        if tag.startswith(_LAST_VALUE_PREFIXES):
+            last = [series[k] for k in sorted(series)[-window:]]
+            out[tag] = sum(last) / len(last)
     return out
 
 
@@ -161,8 +157,8 @@ def main() -> None:
         "checkpoint": None if ckpt is None else ckpt.name,
         "metrics": metrics,
         "train_cfg": json.loads((run_dir / "train_cfg.json").read_text()),
-        "curve": _curve(run_dir),
-        "last_values": _last_values(run_dir),
+        "curve": _curve(scalars := _scalars(run_dir)),
+        "last_values": _last_values(scalars),
         "wall_s": time.time() - t0,
         "commit": commit or None,
     }
