@@ -66,6 +66,12 @@ def _parse(argv: list[str] | None) -> argparse.Namespace:
     p.add_argument("--no-held-out", action="store_true", help="let the DR draw the held-out region too")
     p.add_argument("--teacher-checkpoint", type=Path, default=None)
     p.add_argument(
+        "--warm-start-ppo",
+        type=Path,
+        default=None,
+        help="teacher: start a fresh run from this PPO checkpoint's actor and critic (e.g. artifacts/ppo_rft3d/checkpoint.pt)",
+    )
+    p.add_argument(
         "--curriculum-scale",
         type=float,
         default=None,
@@ -271,6 +277,7 @@ def main(argv: list[str] | None = None) -> dict[str, Any]:
         rsl_rl_overrides=_entries(args),
         history_length=args.history_length,
         init_checkpoint=None if init is None else str(init),
+        warm_start_ppo=None if args.stage != "teacher" or args.warm_start_ppo is None else str(args.warm_start_ppo),
     )
     metrics = train(cfg)
     ckpt = _newest(run_dir)

@@ -67,6 +67,10 @@ class TrainRunCfg:
     init_checkpoint: str | None = None
     """Checkpoint loaded (through the algorithm's ``load``) when ``run_dir`` has none yet, e.g. the teacher's
     ``model_<it>.pt`` for distillation; None: start from scratch."""
+    warm_start_ppo: str | None = None
+    """VAE teacher only: a vanilla-PPO checkpoint of the same task whose actor (stacked frames mapped onto one
+    frame, latent inputs zero) and critic start the teacher when ``run_dir`` has no checkpoint
+    (``gmloco.train.teacher_student.warm_start``); None: start from scratch."""
 
 
 def _check_resume_cfg(run_dir: Path, cfg: TrainRunCfg) -> None:
@@ -108,6 +112,15 @@ def _make_runner(cfg: TrainRunCfg, env: Any, run_dir: Path) -> Any:
     return runner
 
 
+def _warm_start(runner: Any, env: Any, path: str, run_dir: Path) -> None:
+    """Start a VAE teacher from a PPO checkpoint; the record goes to ``run_dir/warm_start.json``."""
+    from gmloco.train.teacher_student.warm_start import warm_start_from_ppo
+
+    dims = env.unwrapped.observation_manager.group_obs_term_dim["actor"]
+    record = warm_start_from_ppo(runner.alg, Path(path).resolve(), [int(d[-1]) for d in dims])
+    (run_dir / "warm_start.json").write_text(json.dumps(record, indent=1))
+
+
 def train(cfg: TrainRunCfg) -> dict[str, float]:
     """Train (or resume) PPO on the granular G1 task and return summary metrics.
 
@@ -137,6 +150,8 @@ def train(cfg: TrainRunCfg) -> dict[str, float]:
         runner.load(str(checkpoint))
     elif cfg.init_checkpoint is not None:
         runner.load(str(Path(cfg.init_checkpoint).resolve()))
+    elif cfg.warm_start_ppo is not None:
+        _warm_start(runner, env, cfg.warm_start_ppo, run_dir)
     resumed_from = runner.current_learning_iteration
     remaining = cfg.max_iterations - resumed_from
     if remaining > 0:
