@@ -3,9 +3,16 @@
 
 * Robots: mjlab's G1 MJCF loaded into Newton (``ModelBuilder.add_mjcf``), ``num_robots`` copies, each in its own
   lane (y offset ``lane_spacing``), stepped by ``SolverMuJoCo`` (one MuJoCo world per robot on CUDA through
-  mujoco_warp; all robots in one MuJoCo C world on CPU) with MuJoCo contacts off: the robots touch only sand.
+  mujoco_warp; all robots in one MuJoCo C world on CPU). MuJoCo's only contacts are the sole boxes against the
+  rigid floor under the sand (``floor_contact``): a sole pressed through the bed stands on the floor, as a foot
+  would on the bottom of a sandbox, instead of falling through a floor that holds only particles.
 * Sand: one ``SolverImplicitMPM`` for all robots; each robot walks on its own window of sand
   (:mod:`gmloco.eval.mpm.window`): static (a full bed, the naive baseline) or moving with it (recycled columns).
+  The window's four walls are kinematic MPM colliders (``wall_colliders``): one wall body per robot, in a
+  collider-only copy of the robot model, moved with the window every frame. Clamping particles back into the
+  window after the MPM step (``SandWindow.apply_walls``, kept as a safety net) is not enough on its own: the solve
+  then sees free vertical faces of sand, the bed slumps towards them every step and never builds its
+  confining stress, and a standing G1 sank ~23 cm instead of ~6 cm (``results/mpm_eval/G1_SINKAGE.md``).
 * Feet: every MJCF geom is hidden from the particles; each ankle-roll link gets a sole box (``SoleCfg``,
   no mass, no rigid contact) that only the particles resolve (thin foot capsules fall through a coarse bed).
 * Coupling: the box scene's semi-implicit scheme (:mod:`gmloco.eval.mpm.box_scene`): rigid substeps with the
@@ -93,6 +100,12 @@ class G1MpmSceneCfg:
     """MPM numerics; frame_dt / rigid_substeps is the 200 Hz physics step."""
     sole: SoleCfg = field(default_factory=SoleCfg)
     """Foot sole colliders."""
+    floor_contact: bool = True
+    """Soles collide with the rigid floor at z = -depth through MuJoCo contacts (False: the floor holds sand only)."""
+    wall_colliders: bool = True
+    """Window walls as kinematic MPM colliders (False: only the particle clamp after each MPM step)."""
+    wall_thickness: float = 0.05
+    """Half thickness of the wall boxes [m]."""
     drop_height: float = 0.005
     """Initial gap between the lowest sole point and the sand surface [m]."""
     commands: tuple[tuple[float, float, float], ...] = ((0.0, 0.0, 0.0),)
@@ -168,13 +181,14 @@ class G1MpmScene:
         """One G1 from the MJCF; particles see only the two sole boxes."""
         b = newton.ModelBuilder()
         b.add_mjcf(str(g1_mjcf_path()), floating=True, parse_visuals=False)
-        particle_bit = int(newton.ShapeFlags.COLLIDE_PARTICLES)
-        b.shape_flags = [int(f) & ~particle_bit for f in b.shape_flags]
+        # MJCF geoms touch nothing: particles see the soles only, MuJoCo contacts are the soles' with the floor
+        hidden = int(newton.ShapeFlags.COLLIDE_PARTICLES) | int(newton.ShapeFlags.COLLIDE_SHAPES)
+        b.shape_flags = [int(f) & ~hidden for f in b.shape_flags]
         labels = [label.rsplit("/", 1)[-1] for label in b.body_label]
         self.foot_local = [labels.index(name) for name in FOOT_BODIES]
         sole = self.cfg.sole
         mu = float(np.median([m.collider_friction for m in self.mats]))
-        sole_cfg = newton.ModelBuilder.ShapeConfig(density=0.0, mu=mu, has_shape_collision=False)
+        sole_cfg = newton.ModelBuilder.ShapeConfig(density=0.0, mu=mu, has_shape_collision=self.cfg.floor_contact)
         for body in self.foot_local:
             b.add_shape_box(body, xform=wp.transform(wp.vec3(*sole.center), wp.quat_identity()),
                             hx=sole.half_extents[0], hy=sole.half_extents[1], hz=sole.half_extents[2],
@@ -188,20 +202,10 @@ class G1MpmScene:
         rb = self._robot_builder(newton, wp)
         self.bodies_per_robot, self.coords_per_robot = rb.body_count, rb.joint_coord_count
         self.dofs_per_robot = rb.joint_dof_count
-        builder = newton.ModelBuilder()
         as_worlds = self.cfg.robots_as_worlds
         self.as_worlds = self.device.is_cuda if as_worlds is None else as_worlds
-        if self.as_worlds:
-            for _ in range(self.cfg.num_robots):
-                builder.add_world(rb)
-        else:
-            builder.begin_world()
-            for _ in range(self.cfg.num_robots):
-                builder.add_builder(rb)
-            builder.end_world()
-        floor = newton.ModelBuilder.ShapeConfig(mu=float(self.mats[0].friction), density=0.0)
-        builder.add_ground_plane(height=-float(self.cfg.terrain.depth), cfg=floor)
-        model = builder.finalize()
+        self._rb = rb
+        model = self._assemble(newton, wp).finalize()
         q_start, qd_start = model.joint_q_start.numpy(), model.joint_qd_start.numpy()
         self.q_idx = np.array([q_start[j] for j in self.joints_local])
         self.qd_idx = np.array([qd_start[j] for j in self.joints_local])
@@ -222,6 +226,28 @@ class G1MpmScene:
         model.joint_q.assign(q)
         self._drop_onto_surface(newton, model, q)
         return model
+
+    def _assemble(self, newton: Any, wp: Any, walls: list[np.ndarray] | None = None) -> Any:
+        """Builder of R robots (worlds or one world) and the floor; ``walls``: one wall body per robot after them."""
+        builder = newton.ModelBuilder()
+        if self.as_worlds:
+            for _ in range(self.cfg.num_robots):
+                builder.add_world(self._rb)
+        else:
+            builder.begin_world()
+            for _ in range(self.cfg.num_robots):
+                builder.add_builder(self._rb)
+            builder.end_world()
+        if walls is not None:
+            wall_cfg = newton.ModelBuilder.ShapeConfig(mu=0.0, density=0.0, has_shape_collision=False)
+            for corner in walls:
+                body = builder.add_body(xform=wp.transform(wp.vec3(*corner), wp.quat_identity()), mass=0.0)
+                for c, h in self.window.wall_boxes(self.cfg.wall_thickness, height=0.3):
+                    builder.add_shape_box(body, xform=wp.transform(wp.vec3(*c), wp.quat_identity()),
+                                          hx=h[0], hy=h[1], hz=h[2], cfg=wall_cfg)  # fmt: skip
+        floor = newton.ModelBuilder.ShapeConfig(mu=float(self.mats[0].friction), density=0.0)
+        builder.add_ground_plane(height=-float(self.cfg.terrain.depth), cfg=floor)
+        return builder
 
     def _drop_onto_surface(self, newton: Any, model: Any, q: np.ndarray) -> None:
         """Lift every robot so its lowest sole corner is ``drop_height`` above the terrain surface."""
@@ -262,27 +288,44 @@ class G1MpmScene:
     def _build_solvers(self, newton: Any, wp: Any) -> None:
         """Implicit MPM with the sole boxes as dynamic colliders of effective mass; MuJoCo for the robots."""
         self.mpm = make_mpm_solver(newton, self.sand_model, self.cfg.solver, self.mats[0])
+        # colliders: the robots' soles (same body indices as the robot model), the floor and, with
+        # wall_colliders, one kinematic (zero effective mass) wall body per robot after the robots' bodies
+        self.wall_body_offset = self.model.body_count
+        if self.cfg.wall_colliders:
+            corners = self.window.bounds()[:, 0]
+            walls = [np.array([x, y, 0.0]) for x, y in corners]
+            self.collider_model = self._assemble(newton, wp, walls).finalize()
+        else:
+            self.collider_model = self.model
         m_eff = self.cfg.sole.effective_mass or 0.5 * self.robot_mass
-        mass = self.model.body_mass.numpy().copy()
-        inv_inertia = self.model.body_inv_inertia.numpy().copy()
+        mass = self.collider_model.body_mass.numpy().copy()
+        mass[self.wall_body_offset :] = 0.0
+        inv_inertia = self.collider_model.body_inv_inertia.numpy().copy()
         for b in self.foot_bodies.ravel():
             inv_inertia[b] *= mass[b] / m_eff
             mass[b] = m_eff
         inv_mass = np.where(mass > 0, 1.0 / np.maximum(mass, 1e-12), 0.0)
         self.eff_inv_mass = wp.array(inv_mass.astype(np.float32), dtype=float)
         self.eff_inv_inertia = wp.array(inv_inertia.astype(np.float32), dtype=wp.mat33)
-        self.mpm.setup_collider(model=self.model, body_mass=wp.array(mass.astype(np.float32), dtype=float),
+        self.mpm.setup_collider(model=self.collider_model, body_mass=wp.array(mass.astype(np.float32), dtype=float),
                                 body_inv_inertia=self.eff_inv_inertia)  # fmt: skip
         per_world = 1 if self.as_worlds else self.cfg.num_robots
         self.rigid = newton.solvers.SolverMuJoCo(
-            self.model, use_mujoco_cpu=not self.as_worlds, use_mujoco_contacts=False,
+            self.model, use_mujoco_cpu=not self.as_worlds, use_mujoco_contacts=self.cfg.floor_contact,
             njmax=64 * per_world, nconmax=64 * per_world,
         )  # fmt: skip
         # mujoco_warp without MuJoCo contacts still reads Newton contacts: an empty set (the robots touch only sand)
-        self.contacts = None if not self.as_worlds else newton.Contacts(0, 0, device=self.device)
+        no_contacts = self.cfg.floor_contact or not self.as_worlds
+        self.contacts = None if no_contacts else newton.Contacts(0, 0, device=self.device)
         st = make_coupled_states(newton, wp, self.model, self.sand_model)
         self.state_0, self.state_1, self.control = st.state_0, st.state_1, st.control
         self.sand_state, self.sand_wrench = st.sand_state, st.sand_wrench
+        if self.cfg.wall_colliders:  # the sand state's bodies: the robots' then the wall bodies
+            nb = self.collider_model.body_count
+            self.sand_state.body_q = wp.clone(self.collider_model.body_q)
+            self.sand_state.body_qd = wp.zeros(nb, dtype=wp.spatial_vector, device=self.device)
+            wp.copy(self.sand_state.body_q, self.state_0.body_q, count=self.wall_body_offset)
+            self.window.place_walls(self.wall_body_offset, self.sand_state.body_q, self.sand_state.body_qd)
         self.window.bind(self.sand_model, self.sand_state, self.mpm)
         a = len(self.spec.joint_names)
         self.pd = {
@@ -360,7 +403,9 @@ class G1MpmScene:
             self.rigid.step(self.state_0, self.state_1, self.control, self.contacts, self.sim_dt)
             self.state_0, self.state_1 = self.state_1, self.state_0
         self.window.advance(self.state_0.body_q)
-        wp.copy(self.sand_state.body_q, self.state_0.body_q)
+        wp.copy(self.sand_state.body_q, self.state_0.body_q, count=self.wall_body_offset)
+        if self.cfg.wall_colliders:
+            self.window.place_walls(self.wall_body_offset, self.sand_state.body_q, self.sand_state.body_qd)
         eval_rewind_body_velocity(
             self.eff_inv_mass, self.eff_inv_inertia, self.frame_dt, self.state_0.body_q,
             self.state_0.body_qd, self.sand_wrench, self.sand_state.body_qd,

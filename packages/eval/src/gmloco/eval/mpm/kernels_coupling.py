@@ -28,7 +28,7 @@ def _body_sand_wrench(
     if cid < 0 or cid >= collider_body.shape[0]:
         return
     b = collider_body[cid]
-    if b < 0:
+    if b < 0 or b >= body_wrench_out.shape[0]:  # static, or a body the rigid solver does not own (window walls)
         return
     # F = J / dt: the impulse the sand gave the collider over the MPM step
     f = node_impulse_in[i] * inv_dt

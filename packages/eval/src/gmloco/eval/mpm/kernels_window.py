@@ -14,7 +14,7 @@ from __future__ import annotations
 
 import warp as wp
 
-__all__ = ["WindowArrays", "eval_window_origin", "eval_window_recycle", "eval_window_walls"]
+__all__ = ["WindowArrays", "eval_window_origin", "eval_window_recycle", "eval_window_wall_pose", "eval_window_walls"]
 
 
 @wp.struct
@@ -227,3 +227,35 @@ def eval_window_walls(w: WindowArrays, origin: wp.array, particle_q: wp.array, p
     """Keep every robot's sand inside its window box (frictionless walls that move with the window)."""
     wp.launch(_window_walls, dim=particle_q.shape[0], inputs=[w, origin], outputs=[particle_q, particle_qd],
               device=particle_q.device)  # fmt: skip
+
+
+@wp.kernel
+def _window_wall_pose(
+    # Model:
+    w: WindowArrays,
+    body_offset: int,
+    # Data in:
+    origin_in: wp.array[wp.vec2i],
+    # Data out:
+    body_q_out: wp.array[wp.transform],
+    body_qd_out: wp.array[wp.spatial_vector],
+) -> None:
+    """Pose of robot r's wall body: the lower window corner (x, y) at z = 0, axis-aligned, at rest."""
+    r = wp.tid()
+    o = origin_in[r]
+    p = wp.vec3(float(o[0]) * w.h, float(o[1]) * w.h + w.lane_y[r], 0.0)
+    body_q_out[body_offset + r] = wp.transform(p, wp.quat_identity())
+    body_qd_out[body_offset + r] = wp.spatial_vector()
+
+
+def eval_window_wall_pose(
+    w: WindowArrays, origin: wp.array, body_offset: int, body_q: wp.array, body_qd: wp.array
+) -> None:
+    """Move every robot's wall collider body (index ``body_offset + r``) to its window (graph-capturable).
+
+    The walls are kinematic MPM colliders (zero effective mass) whose boxes sit on the window boundary in the
+    body frame; they jump with the window origin by whole columns, after the column they leave was recycled, so
+    they never sweep sand: their velocity is zero.
+    """
+    wp.launch(_window_wall_pose, dim=origin.shape[0], inputs=[w, body_offset, origin], outputs=[body_q, body_qd],
+              device=body_q.device)  # fmt: skip

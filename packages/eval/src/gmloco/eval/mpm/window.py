@@ -136,6 +136,28 @@ class SandWindow:
         eval_window_origin(self.arrays, True, body_q, self.origin)
         eval_window_recycle(self.arrays, self.origin, self.column, self._state_arrays, self._model_arrays)
 
+    def wall_boxes(self, thickness: float, height: float) -> list[tuple[tuple[float, ...], tuple[float, ...]]]:
+        """The four walls of a window as (centre, half extents) boxes [m] in its wall-body frame.
+
+        The frame sits at the window's lower (x, y) corner at z = 0; the walls enclose ``nx h x ny h`` from the
+        floor z = -depth up to ``height`` above z = 0 and are ``2 thickness`` thick.
+        """
+        length, width, t = self.nx * self.h, self.ny * self.h, thickness
+        hz = 0.5 * (self.terrain.depth + height)
+        cz = -self.terrain.depth + hz
+        return [
+            ((-t, 0.5 * width, cz), (t, 0.5 * width + 2 * t, hz)),
+            ((length + t, 0.5 * width, cz), (t, 0.5 * width + 2 * t, hz)),
+            ((0.5 * length, -t, cz), (0.5 * length, t, hz)),
+            ((0.5 * length, width + t, cz), (0.5 * length, t, hz)),
+        ]
+
+    def place_walls(self, body_offset: int, body_q: Any, body_qd: Any) -> None:
+        """Write every robot's wall body pose (index ``body_offset + r``) from its window origin."""
+        from gmloco.eval.mpm.kernels_window import eval_window_wall_pose
+
+        eval_window_wall_pose(self.arrays, self.origin, body_offset, body_q, body_qd)
+
     def apply_walls(self) -> None:
         """Clamp the sand into each window (after the MPM step)."""
         from gmloco.eval.mpm.kernels_window import eval_window_walls
