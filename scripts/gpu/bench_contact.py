@@ -4,17 +4,23 @@
 
 For every contact model and collider size (sole 5x5 = 25 points, six-face 5x5 = 150 points per foot) it times
 ``model.compute`` (the stateless part that runs inside the passive callback) and, for stateful models,
-``model.update_state``, each captured in a CUDA graph of ``--reps`` launches. The reference is one physics
-substep of mjlab's stock G1 (``env.sim.step()``, rigid contact) at the same world count, built in the same
-process (``--skip-sim`` leaves it out).
+``model.update_state`` and ``model.compute_and_update_state`` (``step_s``: both in one call; one launch of
+``rft3d_foot_wrench_kernel`` with ``advance=1`` on the fused 3D-RFT path, else the two calls), each captured in
+a CUDA graph of ``--reps`` calls. Each record lists the kernels every timed call launches (``launches``,
+recorded by intercepting ``wp.launch`` / ``wp.launch_tiled`` during one untimed call) and, for stateful models,
+``step_max_rel_diff_vs_two_calls``: max relative difference of the wrench and every state array between
+compute_and_update_state() and compute() + update_state() after one substep (0 expected). The reference is one
+physics substep of mjlab's stock G1 (``env.sim.step()``, rigid contact) at the same world count, built in the
+same process (``--skip-sim`` leaves it out). ``share_of_substep`` = (compute + update_state) / substep;
+``share_of_substep_step`` = compute_and_update_state / substep.
 
 Paths (``--paths``, default both): ``fused`` (``model.fused = True``, the default: 3D-RFT elements + per-foot tile
 sum in one launch, tiled per-foot sums for the other models) under the plain key (``rft3d/150pt``), and
 ``unfused`` (``model.fused = False``: per-point pass + one-thread-per-foot sum) under ``<key>/unfused``. Both
-paths share update_state (one launch, no force pass). Each fused record also carries
-``wrench_max_rel_diff_vs_unfused``: max |W_fused - W_unfused| / max |W_unfused| after one compute on the benchmark
-state (float32 round-off expected, ~1e-6). ``rft3d_viscous`` is 3D-RFT with ``static_friction=False`` (the cost
-of the stick anchors).
+paths share update_state (one launch, no force pass); compute_and_update_state is one launch only on the fused
+3D-RFT path. Each fused record also carries ``wrench_max_rel_diff_vs_unfused``: max |W_fused - W_unfused| /
+max |W_unfused| after one compute on the benchmark state (float32 round-off expected, ~1e-6). ``rft3d_viscous``
+is 3D-RFT with ``static_friction=False`` (the cost of the stick anchors).
 
 Time box and resume: the JSON (``<out>/bench_contact.json``) is rewritten atomically after every record; a rerun
 with the same ``--out`` skips the records already there (``--force`` redoes them). The run stops starting new
@@ -172,17 +178,66 @@ def record_keys(models: list[str], paths: list[str]) -> list[tuple[str, str, Lit
     return keys
 
 
+def _launches(fn: Callable[[], object]) -> list[str]:
+    """Return the kernel names ``fn`` launches, in order (``wp.launch`` / ``wp.launch_tiled`` intercepted once)."""
+    import warp as wp
+
+    names: list[str] = []
+    originals = wp.launch, wp.launch_tiled
+
+    def recorder(original: Callable[..., Any]) -> Callable[..., Any]:
+        def record(kernel: Any, *a: Any, **kw: Any) -> Any:
+            names.append(kernel.key)
+            return original(kernel, *a, **kw)
+
+        return record
+
+    wp.launch, wp.launch_tiled = recorder(originals[0]), recorder(originals[1])
+    try:
+        fn()
+    finally:
+        wp.launch, wp.launch_tiled = originals
+    return names
+
+
+def _step_vs_two_calls(cfg: Any, num_worlds: int, device: str, fused: bool) -> float:
+    """Max |x_step - x_two| / max |x_two| over the wrench and every state array after one substep.
+
+    x_step: ``compute_and_update_state()``; x_two: ``compute(); update_state()``; both from the benchmark state
+    (0 expected: same element functions, same sum order).
+    """
+    out = []
+    for one_call in (True, False):
+        model, state = _prepared_model(cfg, num_worlds, device, fused)
+        if one_call:
+            model.compute_and_update_state(*state)
+        else:
+            model.compute(*state)
+            model.update_state(*state[:5])
+        arrays = [state[5], model.depth_max, model.ema_tau, model.vel_prev, model.anchor, model.force_prev]
+        out.append([a.numpy().astype(np.float64) for a in arrays])
+    return max(float(np.abs(a - b).max() / max(np.abs(b).max(), 1e-30)) for a, b in zip(*out, strict=True))
+
+
 def bench_record(
     name: str, faces: Literal["sole", "box"], path: str, args: argparse.Namespace, paths: list[str]
-) -> dict[str, float]:
-    """Seconds per launch of one model's compute / update_state on one path."""
+) -> dict[str, Any]:
+    """Seconds per call of one model's compute / update_state / compute_and_update_state on one path.
+
+    ``launches`` names the kernels each timed call launches (recorded, not assumed).
+    """
     cfg = _model_cfgs(faces)[name]
     model, state = _prepared_model(cfg, args.num_worlds, args.device, path == "fused")
-    rec = {"compute_s": _time_graph(lambda: model.compute(*state), args.reps, args.device)}
+    calls: dict[str, Callable[[], object]] = {"compute": lambda: model.compute(*state)}
     if model.is_stateful:
-        rec["update_state_s"] = _time_graph(lambda: model.update_state(*state[:5]), args.reps, args.device)
+        calls["update_state"] = lambda: model.update_state(*state[:5])
+        calls["step"] = lambda: model.compute_and_update_state(*state)
+    rec: dict[str, Any] = {f"{k}_s": _time_graph(fn, args.reps, args.device) for k, fn in calls.items()}
+    rec["launches"] = {k: _launches(fn) for k, fn in calls.items()}
     if path == "fused" and "unfused" in paths:
         rec["wrench_max_rel_diff_vs_unfused"] = _wrench_rel_diff(cfg, args.num_worlds, args.device)
+    if model.is_stateful:
+        rec["step_max_rel_diff_vs_two_calls"] = _step_vs_two_calls(cfg, args.num_worlds, args.device, path == "fused")
     return rec
 
 
@@ -227,11 +282,17 @@ def _device_name(device: str) -> str:
 
 
 def _shares(res: dict[str, Any]) -> None:
-    """Add each record's (compute + update_state) / G1 substep when the substep was measured."""
+    """Add each record's per-substep contact cost / G1 substep when the substep was measured.
+
+    ``share_of_substep``: compute + update_state (two calls); ``share_of_substep_step``: compute_and_update_state
+    (stateful models; one launch on the fused 3D-RFT path).
+    """
     step = res.get("g1_substep_s")
     for rec in res["models"].values():
         if step:
             rec["share_of_substep"] = (rec["compute_s"] + rec.get("update_state_s", 0.0)) / step
+            if "step_s" in rec:
+                rec["share_of_substep_step"] = rec["step_s"] / step
 
 
 def main(argv: list[str] | None = None) -> int:

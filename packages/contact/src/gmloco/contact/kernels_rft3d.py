@@ -23,19 +23,21 @@ from gmloco.contact.kernels_state import (
     AT_REST_UNLOADING,
     AtRestParams,
     ElementState,
+    advance_element_state,
     at_rest_filter,
     crater_friction,
     elastic_depth,
     point_kernel_data,
-    rft_element_model,
 )
 
 __all__ = [
     "RFT3DCoeffs",
+    "RFT3DModel",
     "eval_rft3d_foot_wrench",
     "eval_rft3d_point_forces",
     "rft3d_alpha",
     "rft3d_generic",
+    "rft3d_model",
     "unit_velocity",
 ]
 
@@ -162,17 +164,35 @@ def rft3d_elastic_force(
     return f + crater_friction(f, n, v, offset, mu_surf, rest.tangential_damping * area, rest.stick_distance)
 
 
+@wp.struct
+class RFT3DModel:
+    """The per-element ``# Model:`` data of the 3D-RFT kernels as one by-value kernel argument.
+
+    Collider points, outward normals [body frame] and areas [m^2]; per-world rho_c [kg/m^3], mu_int, mu_surf;
+    the terrain; gravity [m/s^2]; v_eps [m/s]; the MATLAB sign fix (0/1); the at-rest parameters. The
+    coefficients stay a separate kernel parameter (constant-bank operands, as before).
+    """
+
+    points_b: wp.array[wp.vec3]
+    normals_b: wp.array[wp.vec3]
+    areas: wp.array[float]
+    rho_c: wp.array[float]
+    mu_int: wp.array[float]
+    mu_surf: wp.array[float]
+    terrain: TerrainData
+    gravity: float
+    v_eps: float
+    sign_fix: int
+    rest: AtRestParams
+
+
 @wp.func
 def rft3d_element_force(
     kin: wp.mat33,
     depth: float,
-    area: float,
     mat: wp.vec3,
-    gravity: float,
     coeffs: RFT3DCoeffs,
-    v_eps: float,
-    sign_fix: int,
-    rest: AtRestParams,
+    m: RFT3DModel,
     state: ElementState,
     w: int,
     f: int,
@@ -186,7 +206,9 @@ def rft3d_element_force(
     """
     n = kin[1]
     v = kin[2]
-    xi = media_scaling(mat[0], mat[1], gravity)
+    rest = m.rest
+    area = m.areas[p]
+    xi = media_scaling(mat[0], mat[1], m.gravity)
     depth_max = state.depth_max[w, f, p]
     force = wp.vec3(0.0)
     if rest.mode == AT_REST_UNLOADING and depth > 0.0 and depth < depth_max:
@@ -196,25 +218,54 @@ def rft3d_element_force(
         tau_rev = state.ema_tau[w, f, p]
         force = rft3d_elastic_force(n, v, offset, depth, depth_max, area, xi, mat[2], coeffs, rest, tau_rev)
     else:
-        force = rft3d_plastic_force(n, v, depth, area, xi, mat[2], coeffs, v_eps, sign_fix)
+        force = rft3d_plastic_force(n, v, depth, area, xi, mat[2], coeffs, m.v_eps, m.sign_fix)
     return at_rest_filter(force, v, depth, rest, state, w, f, p, 0)
+
+
+@wp.func
+def element_active(depth: float, rest: AtRestParams) -> bool:
+    """Return whether an element's force needs evaluating: submerged, or any element in ``"ema"`` mode.
+
+    An emerged element's force is exactly zero in every mode (plastic mask, elastic branch only for depth > 0,
+    EMA weight 0 out of contact), so the others are skipped (no material, xi or RFT evaluation).
+    """
+    return depth > 0.0 or rest.mode == AT_REST_EMA
+
+
+@wp.func
+def rft3d_element(  # noqa: ANN202 (returns the tuple wp.vec3, float, wp.mat33; Warp infers it)
+    coeffs: RFT3DCoeffs,
+    m: RFT3DModel,
+    state: ElementState,
+    pos: wp.vec3,
+    rot: wp.mat33,
+    lin_vel: wp.vec3,
+    ang_vel: wp.vec3,
+    w: int,
+    f: int,
+    p: int,
+):
+    """Return (force [N], depth [m], kinematics rows (x, n, v)) of element [w, f, p] of a foot with finite inputs.
+
+    The per-element body shared by the per-point and the fused kernels: kinematics, depth below the local free
+    surface, and for an :func:`element_active` element the local material and :func:`rft3d_element_force`
+    (else force 0). Reads the old state only.
+    """
+    kin = foot_point_kinematics(pos, rot, lin_vel, ang_vel, m.points_b[p], m.normals_b[p])
+    x = kin[0]
+    depth = terrain_height(m.terrain, x[0], x[1]) - x[2]
+    force = wp.vec3(0.0)
+    if element_active(depth, m.rest):
+        mat = point_material(m.terrain, m.rho_c, m.mu_int, m.mu_surf, w, x[0])
+        force = rft3d_element_force(kin, depth, mat, coeffs, m, state, w, f, p)
+    return force, depth, kin
 
 
 @wp.kernel
 def rft3d_point_force_kernel(
     # Model:
     coeffs: RFT3DCoeffs,
-    points_b: wp.array[wp.vec3],
-    normals_b: wp.array[wp.vec3],
-    areas: wp.array[float],
-    rho_c: wp.array[float],
-    mu_int: wp.array[float],
-    mu_surf: wp.array[float],
-    terrain: TerrainData,
-    gravity: float,
-    v_eps: float,
-    sign_fix: int,
-    rest: AtRestParams,
+    model: RFT3DModel,
     # Data in:
     foot_pos_in: wp.array2d[wp.vec3],
     foot_mat_in: wp.array2d[wp.mat33],
@@ -233,21 +284,25 @@ def rft3d_point_force_kernel(
     rot = foot_mat_in[w, f]
     lin_vel = foot_lin_vel_in[w, f]
     ang_vel = foot_ang_vel_in[w, f]
-    if not foot_inputs_finite(pos, rot, lin_vel, ang_vel):
+    force = wp.vec3(0.0)
+    depth = 0.0
+    v = wp.vec3(0.0)
+    if foot_inputs_finite(pos, rot, lin_vel, ang_vel):
+        force, depth, kin = rft3d_element(coeffs, model, state_in, pos, rot, lin_vel, ang_vel, w, f, p)
+        v = kin[2]
+    else:
         wp.atomic_add(nan_count_out, 0, 1)
-        write_element(wp.vec3(0.0), 0.0, wp.vec3(0.0), point_force_out, point_depth_out, point_vel_out, w, f, p)
-        return
-    kin = foot_point_kinematics(pos, rot, lin_vel, ang_vel, points_b[p], normals_b[p])
-    x = kin[0]
-    depth = terrain_height(terrain, x[0], x[1]) - x[2]
-    mat = point_material(terrain, rho_c, mu_int, mu_surf, w, x[0])
-    force = rft3d_element_force(kin, depth, areas[p], mat, gravity, coeffs, v_eps, sign_fix, rest, state_in, w, f, p)
-    write_element(force, depth, kin[2], point_force_out, point_depth_out, point_vel_out, w, f, p)
+    write_element(force, depth, v, point_force_out, point_depth_out, point_vel_out, w, f, p)
 
 
-def _rft3d_model_inputs(model: Any) -> list:
-    """Return the ``# Model:`` arguments shared by the per-point and the fused 3D-RFT kernels."""
-    return [model.coeffs, *rft_element_model(model), int(model.cfg.sign_fix), model.rest]
+def rft3d_model(model: Any) -> Any:  # an RFT3DModel instance (Warp struct)
+    """Return the :class:`RFT3DModel` argument of a model (its arrays are views: built per launch, cheap)."""
+    m = RFT3DModel()
+    m.points_b, m.normals_b, m.areas = model.points_b, model.normals_b, model.areas
+    m.rho_c, m.mu_int, m.mu_surf = model.rho_c, model.mu_int, model.mu_surf
+    m.terrain, m.gravity, m.v_eps = model.terrain, model.cfg.gravity, model.cfg.v_eps
+    m.sign_fix, m.rest = int(model.cfg.sign_fix), model.rest
+    return m
 
 
 def eval_rft3d_point_forces(model: Any, inputs: tuple, nan_count_out: wp.array) -> None:
@@ -255,89 +310,102 @@ def eval_rft3d_point_forces(model: Any, inputs: tuple, nan_count_out: wp.array) 
     wp.launch(
         rft3d_point_force_kernel,
         dim=model.point_depth.shape,
-        inputs=[*_rft3d_model_inputs(model), *point_kernel_data(model, inputs)],
+        inputs=[model.coeffs, rft3d_model(model), *point_kernel_data(model, inputs)],
         outputs=[model.point_force, model.point_depth, model.point_vel, nan_count_out],
         device=model.device,
     )
 
 
-@wp.kernel
-def rft3d_foot_wrench_kernel(
-    # Model:
-    coeffs: RFT3DCoeffs,
-    points_b: wp.array[wp.vec3],
-    normals_b: wp.array[wp.vec3],
-    areas: wp.array[float],
-    rho_c: wp.array[float],
-    mu_int: wp.array[float],
-    mu_surf: wp.array[float],
-    terrain: TerrainData,
-    gravity: float,
-    v_eps: float,
-    sign_fix: int,
-    rest: AtRestParams,
-    # Data in:
-    foot_pos_in: wp.array2d[wp.vec3],
-    foot_mat_in: wp.array2d[wp.mat33],
-    foot_lin_vel_in: wp.array2d[wp.vec3],
-    foot_ang_vel_in: wp.array2d[wp.vec3],
-    foot_com_in: wp.array2d[wp.vec3],
-    state_in: ElementState,
-    # Data out:
-    point_force_out: wp.array3d[wp.vec3],
-    point_depth_out: wp.array3d[float],
-    point_vel_out: wp.array3d[wp.vec3],
-    wrench_out: wp.array2d[wp.spatial_vector],
-    nan_count_out: wp.array[int],
-) -> None:
-    """3D-RFT element forces and their per-foot wrench in one pass: one block per foot, lanes stride over points.
+def _rft3d_foot_wrench_kernel(advance: bool, name: str) -> wp.Kernel:
+    """Return the fused 3D-RFT kernel, compiled with (advance=True) or without the state update.
 
-    Same element outputs as :func:`rft3d_point_force_kernel` (same :func:`rft3d_element_force`) and the same
-    wrench as :func:`foot_wrench_kernel` (float32 round-off: cubic in basis form, tile-sum order). Emerged
-    elements (depth <= 0) skip the material, xi and RFT evaluation: their force is exactly zero in every
-    at-rest mode (the EMA weight is 0 out of contact).
+    Two specializations of one source (``wp.static``): the compute-only kernel carries no state-update code. On
+    sm_90 (NVRTC, block 160 for 150 points) the compute-only kernel uses 96 registers per thread, i.e. 4 blocks
+    of 5 warps per SM; the state update would raise that to 108 (3 blocks per SM). Recomputing x and n for the
+    update (below) and a 96-register cap keep the step kernel at 96 registers with no spill (cuobjdump
+    -res-usage: the same 32-byte stack, no local memory as the compute-only kernel), so it keeps the occupancy.
     """
-    w, f, lane = wp.tid()
-    pos = foot_pos_in[w, f]
-    rot = foot_mat_in[w, f]
-    lin_vel = foot_lin_vel_in[w, f]
-    ang_vel = foot_ang_vel_in[w, f]
-    com = foot_com_in[w, f]
-    finite = foot_inputs_finite(pos, rot, lin_vel, ang_vel)
-    force_sum = wp.vec3(0.0)
-    torque_sum = wp.vec3(0.0)
-    for p in range(lane, points_b.shape[0], wp.block_dim()):
-        force = wp.vec3(0.0)
-        depth = 0.0
-        v = wp.vec3(0.0)
-        if finite:
-            kin = foot_point_kinematics(pos, rot, lin_vel, ang_vel, points_b[p], normals_b[p])
-            x = kin[0]
-            v = kin[2]
-            depth = terrain_height(terrain, x[0], x[1]) - x[2]
-            if depth > 0.0 or rest.mode == AT_REST_EMA:
-                mat = point_material(terrain, rho_c, mu_int, mu_surf, w, x[0])
-                force = rft3d_element_force(
-                    kin, depth, areas[p], mat, gravity, coeffs, v_eps, sign_fix, rest, state_in, w, f, p
-                )
-                force_sum += force
-                # tau_com = sum (p_i - p_com) x F_i, as foot_wrench_kernel (x = pos + R p_b)
-                torque_sum += wp.cross(x - com, force)
-        else:
-            wp.atomic_add(nan_count_out, 0, 1)
-        write_element(force, depth, v, point_force_out, point_depth_out, point_vel_out, w, f, p)
-    wrench = foot_wrench_block_sum(wp.spatial_vector(force_sum, torque_sum), pos, rot, com, lane, nan_count_out)
-    if lane == 0:
-        wrench_out[w, f] = wrench
+
+    @wp.kernel(name=name, module="unique", enable_backward=False, cuda_max_registers=96 if advance else None)
+    def rft3d_foot_wrench_kernel(
+        # Model:
+        coeffs: RFT3DCoeffs,
+        model: RFT3DModel,
+        # Data in:
+        foot_pos_in: wp.array2d[wp.vec3],
+        foot_mat_in: wp.array2d[wp.mat33],
+        foot_lin_vel_in: wp.array2d[wp.vec3],
+        foot_ang_vel_in: wp.array2d[wp.vec3],
+        foot_com_in: wp.array2d[wp.vec3],
+        # Data out:
+        state_out: ElementState,
+        point_force_out: wp.array3d[wp.vec3],
+        point_depth_out: wp.array3d[float],
+        point_vel_out: wp.array3d[wp.vec3],
+        wrench_out: wp.array2d[wp.spatial_vector],
+        nan_count_out: wp.array[int],
+    ) -> None:
+        """3D-RFT element forces and their per-foot wrench in one pass: one block per foot, lanes stride over points.
+
+        Same element outputs as :func:`rft3d_point_force_kernel` (same :func:`rft3d_element`) and the same wrench as
+        :func:`foot_wrench_kernel` (float32 round-off: cubic in basis form, tile-sum order). ``state_out`` is the
+        old state the forces read; with ``advance`` each element's memory is then advanced past this substep
+        by :func:`advance_element_state`, as :func:`state_update_kernel` does with the same inputs (compute() +
+        update_state() in one launch; without it nothing is written to it). No race:
+        element p of foot [w, f] is read (force) and then written (state) by the one lane that owns it (p = lane,
+        lane + block_dim, ...), and no other thread reads or writes it.
+        """
+        w, f, lane = wp.tid()
+        pos = foot_pos_in[w, f]
+        rot = foot_mat_in[w, f]
+        lin_vel = foot_lin_vel_in[w, f]
+        ang_vel = foot_ang_vel_in[w, f]
+        com = foot_com_in[w, f]
+        finite = foot_inputs_finite(pos, rot, lin_vel, ang_vel)
+        force_sum = wp.vec3(0.0)
+        torque_sum = wp.vec3(0.0)
+        for p in range(lane, model.points_b.shape[0], wp.block_dim()):
+            force = wp.vec3(0.0)
+            depth = 0.0
+            kin = wp.mat33(0.0)
+            if finite:
+                force, depth, kin = rft3d_element(coeffs, model, state_out, pos, rot, lin_vel, ang_vel, w, f, p)
+                if element_active(depth, model.rest):
+                    force_sum += force
+                    # tau_com = sum (p_i - p_com) x F_i, as foot_wrench_kernel (x = pos + R p_b)
+                    torque_sum += wp.cross(kin[0] - com, force)
+            else:
+                wp.atomic_add(nan_count_out, 0, 1)
+            write_element(force, depth, kin[2], point_force_out, point_depth_out, point_vel_out, w, f, p)
+            if wp.static(advance):
+                # x and n recomputed with the same function instead of kept live across the force evaluation
+                # (registers, see above); unused for a non-finite foot (depth 0: no anchor update)
+                xn = foot_point_kinematics(pos, rot, lin_vel, ang_vel, model.points_b[p], model.normals_b[p])
+                advance_element_state(state_out, model.rest, 0, w, f, p, xn[0], xn[1], kin[2], depth, force)
+        wrench = foot_wrench_block_sum(wp.spatial_vector(force_sum, torque_sum), pos, rot, com, lane, nan_count_out)
+        if lane == 0:
+            wrench_out[w, f] = wrench
+
+    return rft3d_foot_wrench_kernel
 
 
-def eval_rft3d_foot_wrench(model: Any, inputs: tuple, wrench_out: wp.array) -> None:
-    """Launch :func:`rft3d_foot_wrench_kernel` over [num_worlds, num_feet] blocks (fused compute())."""
+rft3d_foot_wrench_kernel = _rft3d_foot_wrench_kernel(False, "rft3d_foot_wrench_kernel")
+"""Fused compute(): element forces + per-foot wrench, state read only."""
+rft3d_foot_step_kernel = _rft3d_foot_wrench_kernel(True, "rft3d_foot_step_kernel")
+"""Fused compute_and_update_state(): as :data:`rft3d_foot_wrench_kernel`, then each lane advances its elements."""
+
+
+def eval_rft3d_foot_wrench(model: Any, inputs: tuple, wrench_out: wp.array, advance: bool = False) -> None:
+    """Launch the fused 3D-RFT kernel over [num_worlds, num_feet] blocks of :func:`tile_block_dim` lanes.
+
+    ``advance`` False: :data:`rft3d_foot_wrench_kernel` (compute()); True: :data:`rft3d_foot_step_kernel`, which
+    also advances the element state (compute() + update_state() in one launch).
+    """
     wp.launch_tiled(
-        rft3d_foot_wrench_kernel,
+        rft3d_foot_step_kernel if advance else rft3d_foot_wrench_kernel,
         dim=(model.num_worlds, model.num_feet),
-        inputs=[*_rft3d_model_inputs(model), *inputs, model.state],
-        outputs=[model.point_force, model.point_depth, model.point_vel, wrench_out, model.nan_count],
+        inputs=[model.coeffs, rft3d_model(model), *inputs],
+        outputs=[model.state, model.point_force, model.point_depth, model.point_vel, wrench_out, model.nan_count],
         block_dim=tile_block_dim(model.num_points),
         device=model.device,
     )

@@ -17,6 +17,7 @@ __all__ = [
     "AT_REST_CODES",
     "AtRestParams",
     "ElementState",
+    "advance_element_state",
     "advance_stick_anchor",
     "at_rest_filter",
     "crater_friction",
@@ -198,6 +199,47 @@ def advance_stick_anchor(
         anchor_out[w, f, p] = x - s_t * (distance / length)
 
 
+@wp.func
+def advance_element_state(
+    state: ElementState,
+    rest: AtRestParams,
+    vertical_only: int,
+    w: int,
+    f: int,
+    p: int,
+    x: wp.vec3,
+    n: wp.vec3,
+    vel: wp.vec3,
+    depth: float,
+    force: wp.vec3,
+) -> None:
+    """Advance element [w, f, p]'s memory past this substep: stick anchor, z_max, EMA rigidity, velocity, force.
+
+    ``x``, ``n``, ``vel``, ``depth``: the element's position, normal, velocity and depth this substep (zeros for
+    non-finite foot inputs); ``force``: its filtered force this substep, stored only in ``"ema"`` mode. Reads
+    and writes element [w, f, p] only, so the thread that owns the element may call it after its own force
+    evaluation has read the old state (no other thread touches the entry). Unchanged z_max, tau_r and anchors
+    are not rewritten.
+    """
+    depth_max = state.depth_max[w, f, p]
+    if rest.stick_distance > 0.0 and depth > 0.0:
+        advance_stick_anchor(state.anchor, w, f, p, x, n, depth, depth_max, rest.stick_distance)
+    new_depth_max = 0.0
+    if depth > 0.0:
+        new_depth_max = wp.max(depth_max, depth)
+    if new_depth_max != depth_max:
+        state.depth_max[w, f, p] = new_depth_max
+    tau = state.ema_tau[w, f, p]
+    new_tau = 0.0  # = ema_rigidity out of contact, without loading vel_prev (12 B) for emerged elements
+    if depth > 0.0:
+        new_tau = ema_rigidity(tau, vel, state.vel_prev[w, f, p], depth, rest.ema_rate, vertical_only)
+    if new_tau != tau:
+        state.ema_tau[w, f, p] = new_tau
+    state.vel_prev[w, f, p] = vel
+    if rest.mode == AT_REST_EMA:
+        state.force_prev[w, f, p] = force
+
+
 def rft_element_model(model: Any) -> list:
     """Return the ``# Model:`` arguments the RFT element kernels share, in their order.
 
@@ -253,21 +295,10 @@ def state_update_kernel(
         n = kin[1]
         vel = kin[2]
         depth = terrain_height(terrain, x[0], x[1]) - x[2]
-    depth_max = state_out.depth_max[w, f, p]
-    if rest.stick_distance > 0.0 and depth > 0.0:
-        advance_stick_anchor(state_out.anchor, w, f, p, x, n, depth, depth_max, rest.stick_distance)
-    new_depth_max = 0.0
-    if depth > 0.0:
-        new_depth_max = wp.max(depth_max, depth)
-    if new_depth_max != depth_max:
-        state_out.depth_max[w, f, p] = new_depth_max
-    tau = state_out.ema_tau[w, f, p]
-    new_tau = ema_rigidity(tau, vel, state_out.vel_prev[w, f, p], depth, rest.ema_rate, vertical_only)
-    if new_tau != tau:
-        state_out.ema_tau[w, f, p] = new_tau
-    state_out.vel_prev[w, f, p] = vel
+    force = wp.vec3(0.0)
     if rest.mode == AT_REST_EMA:
-        state_out.force_prev[w, f, p] = point_force_in[w, f, p]
+        force = point_force_in[w, f, p]
+    advance_element_state(state_out, rest, vertical_only, w, f, p, x, n, vel, depth, force)
 
 
 def eval_state_update(model: Any, inputs: tuple, vertical_only: int) -> None:

@@ -97,10 +97,12 @@ class ContactModel:
     """compute() path. True (default): the model's fused points + wrench pass where it has one (3D-RFT), else its
     per-point pass + a tiled per-foot sum (one block per foot). False: per-point pass + one-thread-per-foot sum,
     kept as the parity oracle of the tile sums and for benchmarks; both paths evaluate each element with the
-    same functions (same results to float32 round-off in the sum order). update_state() is one path."""
+    same functions (same results to float32 round-off in the sum order). update_state() is one path;
+    compute_and_update_state() is one launch on the fused 3D-RFT path, else compute() then update_state()."""
     _vertical_only: int = 0
     _eval_points: Callable[[Any, tuple, wp.array], None]
-    _eval_fused: Callable[[Any, tuple, wp.array], None] | None = None
+    _eval_fused: Callable[..., None] | None = None
+    """Fused compute(): ``(model, inputs, wrench_out, advance=False)``; ``advance=True`` also advances the state."""
 
     def __init__(
         self,
@@ -262,6 +264,30 @@ class ContactModel:
             self._eval_points(self, inputs, self._scratch_count)
         # z_max, stick anchor, EMA rigidity, previous velocity (and force in "ema" mode), one launch
         eval_state_update(self, inputs, self._vertical_only)
+
+    def compute_and_update_state(
+        self,
+        foot_pos_w: wp.array,
+        foot_mat_w: wp.array,
+        foot_lin_vel_w: wp.array,
+        foot_ang_vel_w: wp.array,
+        foot_com_w: wp.array,
+        wrench_out: wp.array,
+    ) -> None:
+        """compute() then update_state() with the same inputs: this substep's wrench, then the memory advanced.
+
+        On the fused 3D-RFT path this is one launch: each lane evaluates its elements from the old state and
+        then advances their state (it owns those entries: no race), with the functions the two-launch sequence
+        uses, so wrench, per-point outputs and state equal those of ``compute(); update_state()``. Elsewhere
+        (``fused = False``, other models) it is exactly those two calls. Call it once per physics substep, in
+        place of both (not in a ``sim.forward()`` that must leave the state alone: use compute() there).
+        """
+        inputs = (foot_pos_w, foot_mat_w, foot_lin_vel_w, foot_ang_vel_w, foot_com_w)
+        if self.fused and self._eval_fused is not None:
+            self._eval_fused(self, inputs, wrench_out, advance=True)
+            return
+        self.compute(*inputs, wrench_out)
+        self.update_state(*inputs)
 
     def reset(self, env_ids: Any = None) -> None:
         """Clear the state of the given worlds (all when None)."""
