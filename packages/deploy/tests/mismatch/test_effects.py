@@ -67,8 +67,9 @@ def test_injection_code_is_independent_of_hypothesis_code() -> None:
         "gmloco.deploy.mismatch.terrain",
         "gmloco.deploy.mismatch.attribution",
         "gmloco.deploy.mismatch.problem",
+        "gmloco.deploy.mismatch.sand",
     }
-    for f in ("truth.py", "generator.py", "controller.py"):
+    for f in ("truth.py", "truth_sand.py", "generator.py", "controller.py", "policy_motion.py"):
         tree = ast.parse((bench / f).read_text())
         mods = {n.module for n in ast.walk(tree) if isinstance(n, ast.ImportFrom)}
         assert not mods & forbidden, f

@@ -23,6 +23,12 @@ def _parser() -> argparse.ArgumentParser:
     )
     p.add_argument("--effects", default=None, help="comma-separated effect ids to screen (default: the whole library)")
     p.add_argument("--horizon", type=int, default=30, help="shooting horizon [samples]")
+    p.add_argument(
+        "--ground",
+        default="plane",
+        help="nominal ground: 'plane' (MuJoCo soft contact) or 'sand[:MATERIAL]' (the project's 3D-RFT sand, "
+        "default material dry_sand; gmloco.contact.MATERIAL_PRESETS)",
+    )
     p.add_argument("--no-plots", action="store_true", help="skip matplotlib plots")
     return p
 
@@ -34,7 +40,7 @@ def main(argv: list[str] | None = None) -> int:
 
     from gmloco.deploy.mismatch.io import read_recording
     from gmloco.deploy.mismatch.pipeline import AnalysisCfg, analyze
-    from gmloco.deploy.mismatch.replay import ReplayCfg
+    from gmloco.deploy.mismatch.replay import ReplayCfg, sand_replay_cfg
     from gmloco.deploy.mismatch.report import write_report
 
     args = _parser().parse_args(argv)
@@ -49,7 +55,16 @@ def main(argv: list[str] | None = None) -> int:
             "[yellow]--sim given: the simulated log is checked for its contract only; residuals come from replay at the real states (short horizons), which a free-running sim log cannot provide."
         )
         read_recording(args.sim)
-    cfg = AnalysisCfg(replay=ReplayCfg(horizon=args.horizon))
+    ground, _, material = args.ground.partition(":")
+    if ground not in ("plane", "sand"):
+        console.print(f"[red]--ground {args.ground!r}: expected 'plane' or 'sand[:MATERIAL]'")
+        return 2
+    replay = (
+        sand_replay_cfg(material or "dry_sand", 1.0 / rec.dt, args.horizon)
+        if ground == "sand"
+        else ReplayCfg(horizon=args.horizon)
+    )
+    cfg = AnalysisCfg(replay=replay)
     if args.effects:
         cfg.attribution.effects = tuple(s.strip() for s in args.effects.split(","))
     with Progress(console=console) as prog:

@@ -89,8 +89,14 @@ def _joint_map(rec: Recording, cfg: ContractCfg) -> list[ContractIssue]:
             out_of_range.append((n, round(frac, 3)))
     dist = np.median(np.abs(rec.q_cmd[:, :, None] - rec.q[:, None, :]), axis=0)  # [cmd joint, state joint]
     corr = _xcorr(rec.q_cmd, rec.q)
+    pd_ok = _pd_consistent(rec)
     swaps = []
     for j, n in enumerate(rec.joint_names):
+        if pd_ok[j]:
+            # The motor law ties this column's command, state and tau_est together: the pairing is right even
+            # when a low-gain policy's targets sit far from the measured positions (the distance/correlation
+            # heuristics below would then misfire).
+            continue
         k = int(np.argmin(dist[j]))
         c = int(np.nanargmax(corr[j])) if np.any(np.isfinite(corr[j])) else j
         # Distance alone is fooled by joints with similar set-points under load sag: it needs the
@@ -123,6 +129,20 @@ def _joint_map(rec: Recording, cfg: ContractCfg) -> list[ContractIssue]:
         msg += "Fix the joint order (Unitree motor index order, see gmloco.deploy.logs.g1.G1_JOINT_NAMES)."
         issues.append(ContractIssue("joint_map", "error", msg, {"swaps": swaps, "out_of_range": out_of_range}))
     return issues
+
+
+def _pd_consistent(rec: Recording, min_corr: float = 0.9) -> np.ndarray:
+    """Per joint, whether ``tau_est`` follows the labelled PD law ``kp (q* - q) + kd (dq* - dq) + tau_ff``, shape [29].
+
+    A correlation above ``min_corr`` between the two (over the recording) means the command and state columns of
+    the joint belong together. False where ``tau_est`` is not logged or does not vary.
+    """
+    pd = rec.kp * (rec.q_cmd - rec.q) + rec.kd * (rec.dq_cmd - rec.dq) + rec.tau_ff
+    a, b = pd - pd.mean(0), rec.tau_est - rec.tau_est.mean(0)
+    sa, sb = a.std(0), b.std(0)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        c = (a * b).mean(0) / (sa * sb)
+    return np.nan_to_num(c, nan=0.0) * (sb > 1e-3) > min_corr
 
 
 def _xcorr(a: np.ndarray, b: np.ndarray) -> np.ndarray:

@@ -11,13 +11,14 @@ parametric change of *this* model.
 from __future__ import annotations
 
 import importlib.util
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any
+from typing import Any, Literal
 
 import numpy as np
 
 from gmloco.deploy.logs.g1 import G1_JOINT_NAMES
+from gmloco.deploy.mismatch.sand import SandCfg
 
 __all__ = [
     "G1_ARMATURE",
@@ -86,6 +87,11 @@ class G1SimCfg:
     """MuJoCo ``solref`` damping ratio of the foot-ground contact [-]."""
     foot_friction: float = 0.8
     """Sliding friction coefficient of the foot capsules on the ground [-]."""
+    ground: Literal["plane", "sand"] = "plane"
+    """Nominal ground: MuJoCo soft contact on a plane, or the project's 3D-RFT sand on the soles (then the feet
+    have no MuJoCo contact; the replay applies the sand forces, :mod:`gmloco.deploy.mismatch.sand`)."""
+    sand: SandCfg = field(default_factory=SandCfg)
+    """Sand medium and RFT settings (``ground="sand"``)."""
 
 
 def build_model(cfg: G1SimCfg | None = None, spec_edit: Any = None) -> Any:
@@ -107,7 +113,7 @@ def build_model(cfg: G1SimCfg | None = None, spec_edit: Any = None) -> Any:
     for g in spec.geoms:
         if g.name.endswith("_collision"):
             foot = "_foot" in g.name
-            g.contype = 1 if foot else 0
+            g.contype = 1 if foot and cfg.ground == "plane" else 0
             g.conaffinity = 0  # feet collide with the floor only, never with each other
             if foot:
                 g.condim = 3

@@ -12,6 +12,7 @@ sensor, model edits) or in :mod:`gmloco.deploy.mismatch.terrain`, and all are ex
 from __future__ import annotations
 
 from dataclasses import dataclass, field, replace
+from typing import Any
 
 import numpy as np
 
@@ -20,9 +21,18 @@ from gmloco.deploy.mismatch.effects import EFFECTS, effect
 from gmloco.deploy.mismatch.frames import quat_conj, quat_from_roll_pitch, quat_mul, quat_to_mat
 from gmloco.deploy.mismatch.g1model import G1_ARMATURE, G1_EFFORT_LIMIT, SOLE_POINTS, G1SimCfg, build_model
 from gmloco.deploy.mismatch.recording import Recording
-from gmloco.deploy.mismatch.terrain import TerrainCfg, TerrainParams, sole_forces
+from gmloco.deploy.mismatch.sand import SandCfg, SoleRFT
+from gmloco.deploy.mismatch.terrain import TerrainCfg, TerrainParams, sand_effect_forces, sole_forces
 
-__all__ = ["CHANNEL_GROUPS", "N_CHANNELS", "ReplayCfg", "Replayer", "attitude_rate_residual", "channel_names"]
+__all__ = [
+    "CHANNEL_GROUPS",
+    "N_CHANNELS",
+    "ReplayCfg",
+    "Replayer",
+    "attitude_rate_residual",
+    "channel_names",
+    "sand_replay_cfg",
+]
 
 CHANNEL_GROUPS: tuple[tuple[str, int], ...] = (
     ("q", 29),
@@ -99,6 +109,19 @@ class ReplayCfg:
     """Half window of the gyro-vs-attitude-rate channel [samples] (16 ms at 500 Hz)."""
 
 
+def sand_replay_cfg(material: str = "dry_sand", rate_hz: float = 500.0, horizon: int = 30) -> ReplayCfg:
+    """Return the replay settings for the project's 3D-RFT sand as nominal ground.
+
+    Two physics steps per log sample: on a walking null, 1 kHz removes a third of the 500 Hz residual energy
+    (the sand's elastic branch is stiff) for 1.3x the cost.
+    """
+    return ReplayCfg(
+        horizon=horizon,
+        substeps=2,
+        sim=G1SimCfg(timestep=0.5 / rate_hz, ground="sand", sand=SandCfg(material=material)),
+    )
+
+
 @dataclass
 class _Hyp:
     """All effect parameters, unpacked for the inner loop."""
@@ -114,6 +137,7 @@ class _Hyp:
     mis: np.ndarray
     dmass: float
     terrain: TerrainParams
+    rmis_t: np.ndarray
 
 
 def _unpack(params: dict[str, np.ndarray]) -> _Hyp:
@@ -138,7 +162,30 @@ def _unpack(params: dict[str, np.ndarray]) -> _Hyp:
             rho_drag=float(p["terrain.rate_drag"]["rho_drag"][0]),
             cohesion=float(p["terrain.cohesion"]["cohesion"][0]),
         ),
+        rmis_t=quat_to_mat(quat_from_roll_pitch(*(float(a) for a in p["imu.misalignment"]["angle"]))).T,
     )
+
+
+@dataclass
+class _Seg:
+    """State of one shooting segment while the segments are stepped side by side."""
+
+    d: Any
+    """Its ``mujoco.MjData``."""
+    k0: int
+    """Start sample."""
+    qc: np.ndarray
+    """Delayed position commands [rad], shape [H+1, 29]."""
+    dqc: np.ndarray
+    """Delayed velocity commands [rad/s], shape [H+1, 29]."""
+    tff: np.ndarray
+    """Delayed feed-forward torques [N*m], shape [H+1, 29]."""
+    qm: np.ndarray = field(default_factory=lambda: np.zeros(29))
+    """Encoder reading of the current step [rad]."""
+    tau: np.ndarray = field(default_factory=lambda: np.zeros(29))
+    """Motor torque of the current step [N*m]."""
+    w_imu: np.ndarray = field(default_factory=lambda: np.zeros(3))
+    """Pelvis angular velocity at the last compare point [rad/s]."""
 
 
 class Replayer:
@@ -161,6 +208,11 @@ class Replayer:
         self.offsets = np.arange(self.cfg.stride, self.cfg.horizon + 1, self.cfg.stride)
         self._base_cache: dict[tuple, BaseTrajectory] = {}
         self._sink_cache: dict[tuple, float] = {}
+        self._crater_cache: dict[tuple, np.ndarray] = {}
+        self._zmax0: np.ndarray | None = None
+        self._pool: list = []
+        self.sand = SoleRFT(self.cfg.sim.sand) if self.cfg.sim.ground == "sand" else None
+        """Nominal 3D-RFT sand on the soles (None on the plane ground)."""
         self.gyro_att = attitude_rate_residual(rec.imu_quat, rec.imu_gyro, rec.dt, self.cfg.attitude_half_window)
 
     # ----------------------------------------------------------------------------------------------- data
@@ -181,21 +233,56 @@ class Replayer:
             [r.q[idx], r.dq[idx], r.tau_est[idx], r.imu_gyro[idx], r.imu_acc[idx], self.gyro_att[idx]], axis=-1
         )
 
-    def base(self, params: dict[str, np.ndarray], starts: np.ndarray) -> BaseTrajectory:
-        """Base state at the segment starts under the sensor hypotheses of ``params`` (cached)."""
-        h = _unpack(params)
-        key = (
+    def _base_key(self, h: _Hyp) -> tuple:
+        """Hypothesis parameters the base estimate depends on (sensor effects and the static load)."""
+        return (
             tuple(np.round(h.offset[:12], 9)),
             tuple(np.round(h.mis, 9)),
             tuple(np.round(h.gyro_bias, 9)),
             self._load_key(h),
-            starts.tobytes(),
         )
+
+    def base(self, params: dict[str, np.ndarray], starts: np.ndarray) -> BaseTrajectory:
+        """Base state at the segment starts under the sensor hypotheses of ``params`` (cached)."""
+        h = _unpack(params)
+        key = (*self._base_key(h), starts.tobytes())
         if key not in self._base_cache:
             self._base_cache[key] = self._estimate(h, starts)
             if len(self._base_cache) > 64:
                 self._base_cache.pop(next(iter(self._base_cache)))
         return self._base_cache[key]
+
+    def crater_memory(self, params: dict[str, np.ndarray]) -> np.ndarray:
+        """Each sole cell's deepest depth since it last entered the sand, per sample [m], shape [N, 2M] (cached).
+
+        The nominal sand remembers, per cell, the maximum depth ``z_max`` of its current contact (the elastic
+        unloading branch of :mod:`gmloco.deploy.mismatch.sand`); a segment that starts with ``z_max`` = present
+        depth misplaces every foot that has rebounded. The memory is rebuilt kinematically: the sole cells follow
+        the logged joints on the estimated base over the whole recording.
+        """
+        import mujoco
+
+        h = _unpack(params)
+        key = self._base_key(h)
+        if key not in self._crater_cache:
+            r, m, sand = self.rec, self.model, self.sand
+            assert sand is not None
+            base = self.base(params, np.arange(r.n))
+            d = mujoco.MjData(m)
+            depth = np.empty((r.n, 2 * sand.m))
+            for k in range(r.n):
+                d.qpos[2], d.qpos[3:7], d.qpos[7:] = base.pos[k, 2], base.quat[k], r.q[k] - h.offset
+                mujoco.mj_kinematics(m, d)
+                pts = np.einsum("fij,mj->fmi", d.xmat[self._feet].reshape(2, 3, 3), sand.points_body)
+                depth[k] = sand.cfg.surface_z - (pts[..., 2] + d.xpos[self._feet][:, None, 2]).ravel()
+            zm, out = np.zeros(2 * sand.m), np.empty_like(depth)
+            for k in range(r.n):
+                zm = np.where(depth[k] > 0.0, np.maximum(zm, depth[k]), 0.0)
+                out[k] = zm
+            self._crater_cache[key] = out
+            if len(self._crater_cache) > 16:
+                self._crater_cache.pop(next(iter(self._crater_cache)))
+        return self._crater_cache[key]
 
     def _estimate(self, h: _Hyp, starts: np.ndarray) -> BaseTrajectory:
         """Run the base estimator (or wrap odometry) at ``starts``."""
@@ -217,8 +304,10 @@ class Replayer:
         omega = (r.imu_gyro[starts] - h.gyro_bias) @ quat_to_mat(qm).T
         # Sinkage is not observable from proprioception: the assumed support-foot penetration follows the
         # static sinkage of the hypothesis (terrain laws and body mass change it), relative to the nominal one.
-        sink = self._static_sinkage(h) - self._static_sinkage(_unpack({}))
-        base_cfg = replace(self.cfg.base, penetration=self.cfg.base.penetration + sink)
+        # On sand the nominal sinkage itself (millimetres to centimetres) replaces the plane's fixed penetration.
+        sink = self._static_sinkage(h) - (0.0 if self.sand is not None else self._static_sinkage(_unpack({})))
+        pen0 = 0.0 if self.sand is not None else self.cfg.base.penetration
+        base_cfg = replace(self.cfg.base, penetration=pen0 + sink)
         return estimate_base(self.model, q_true, r.dq[starts], quat, omega, base_cfg)
 
     @staticmethod
@@ -251,8 +340,8 @@ class Replayer:
         for k in range(n):
             mujoco.mj_step1(m, d)
             d.qfrc_applied[6:] = -500.0 * d.qpos[7:]
-            if h.terrain.active():
-                self._terrain(h.terrain)
+            self._zmax0 = None
+            self._ground(h, [d], reset=k == 0)
             mujoco.mj_step2(m, d)
             if k >= n - round(0.1 / m.opt.timestep):
                 soles = [d.xpos[b] + SOLE_POINTS @ d.xmat[b].reshape(3, 3).T for b in self._feet]
@@ -284,8 +373,19 @@ class Replayer:
         lerp = lambda a: (1 - w) * a[i0] + w * a[i1]  # noqa: E731
         return lerp(r.q_cmd), lerp(r.dq_cmd), lerp(r.tau_ff)
 
+    def _datas(self, n: int) -> list:
+        """A pool of ``n`` MjData, one per shooting segment (segments are stepped side by side)."""
+        import mujoco
+
+        while len(self._pool) < n:
+            self._pool.append(mujoco.MjData(self.model))
+        return self._pool[:n]
+
     def simulate(self, params: dict[str, np.ndarray], starts: np.ndarray) -> np.ndarray:
         """Simulated measurements at the compare points, shape [S, P, N_CHANNELS].
+
+        All segments are stepped side by side (one MjData each), so the sand forces of every segment are
+        computed in one vectorised call per physics step; each segment's arithmetic is that of a lone replay.
 
         Args:
             params: ``{effect_id: flat parameter vector}``; missing ids are nominal.
@@ -295,15 +395,26 @@ class Replayer:
         self._set_model(h)
         base = self.base(params, starts)
         out = np.zeros((len(starts), len(self.offsets), N_CHANNELS))
-        for s, k0 in enumerate(starts):
-            self._segment(h, base, s, int(k0), out[s])
+        datas = self._datas(len(starts))
+        segs = [self._seg_start(h, base, s, int(k0), datas[s]) for s, k0 in enumerate(starts)]
+        self._zmax0 = self.crater_memory(params)[starts].reshape(-1) if self.sand is not None else None
+        p = 0
+        for j in range(self.cfg.horizon + 1):
+            for sub in range(self.cfg.substeps):
+                at_compare = sub == 0 and p < len(self.offsets) and j == self.offsets[p]
+                for seg in segs:
+                    self._seg_pre(h, seg, j, at_compare)
+                self._ground(h, datas[: len(segs)], reset=j == 0 and sub == 0)
+                for seg, o in zip(segs, out, strict=True):
+                    self._seg_post(h, seg, j, o[p] if at_compare else None)
+                p += int(at_compare)
         return out
 
-    def _segment(self, h: _Hyp, base: BaseTrajectory, s: int, k0: int, out: np.ndarray) -> None:
-        """Reset to the real state at ``k0`` and simulate one shooting segment into ``out`` [P, N_CHANNELS]."""
+    def _seg_start(self, h: _Hyp, base: BaseTrajectory, s: int, k0: int, d: Any) -> _Seg:
+        """Reset ``d`` to the real state at ``k0`` (segment ``s`` of ``base``)."""
         import mujoco
 
-        m, d, r, cfg = self.model, self.data, self.rec, self.cfg
+        m, r = self.model, self.rec
         mujoco.mj_resetData(m, d)
         d.qpos[2] = base.pos[s, 2]
         d.qpos[3:7] = base.quat[s]
@@ -312,45 +423,86 @@ class Replayer:
         d.qvel[3:6] = base.angvel[s]
         d.qvel[6:] = r.dq[k0]
         qc, dqc, tff = self._commands(k0, h.delay)
-        rmis_t = quat_to_mat(quat_from_roll_pitch(float(h.mis[0]), float(h.mis[1]))).T
-        tmax = G1_EFFORT_LIMIT
-        bj = h.b * self._w
-        terrain = h.terrain.active()
-        p, w_imu = 0, np.zeros(3)
-        for j in range(cfg.horizon + 1):
-            k = k0 + j
-            kp, kd = r.kp[k], r.kd[k]
-            for sub in range(cfg.substeps):
-                # Damping enters qfrc_passive in mj_step1 and the implicit Euler update in mj_step2: set it first.
-                m.dof_damping[6:] = h.gain * kd + bj
-                mujoco.mj_step1(m, d)
-                at_compare = sub == 0 and p < len(self.offsets) and j == self.offsets[p]
-                w_imu = d.qvel[3:6].copy() if at_compare else w_imu  # angular velocity the gyro sensor saw
-                qm = d.qpos[7:] + h.offset
-                v = d.qvel[6:]
-                tau = h.gain * (kp * (qc[j] - qm) + kd * (dqc[j] - v)) + tff[j]
-                lim = tmax if h.droop == 0.0 else tmax * np.clip(1.0 - h.droop * np.abs(v), 0.0, None)
-                tau = np.clip(tau, -lim, lim)
-                # The -kd*dq part is integrated implicitly through dof_damping (Euler integrator), so add it back.
-                d.qfrc_applied[6:] = tau + h.gain * kd * v
-                if terrain:
-                    self._terrain(h.terrain)
-                mujoco.mj_step2(m, d)
-                if at_compare:
-                    out[p, :29] = qm
-                    out[p, 29:58] = v
-                    out[p, 58:87] = tau
-                    out[p, 87:90] = rmis_t @ d.sensordata[0:3] + h.gyro_bias
-                    out[p, 90:93] = rmis_t @ d.sensordata[6:9]
-                    # simulated gyro output minus the simulated IMU frame's own angular velocity
-                    out[p, 93:96] = out[p, 87:90] - rmis_t @ w_imu
-                    p += 1
+        return _Seg(d, k0, qc, dqc, tff)
 
-    def _terrain(self, tp: TerrainParams) -> None:
-        """Write the terrain-effect wrench of both feet into ``xfrc_applied``."""
+    def _seg_pre(self, h: _Hyp, seg: _Seg, j: int, at_compare: bool) -> None:
+        """First half of a physics step of one segment: kinematics, motor torques (PD on the encoders)."""
         import mujoco
 
-        m, d = self.model, self.data
+        m, d, r = self.model, seg.d, self.rec
+        k = seg.k0 + j
+        kp, kd = r.kp[k], r.kd[k]
+        # Damping enters qfrc_passive in mj_step1 and the implicit Euler update in mj_step2: set it first.
+        m.dof_damping[6:] = h.gain * kd + h.b * self._w
+        mujoco.mj_step1(m, d)
+        if at_compare:
+            seg.w_imu = d.qvel[3:6].copy()  # angular velocity the gyro sensor saw
+        seg.qm = d.qpos[7:] + h.offset
+        v = d.qvel[6:]
+        tau = h.gain * (kp * (seg.qc[j] - seg.qm) + kd * (seg.dqc[j] - v)) + seg.tff[j]
+        lim = G1_EFFORT_LIMIT if h.droop == 0.0 else G1_EFFORT_LIMIT * np.clip(1.0 - h.droop * np.abs(v), 0.0, None)
+        seg.tau = np.clip(tau, -lim, lim)
+        # The -kd*dq part is integrated implicitly through dof_damping (Euler integrator), so add it back.
+        d.qfrc_applied[6:] = seg.tau + h.gain * kd * v
+
+    def _seg_post(self, h: _Hyp, seg: _Seg, j: int, out: np.ndarray | None) -> None:
+        """Second half of the physics step; write the simulated measurements into ``out`` [N_CHANNELS] if given."""
+        import mujoco
+
+        m, d = self.model, seg.d
+        m.dof_damping[6:] = h.gain * self.rec.kd[seg.k0 + j] + h.b * self._w
+        mujoco.mj_step2(m, d)
+        if out is None:
+            return
+        rmis_t = h.rmis_t
+        out[:29] = seg.qm
+        out[29:58] = d.qvel[6:]
+        out[58:87] = seg.tau
+        out[87:90] = rmis_t @ d.sensordata[0:3] + h.gyro_bias
+        out[90:93] = rmis_t @ d.sensordata[6:9]
+        # simulated gyro output minus the simulated IMU frame's own angular velocity
+        out[93:96] = out[87:90] - rmis_t @ seg.w_imu
+
+    def _ground(self, h: _Hyp, datas: list, reset: bool) -> None:
+        """Write the ground wrench (sand forces, or terrain effects on the plane) into each ``xfrc_applied``."""
+        if self.sand is not None:
+            self._sand_wrench(h.terrain, datas, reset)
+        elif h.terrain.active():
+            for d in datas:
+                self._terrain(h.terrain, d)
+
+    def _sand_wrench(self, tp: TerrainParams, datas: list, reset: bool) -> None:
+        """3D-RFT sand (and its terrain effects) on both soles of every segment, vectorised over segments."""
+        import mujoco
+
+        sand, feet, m = self.sand, self._feet, self.model
+        assert sand is not None
+        ns, mc = len(datas), sand.m
+        pos, rot, xi = np.empty((ns, 2, 3)), np.empty((ns, 2, 3, 3)), np.empty((ns, 2, 3))
+        vel6 = np.empty((ns, 2, 6))
+        for s, d in enumerate(datas):
+            pos[s], rot[s], xi[s] = d.xpos[feet], d.xmat[feet].reshape(2, 3, 3), d.xipos[feet]
+            for f, b in enumerate(feet):
+                mujoco.mj_objectVelocity(m, d, mujoco.mjtObj.mjOBJ_BODY, b, vel6[s, f], 0)
+        rel = np.einsum("sfij,mj->sfmi", rot, sand.points_body)  # cell offsets in the world frame [S, 2, M, 3]
+        pts = pos[:, :, None, :] + rel
+        vel = vel6[:, :, None, 3:] + np.cross(vel6[:, :, None, :3], rel)
+        normals = -rot[:, :, :, 2].reshape(-1, 3)  # outward sole normal = -z of the ankle-roll frame
+        if reset or sand.zmax.shape[0] != ns * 2 * mc:
+            zm = self._zmax0 if self._zmax0 is not None and len(self._zmax0) == ns * 2 * mc else None
+            sand.reset(pts.reshape(-1, 3), zm)
+        f, depth = sand.forces(pts.reshape(-1, 3), vel.reshape(-1, 3), normals)
+        f = sand_effect_forces(f, depth, vel.reshape(-1, 3)[:, 2], sand.area(2 * ns), tp, self.cfg.terrain)
+        f = f.reshape(ns, 2, mc, 3)
+        wrench = np.concatenate([f.sum(2), np.cross(pts - xi[:, :, None, :], f).sum(2)], axis=-1)  # [S, 2, 6]
+        for s, d in enumerate(datas):
+            d.xfrc_applied[feet] = wrench[s]
+
+    def _terrain(self, tp: TerrainParams, d: Any) -> None:
+        """Write the terrain-effect wrench of both feet into ``xfrc_applied`` (plane ground)."""
+        import mujoco
+
+        m = self.model
         vel6 = np.zeros(6)
         for b in self._feet:
             rot = d.xmat[b].reshape(3, 3)

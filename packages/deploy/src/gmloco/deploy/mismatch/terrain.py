@@ -1,7 +1,12 @@
 # SPDX-License-Identifier: Apache-2.0
-"""Terrain effects: extra vertical stress laws at the foot sole points, added to the nominal ground.
+"""Terrain effects: parametric changes of the nominal ground's stress law at the foot sole, zero at zero.
 
-The nominal ground is MuJoCo soft contact on a plane (:mod:`gmloco.deploy.mismatch.g1model`); each terrain
+On the **sand** ground (3D-RFT, :mod:`gmloco.deploy.mismatch.sand`) the effects change the RFT cell forces
+``F_i`` (:func:`sand_effect_forces`): ``zeta`` scales them, ``F_i (1 + zeta)`` (medium scale / packing,
+alpha -> (1 + zeta) alpha); ``kappa`` hardens them with depth, ``F_i (1 + kappa z_i)``; the drag and cohesion laws
+below are added to the vertical force of every submerged cell.
+
+On the **plane** ground (MuJoCo soft contact, :mod:`gmloco.deploy.mismatch.g1model`) each terrain
 effect adds a vertical force per sole point i (area ``A_i``, depth ``z_i > 0`` below the surface, vertical
 velocity ``v_i``), exactly zero at zero parameters:
 
@@ -19,7 +24,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-__all__ = ["TerrainCfg", "TerrainParams", "sole_forces"]
+__all__ = ["TerrainCfg", "TerrainParams", "sand_effect_forces", "sole_forces"]
 
 
 @dataclass
@@ -69,4 +74,27 @@ def sole_forces(points_z: np.ndarray, vel_z: np.ndarray, p: TerrainParams, cfg: 
     f = cfg.alpha_ref * a * (p.zeta * z + p.kappa * z * z)
     f = f + p.rho_drag * a * np.where(vel_z < 0.0, vel_z * vel_z, 0.0) * (z > 0.0)
     f = f - p.cohesion * a * np.tanh(z / cfg.cohesion_depth)
+    return f
+
+
+def sand_effect_forces(
+    f: np.ndarray, depth: np.ndarray, vel_z: np.ndarray, area: np.ndarray, p: TerrainParams, cfg: TerrainCfg
+) -> np.ndarray:
+    """Return the RFT cell forces changed by the terrain effects [N], shape [K, 3] (``f`` itself at zero).
+
+    Args:
+        f: Nominal 3D-RFT forces on the sole cells [N], shape [K, 3].
+        depth: Cell depths below the free surface [m], shape [K].
+        vel_z: Cell vertical velocities [m/s], shape [K].
+        area: Cell areas [m^2], shape [K].
+        p: Effect parameters.
+        cfg: Law constants (cohesion depth).
+    """
+    if not p.active():
+        return f
+    f = f * (1.0 + p.zeta + p.kappa * np.maximum(depth, 0.0))[:, None]
+    inside = depth > 0.0
+    fz = p.rho_drag * area * np.where(vel_z < 0.0, vel_z * vel_z, 0.0) * inside
+    fz = fz - p.cohesion * area * np.tanh(np.maximum(depth, 0.0) / cfg.cohesion_depth)
+    f[:, 2] += fz
     return f

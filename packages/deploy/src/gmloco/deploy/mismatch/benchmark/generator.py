@@ -9,10 +9,12 @@ the tool cannot read it.
 from __future__ import annotations
 
 from dataclasses import dataclass, field
+from typing import Literal
 
 import numpy as np
 
 from gmloco.deploy.mismatch.benchmark.controller import MotionCfg, ScriptedMotion, default_gains
+from gmloco.deploy.mismatch.benchmark.policy_motion import PolicyMotion, PolicyMotionCfg
 from gmloco.deploy.mismatch.benchmark.truth import (
     NoiseCfg,
     TruthActuator,
@@ -21,6 +23,7 @@ from gmloco.deploy.mismatch.benchmark.truth import (
     truth_spec_edit,
     truth_terrain_wrench,
 )
+from gmloco.deploy.mismatch.benchmark.truth_sand import TruthSand
 from gmloco.deploy.mismatch.g1model import G1_EFFORT_LIMIT, G1SimCfg, build_model
 from gmloco.deploy.mismatch.recording import Recording
 
@@ -56,6 +59,12 @@ class EpisodeCfg:
     raising (as a user would trim a real log that ends in a fall); ``min_kept`` seconds must remain."""
     min_kept: float = 3.5
     """Shortest log kept after trimming a fall [s]."""
+    ground: Literal["plane", "sand"] = "plane"
+    """Truth ground: MuJoCo soft plane, or the project's 3D-RFT sand (float64 reference, :mod:`.truth_sand`)."""
+    material: str = "dry_sand"
+    """Sand medium (``gmloco.contact.MATERIAL_PRESETS``) when ``ground="sand"``."""
+    policy: PolicyMotionCfg | None = None
+    """If set, a trained walking policy drives the truth robot (with its own PD gains) instead of ``motion``."""
 
 
 def _initial_state(model: object, data: object, q0: np.ndarray) -> None:
@@ -78,15 +87,23 @@ def generate(cfg: EpisodeCfg) -> tuple[Recording, dict]:
     rng = np.random.default_rng(cfg.seed)
     dt_log = 1.0 / cfg.rate_hz
     dt = dt_log / cfg.substeps
-    model = build_model(G1SimCfg(timestep=dt), spec_edit=truth_spec_edit(cfg.effect, rng, cfg.nuisance))
+    model = build_model(
+        G1SimCfg(timestep=dt, ground=cfg.ground), spec_edit=truth_spec_edit(cfg.effect, rng, cfg.nuisance)
+    )
     model.opt.integrator = mujoco.mjtIntegrator.mjINT_IMPLICITFAST
     data = mujoco.MjData(model)
     act = TruthActuator(cfg.effect, G1_EFFORT_LIMIT, dt, rng, cfg.nuisance)
     sen = TruthSensor(cfg.effect, rng, cfg.noise)
-    ctrl = ScriptedMotion(cfg.motion)
-    kp, kd = default_gains()
+    ctrl: ScriptedMotion | PolicyMotion
+    if cfg.policy is not None:
+        ctrl = PolicyMotion(cfg.policy)
+        kp, kd = ctrl.gains()
+    else:
+        ctrl = ScriptedMotion(cfg.motion)
+        kp, kd = default_gains()
     _initial_state(model, data, ctrl.q0)
     feet = [model.body(f"{s}_ankle_roll_link").id for s in ("left", "right")]
+    sand = TruthSand(cfg.effect, cfg.material) if cfg.ground == "sand" else None
     n = round(cfg.duration * cfg.rate_hz)
     out = {
         k: np.zeros((n, w))
@@ -110,7 +127,10 @@ def generate(cfg: EpisodeCfg) -> tuple[Recording, dict]:
         mujoco.mj_forward(model, data)
         q_enc, dq_enc = sen.encoders(data.qpos[7:].copy(), data.qvel[6:].copy())
         quat, gyro, acc = sen.imu(data.qpos[3:7].copy(), data.sensordata[0:3].copy(), data.sensordata[6:9].copy())
-        qc = ctrl.targets(k * dt_log, quat, gyro)
+        if isinstance(ctrl, PolicyMotion):
+            qc = ctrl.targets(k * dt_log, quat, gyro, q_enc, dq_enc)
+        else:
+            qc = ctrl.targets(k * dt_log, quat, gyro)
         cmd = (qc, np.zeros(29), kp, kd, np.zeros(29))
         for sub in range(cfg.substeps):
             if sub:
@@ -121,7 +141,10 @@ def generate(cfg: EpisodeCfg) -> tuple[Recording, dict]:
                 tau_log = tau.copy()
             data.qfrc_applied[6:] = tau + act.joint_friction(data.qvel[6:])
             data.xfrc_applied[:] = 0.0
-            truth_terrain_wrench(cfg.effect, model, data, feet)
+            if sand is not None:
+                sand.apply(model, data, feet)
+            else:
+                truth_terrain_wrench(cfg.effect, model, data, feet)
             mujoco.mj_step(model, data)
         rot = data.xmat[1].reshape(3, 3)
         out["q"][k], out["dq"][k], out["tau"][k], out["qc"][k] = q_enc, dq_enc, sen.tau(tau_log), qc
@@ -168,5 +191,5 @@ def _to_recording(
         base_linvel=o["v"] if odo else None,
         base_angvel=o["w"] if odo else None,
         valid=valid,
-        meta={"controller": f"scripted_{cfg.motion.kind}", "source": "benchmark"},
+        meta={"controller": "policy" if cfg.policy else f"scripted_{cfg.motion.kind}", "source": "benchmark"},
     )

@@ -34,22 +34,35 @@ def run_episode(
     ``effects`` limits the tool's screening to a subset of the library (quick checks); None screens all.
     """
     from gmloco.deploy.mismatch.benchmark.generator import EpisodeCfg, generate
+    from gmloco.deploy.mismatch.benchmark.policy_motion import PolicyMotionCfg
     from gmloco.deploy.mismatch.benchmark.truth import TruthEffect
     from gmloco.deploy.mismatch.effects import EFFECT_IDS
     from gmloco.deploy.mismatch.pipeline import AnalysisCfg, analyze
+    from gmloco.deploy.mismatch.replay import sand_replay_cfg
 
     t0 = time.time()
     eff = TruthEffect(ep["effect"], ep["params"])
+    sand = ep.get("ground", "plane") == "sand"
     try:
         rec, key = generate(
-            EpisodeCfg(effect=eff, duration=duration, seed=ep["seed"], keep_before_fall=keep_before_fall)
+            EpisodeCfg(
+                effect=eff,
+                duration=duration,
+                seed=ep["seed"],
+                keep_before_fall=keep_before_fall,
+                ground="sand" if sand else "plane",
+                material=ep.get("material", "dry_sand"),
+                policy=PolicyMotionCfg() if ep.get("policy") else None,
+                odometry=bool(ep.get("odometry", False)),
+            )
         )
     except RuntimeError as exc:
         return {**ep, "error": str(exc)}
     keys = Path(out) / "keys"
     keys.mkdir(parents=True, exist_ok=True)
     (keys / f"{ep['name']}.json").write_text(json.dumps(key))
-    cfg = AnalysisCfg()
+    # The ground is what the user tells the tool (the robot walked on sand), not part of the hidden truth.
+    cfg = AnalysisCfg(replay=sand_replay_cfg(ep.get("material", "dry_sand"))) if sand else AnalysisCfg()
     cfg.attribution.effects = effects
     res = analyze(rec, cfg)
     rep = res.report
@@ -141,7 +154,7 @@ def _manifest(
 
 def main(argv: list[str] | None = None) -> None:
     """Run the sweep and write ``summary.json`` and ``manifest.json``."""
-    from gmloco.deploy.mismatch.benchmark.episodes import episode_list
+    from gmloco.deploy.mismatch.benchmark.episodes import episode_list, sand_episode_list
     from gmloco.deploy.mismatch.benchmark.scorer import score
 
     p = argparse.ArgumentParser()
@@ -151,6 +164,7 @@ def main(argv: list[str] | None = None) -> None:
     p.add_argument("--nulls", type=int, default=20)
     p.add_argument("--duration", type=float, default=8.0)
     p.add_argument("--strengths", default="mid")
+    p.add_argument("--suite", choices=("plane", "sand"), default="plane", help="plane: scripted stepping; sand: policy")
     p.add_argument(
         "--keep-before-fall",
         type=float,
@@ -169,7 +183,10 @@ def main(argv: list[str] | None = None) -> None:
             json.dumps({**score(rows), "episodes_scored": len(rows)}, indent=2, default=float)
         )
         return
-    eps = episode_list(a.seeds, a.nulls, tuple(a.strengths.split(",")))
+    if a.suite == "sand":
+        eps = sand_episode_list(a.seeds, a.nulls)
+    else:
+        eps = episode_list(a.seeds, a.nulls, tuple(a.strengths.split(",")))
     if a.only:
         eps = [e for e in eps if any(e["name"].startswith(s) for s in a.only.split(","))]
     a.out.mkdir(parents=True, exist_ok=True)

@@ -1,0 +1,92 @@
+# SPDX-License-Identifier: Apache-2.0
+"""A trained walking policy (exported ONNX, onnxruntime on CPU) as the truth robot's controller.
+
+The policy sees what a deployed policy sees: the *measured* encoders and IMU (offsets, noise and mounting
+rotation included), the velocity command and its last action; it runs at its ``policy_dt`` and holds its
+joint targets in between. The observation layout is the one of the exported metadata (mjlab's observation
+manager: terms in ``observation_names`` order, each term's history oldest first, flattened).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from gmloco.deploy.logs.g1 import G1_JOINT_NAMES
+
+__all__ = ["PolicyMotion", "PolicyMotionCfg"]
+
+
+@dataclass
+class PolicyMotionCfg:
+    """The walking-policy motion of a benchmark episode."""
+
+    path: str = "artifacts/ppo_rft3d/policy.onnx"
+    """Exported policy (``gmloco.train`` export metadata: gains, default pose, history, action scale)."""
+    speed: float = 1.0
+    """Commanded forward speed [m/s]."""
+    stand_time: float = 0.5
+    """Zero command before walking [s]."""
+
+
+class PolicyMotion:
+    """Joint targets and PD gains from a walking policy."""
+
+    def __init__(self, cfg: PolicyMotionCfg) -> None:
+        """Load the ONNX policy and its metadata."""
+        import onnxruntime as ort
+
+        opts = ort.SessionOptions()
+        opts.intra_op_num_threads = 1
+        self.cfg = cfg
+        self.sess = ort.InferenceSession(cfg.path, opts, providers=["CPUExecutionProvider"])
+        meta = self.sess.get_modelmeta().custom_metadata_map
+        if tuple(meta["joint_names"].split(",")) != G1_JOINT_NAMES:
+            raise ValueError("policy joint order differs from G1_JOINT_NAMES")
+        vec = lambda k: np.array([float(x) for x in meta[k].split(",")])  # noqa: E731
+        self.kp, self.kd, self.q0 = vec("joint_stiffness"), vec("joint_damping"), vec("default_joint_pos")
+        self.scale = float(meta["action_scale"])
+        self.dt = float(meta["policy_dt"])
+        self.hist = int(meta["observation_history_length"])
+        self.dims = [int(float(x)) for x in meta["observation_dims"].split(",")]
+        self.names = meta["observation_names"].split(",")
+        self.buf: dict[str, list[np.ndarray]] = {}
+        self.action = np.zeros(29)
+        self.next_t = 0.0
+        self.target = self.q0.copy()
+
+    def gains(self) -> tuple[np.ndarray, np.ndarray]:
+        """PD gains the policy was trained with (kp [N*m/rad], kd [N*m*s/rad]), shape [29] each."""
+        return self.kp, self.kd
+
+    def targets(self, t: float, quat: np.ndarray, gyro: np.ndarray, q: np.ndarray, dq: np.ndarray) -> np.ndarray:
+        """Return joint position targets [rad], shape [29] (a new action every ``policy_dt``)."""
+        if t + 1e-9 < self.next_t:
+            return self.target
+        self.next_t += self.dt
+        w, x, y, z = quat
+        # projected gravity: R^T (0, 0, -1) for the body rotation R of quaternion (w, x, y, z)
+        grav = -np.array([2 * (x * z - w * y), 2 * (y * z + w * x), 1 - 2 * (x * x + y * y)])
+        cmd = np.array([self.cfg.speed if t >= self.cfg.stand_time else 0.0, 0.0, 0.0])
+        terms = {
+            "base_ang_vel": gyro,
+            "projected_gravity": grav,
+            "command": cmd,
+            "joint_pos": q - self.q0,
+            "joint_vel": dq,
+            "actions": self.action,
+        }
+        parts = []
+        for name, dim in zip(self.names, self.dims, strict=True):
+            frames = self.buf.setdefault(name, [])
+            frames.append(np.asarray(terms[name], float).reshape(dim))
+            if len(frames) == 1:  # mjlab back-fills a fresh history with its first frame
+                frames[:] = [frames[0]] * self.hist
+            del frames[: len(frames) - self.hist]
+            parts.append(np.concatenate(frames))
+        obs = np.concatenate(parts).astype(np.float32)[None]
+        out = self.sess.run(None, {self.sess.get_inputs()[0].name: obs})[0]
+        self.action = np.asarray(out, float).reshape(-1)
+        self.target = self.q0 + self.scale * self.action
+        return self.target
