@@ -45,3 +45,24 @@ def test_standing_leaves_swing_effects_untested(null_rec: object) -> None:
     assert "actuator.torque_speed" in untested
     assert "limit" in untested["actuator.torque_speed"]["needs"]
     assert np.isfinite(rep["recording"]["n_eff"])
+
+
+def test_param_cov_sandwich_widens_for_block_correlated_misfit() -> None:
+    """Residuals that share a sign within each time block (a misfit) widen the interval beyond Gauss-Newton."""
+    from gmloco.deploy.mismatch.attribution import _param_cov
+
+    rng = np.random.default_rng(0)
+    blocks = np.repeat(np.arange(8), 10)  # 8 blocks of 10 segments, 5 residuals each
+    J = rng.normal(size=(80 * 5, 1)) + 1.0
+    white = rng.normal(size=80 * 5)
+    # white residual: the sandwich agrees with Gauss-Newton (s2 (J^T J)^-1) up to sampling error, so the larger is
+    # within a factor ~2 of it, and the quantile is Student's t with G - 1 = 7 dof (2.365)
+    cov_w, q = _param_cov(J, white, blocks, float(white @ white) / 399)
+    gn = float(white @ white) / 399 / float(J[:, 0] @ J[:, 0])
+    np.testing.assert_allclose(q, 2.3646, atol=1e-3)
+    assert gn <= cov_w[0, 0] <= 4.0 * gn
+    # block-constant residual (+-1 per block, same direction as J): the cluster sum carries it in full
+    shared = np.repeat(rng.choice([-1.0, 1.0], 8), 50) * J[:, 0]
+    cov_s, _ = _param_cov(J, shared, blocks, float(shared @ shared) / 399)
+    gn_s = float(shared @ shared) / 399 / float(J[:, 0] @ J[:, 0])
+    assert cov_s[0, 0] > 10.0 * gn_s

@@ -52,15 +52,17 @@ def episode_list(seeds: int = 1, nulls: int = 20, strengths: tuple[str, ...] = (
 
 SAND_MID: dict[str, dict[str, list[float]]] = {
     **{k: v for k, v in MID.items() if not k.startswith("terrain.") and k != "actuator.torque_speed"},
-    "actuator.torque_speed": {"droop": [0.1]},
+    "actuator.torque_speed": {"droop": [0.18]},
     "terrain.stiffness_scale": {"zeta": [0.5]},
     "terrain.depth_hardening": {"kappa": [60.0]},
-    "terrain.rate_drag": {"rho_drag": [1.5e4]},
+    "terrain.rate_drag": {"rho_drag": [1.0e5]},
     "terrain.cohesion": {"cohesion": [3000.0]},
 }
 """Mid strengths on the sand suite (walking policy on 3D-RFT dry sand): all 14 library effects. Fixed before
-the suite's test episodes were run; the terrain and saturation values were chosen from the physics (sinkage
-8 mm, knee speeds 3-8 rad/s at 1 m/s), not tuned on test seeds."""
+the suite's test episodes were run. The terrain and saturation values were set on tuning seed 204 from the
+oracle held-out gain of the true model (never the tool's answer): zeta 0.5 -> 0.78, kappa 60 1/m -> 0.89,
+cohesion 3 kPa -> 0.47, rho_drag 1.5e4 -> 0.08 (too weak) then 1e5 -> 0.62, droop 0.1 and 0.15 s/rad -> 0.00
+(the envelope never binds) then 0.18 -> 0.99 (binds at push-off in ~7 % of samples)."""
 
 SAND_OOL: dict[str, dict[str, list[float]]] = {
     "ool.shank_length": {"dl": [0.03]},
