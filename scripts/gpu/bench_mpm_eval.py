@@ -14,16 +14,23 @@ after each case (rerun with the same ``--out`` to resume: measured cases are kep
 again; each call first warms up, i.e. loads or compiles the kernels, apart from the timed cases).
 
 Convergence check (``convergence`` in the JSON): for each voxel size, the multi-robot case's mean sinkage of the
-feet over the last half of the run, the pelvis height and the mean forward velocity (over robots), plus a PD-only
-standing robot's sinkage on 30 cm of sand after ``--stand-frames`` frames; the relative change of each against
-the finest voxel measured. A voxel is accepted when sinkage and pelvis height are within ``--tol`` (relative) of
-the finest, or within a quarter of its particle spacing, and the forward velocity within ``--tol`` m/s; never when
-a foot reached 80 % of the bed depth (the rigid floor then sets the sinkage at every resolution).
+feet over the last half of the run, the pelvis height and the mean forward velocity (over robots), plus a standing
+robot's sinkage on 30 cm of sand after ``--stand-frames`` frames; the relative change of each against the finest
+voxel measured. The standing robot holds the default pose with PD gains ``--stand-gain`` x the policy's: with the
+policy's own gains the PD-only G1 folds at the knees and ankles and tips over even on rigid ground
+(``results/mpm_eval/G1_SINKAGE.md``), so its sinkage would measure posture, not sand. A voxel is accepted when
+sinkage and pelvis height are within ``--tol`` (relative) of the finest, or within a quarter of its particle
+spacing, and the forward velocity within ``--tol`` m/s; never when a foot reached 80 % of the bed depth (the rigid
+floor, which the soles stand on through MuJoCo contacts, then sets the sinkage at every resolution).
+
+Per case, ``soles_on_floor`` / ``soles_below_floor`` count the robots whose lowest sole corner reached the rigid
+floor (the floor carried that foot for a while: the bed was too shallow) / went more than 1 cm below it (must be 0).
 """
 
 from __future__ import annotations
 
 import argparse
+import dataclasses
 import json
 import os
 import time
@@ -47,6 +54,7 @@ def _parse() -> argparse.Namespace:
     p.add_argument("--robots", type=int, default=32, help="robots of the multi-robot cases")
     p.add_argument("--frames", type=int, default=150, help="frames timed per case (100 Hz)")
     p.add_argument("--stand-frames", type=int, default=100, help="frames of the PD-only standing check")
+    p.add_argument("--stand-gain", type=float, default=10.0, help="PD gain factor of the standing check's robot")
     p.add_argument(
         "--naive-voxels", type=float, nargs="*", default=None, help="voxels of the naive case (default: coarsest)"
     )
@@ -131,7 +139,12 @@ def _run_case(case: dict[str, Any], args: argparse.Namespace) -> dict[str, Any]:
     cfg = _scene_cfg(case, args)
     policy = load_policy(args.policy, case["robots"])
     t0 = time.perf_counter()
-    scene = G1MpmScene(cfg, policy.spec if case["mode"] == "stand" else policy)
+    driver: Any = policy
+    # the standing robot: stiff joints hold the default pose (mjlab's gains alone fold it, even on rigid ground)
+    if case["mode"] == "stand":
+        k = float(getattr(args, "stand_gain", 10.0))
+        driver = dataclasses.replace(policy.spec, kp=policy.spec.kp * k, kd=policy.spec.kd * k)
+    scene = G1MpmScene(cfg, driver)
     build_s = time.perf_counter() - t0
     t0 = time.perf_counter()
     scene.capture()
@@ -156,6 +169,10 @@ def _run_case(case: dict[str, Any], args: argparse.Namespace) -> dict[str, Any]:
         "pelvis_z_m": float(np.mean(q[half:, :, 2])), "vx_mps": float(np.mean(qd[half:, :, 0])),
         "support_ratio": float(np.mean(scene.support_ratio())),
         "fallen": int(np.sum(q[-1, :, 2] < 0.2)),
+        # a sole corner more than 1 cm below the rigid floor at any sample (the floor contact should prevent it)
+        "soles_below_floor": int(np.sum(np.asarray(scene.sinkage).max(axis=0) > cfg.terrain.depth + 0.01)),
+        # a sole that reached the floor: the floor, not the sand, carried that foot for a while
+        "soles_on_floor": int(np.sum(np.asarray(scene.sinkage).max(axis=0) > cfg.terrain.depth - 0.005)),
         # pelvis below the rigid floor (z = -depth): the robot went through bed and floor, the timing is not a walk's
         "through_floor": int(np.sum(q[-1, :, 2] < -cfg.terrain.depth)), "device": str(scene.device),
     }  # fmt: skip
@@ -251,6 +268,7 @@ def main() -> None:
             r = results[key]
             print(f"[bench] {key}: {r['particles']} particles, {r['frames_per_s']:.1f} frames/s, "
                   f"{r['episodes_per_min']:.1f} episodes/min, build {r['build_s']:.0f} s, fallen {r['fallen']}, "
+                  f"soles on / below the floor {r['soles_on_floor']} / {r['soles_below_floor']}, "
                   f"through the floor {r['through_floor']} of {r['robots']}", flush=True)  # fmt: skip
         except Exception as exc:  # one failing case must not lose the others
             results[key] = {**case, "error": repr(exc), "traceback": traceback.format_exc()[-2000:]}

@@ -207,7 +207,7 @@ def run_batch(batch: list[EpisodeSpec], cfg: G1EvalCfg, policy: Any) -> list[dic
             "command": scene.commands[r], "joint_names": scene.spec.joint_names, "kp": scene.spec.kp,
             "kd": scene.spec.kd, "start_xy": q[0, :2].copy(), "robot_mass": scene.robot_mass,
             "particles": scene.particle_count, "batch_size": n, "build_s": build_s, "sim_s": scene.wall_time,
-            "frames": scene.frame,
+            "frames": scene.frame, "depth": terrain.depth,
         })  # fmt: skip
     return logs
 
@@ -257,12 +257,16 @@ def score_episode(spec: EpisodeSpec, cfg: G1EvalCfg, log: dict[str, Any]) -> dic
         "support_ratio": float(fz[len(fz) // 2 :].mean() / (log["robot_mass"] * 9.81)),
         "max_sinkage": float(np.max(sink)) if len(sink) else float("nan"),
         "mean_sinkage": float(np.mean(sink)) if len(sink) else float("nan"),
+        # a sole reached the rigid floor under the sand (the soles stand on it): the bed was too shallow there
+        "floor_reached": bool(len(sink) and np.max(sink) >= log.get("depth", math.inf) - 0.005),
         "particles": log["particles"], "batch_size": log.get("batch_size", 1), "build_s": log["build_s"],
         "sim_s": log["sim_s"], "frames_per_s": log["frames"] / max(log["sim_s"], 1e-9),
     }  # fmt: skip
 
 
-METRIC_KEYS = ("success", "vel_error", "yaw_error", "path_error", "support_ratio", "max_sinkage", "mean_sinkage")
+METRIC_KEYS = (
+    "success", "vel_error", "yaw_error", "path_error", "support_ratio", "max_sinkage", "mean_sinkage", "floor_reached",
+)  # fmt: skip
 
 
 def summarize(rows: list[dict[str, Any]]) -> dict[str, float]:
