@@ -52,3 +52,23 @@ def test_too_short_recording_lists_untested_effects(null_rec: object) -> None:
     assert rep["verdict"] == "invalid_input"
     assert len(rep["untested"]) >= 10
     assert all(u["reason"] and u["needs"] for u in rep["untested"])
+
+
+def test_low_gain_policy_with_far_targets_passes(null_rec: object) -> None:
+    """Targets far from the measured positions (a low-gain RL policy) pass when tau_est follows the PD law.
+
+    The commands are the measured positions plus a large, joint-mixing offset pattern (which the distance and
+    correlation heuristics alone read as a swap); tau_est = kp (q* - q) - kd dq ties each command to its column.
+    """
+    rec = null_rec
+    rng = np.random.default_rng(0)
+    wobble = 0.6 * np.sin(np.outer(rec.t, rng.uniform(1.0, 3.0, 29)) + rng.uniform(0, 6, 29))
+    q_cmd = rec.q + wobble[:, rng.permutation(29)]
+    tau = rec.kp * (q_cmd - rec.q) - rec.kd * rec.dq
+    far = dataclasses.replace(rec, q_cmd=q_cmd, tau_est=tau)
+    assert not [i for i in check_recording(far) if i.check == "joint_map"]
+    # the same commands with the state columns of the knees swapped are still caught
+    perm = np.arange(29)
+    perm[[3, 9]] = perm[[9, 3]]
+    with pytest.raises(JointMapError):
+        check_recording(dataclasses.replace(far, q=rec.q[:, perm], dq=rec.dq[:, perm]))

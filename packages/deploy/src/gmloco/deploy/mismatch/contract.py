@@ -89,10 +89,10 @@ def _joint_map(rec: Recording, cfg: ContractCfg) -> list[ContractIssue]:
             out_of_range.append((n, round(frac, 3)))
     dist = np.median(np.abs(rec.q_cmd[:, :, None] - rec.q[:, None, :]), axis=0)  # [cmd joint, state joint]
     corr = _xcorr(rec.q_cmd, rec.q)
-    pd_ok = _pd_consistent(rec)
+    pd_ok, pd_swap, pd_best = _pd_pairing(rec)
     swaps = []
     for j, n in enumerate(rec.joint_names):
-        if pd_ok[j]:
+        if pd_ok[j] and not pd_swap[j]:
             # The motor law ties this column's command, state and tau_est together: the pairing is right even
             # when a low-gain policy's targets sit far from the measured positions (the distance/correlation
             # heuristics below would then misfire).
@@ -107,8 +107,8 @@ def _joint_map(rec: Recording, cfg: ContractCfg) -> list[ContractIssue]:
         else:
             by_dist = by_dist and dist[j, j] > 3 * cfg.map_min_error
         by_corr = c != j and corr[j, c] > 0.8 and not corr[j, j] > 0.5
-        if by_dist or by_corr:
-            m = k if by_dist else c
+        if pd_swap[j] or by_dist or by_corr:
+            m = int(pd_best[j]) if pd_swap[j] else k if by_dist else c
             swaps.append(
                 {
                     "command": n,
@@ -131,18 +131,28 @@ def _joint_map(rec: Recording, cfg: ContractCfg) -> list[ContractIssue]:
     return issues
 
 
-def _pd_consistent(rec: Recording, min_corr: float = 0.9) -> np.ndarray:
-    """Per joint, whether ``tau_est`` follows the labelled PD law ``kp (q* - q) + kd (dq* - dq) + tau_ff``, shape [29].
+def _pd_pairing(rec: Recording, min_corr: float = 0.9) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Pair each command column with a state column through the motor law ``tau_est = kp (q* - q) + kd (dq* - dq)``.
 
-    A correlation above ``min_corr`` between the two (over the recording) means the command and state columns of
-    the joint belong together. False where ``tau_est`` is not logged or does not vary.
+    For command joint j and state column k, ``err[j, k]`` is the median |tau_est_j - kp_j (q*_j - q_k) -
+    kd_j (dq*_j - dq_k) - tau_ff_j|. Returns two [29] boolean arrays: ``ok`` (the labelled column is the best
+    pairing, within 10 %, and the labelled PD torque correlates with tau_est above ``min_corr``) and ``swap``
+    (another column explains tau_est with less than half the labelled error), and the best column per joint.
+    ``ok`` and ``swap`` are False where tau_est is not logged or does not vary.
     """
-    pd = rec.kp * (rec.q_cmd - rec.q) + rec.kd * (rec.dq_cmd - rec.dq) + rec.tau_ff
-    a, b = pd - pd.mean(0), rec.tau_est - rec.tau_est.mean(0)
-    sa, sb = a.std(0), b.std(0)
-    with np.errstate(invalid="ignore", divide="ignore"):
-        c = (a * b).mean(0) / (sa * sb)
-    return np.nan_to_num(c, nan=0.0) * (sb > 1e-3) > min_corr
+    ok, swap, bests = np.zeros(29, bool), np.zeros(29, bool), np.arange(29)
+    if np.allclose(rec.tau_est, 0.0):
+        return ok, swap, bests
+    base = rec.kp * rec.q_cmd + rec.kd * rec.dq_cmd + rec.tau_ff  # [N, 29]
+    for j in range(29):
+        pd = base[:, j : j + 1] - rec.kp[:, j : j + 1] * rec.q - rec.kd[:, j : j + 1] * rec.dq  # [N, 29 cols]
+        err = np.median(np.abs(rec.tau_est[:, j : j + 1] - pd), axis=0)
+        a, b = pd[:, j] - pd[:, j].mean(), rec.tau_est[:, j] - rec.tau_est[:, j].mean()
+        corr = float(a @ b / max(np.sqrt((a @ a) * (b @ b)), 1e-300)) if b.std() > 1e-3 else 0.0
+        best = bests[j] = int(np.argmin(err))
+        ok[j] = err[j] <= 1.1 * err[best] and corr > min_corr
+        swap[j] = best != j and err[best] < 0.5 * err[j] and b.std() > 1e-3
+    return ok, swap, bests
 
 
 def _xcorr(a: np.ndarray, b: np.ndarray) -> np.ndarray:

@@ -173,6 +173,12 @@ def main(argv: list[str] | None = None) -> None:
     )
     p.add_argument("--only", default=None, help="comma-separated episode-name prefixes")
     p.add_argument("--score-only", action="store_true", help="score the rows already under OUT/rows and exit")
+    p.add_argument(
+        "--pool",
+        type=Path,
+        default=None,
+        help="with --score-only: also score OUT/rows pooled with POOL/rows (another suite) into OUT/summary_pooled.json",
+    )
     p.add_argument("--resume", action="store_true", help="skip episodes whose row already exists under OUT/rows")
     p.add_argument("--effects", default=None, help="comma-separated effect ids the tool screens (default: all)")
     argv = list(sys.argv[1:] if argv is None else argv)
@@ -182,6 +188,10 @@ def main(argv: list[str] | None = None) -> None:
         (a.out / "summary.json").write_text(
             json.dumps({**score(rows), "episodes_scored": len(rows)}, indent=2, default=float)
         )
+        if a.pool is not None:
+            rows += [json.loads(f.read_text()) for f in sorted((a.pool / "rows").glob("*.json"))]
+            pooled = {**score(rows), "episodes_scored": len(rows), "pooled_with": str(a.pool)}
+            (a.out / "summary_pooled.json").write_text(json.dumps(pooled, indent=2, default=float))
         return
     if a.suite == "sand":
         eps = sand_episode_list(a.seeds, a.nulls)
