@@ -168,6 +168,7 @@ def test_soles_stand_on_the_floor_under_a_shallow_bed() -> None:
         pytest.skip(f"no exported policy at {POLICY}")
     depth = 0.05
     scene = _stiff_standing(depth=depth, frames=40, drop_height=0.3)
+    scene.test_final()
     sink = np.asarray(scene.sinkage)[:, 0]
     assert sink.max() < depth + 0.012, f"a sole passed the floor: {sink.max():.3f} m below the surface"
     assert abs(sink[-1] - depth) < 0.005, f"the soles should rest on the floor: {sink[-1]:.3f} m"

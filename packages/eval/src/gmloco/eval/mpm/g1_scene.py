@@ -475,7 +475,8 @@ class G1MpmScene:
         q = np.asarray(self.base_q[-1])
         assert np.all(np.isfinite(q)), "robot state is not finite"
         assert np.all(q[:, 2] > 0.3), f"a pelvis fell (z = {q[:, 2]})"
-        assert np.all(self.sinkage[-1] < self.cfg.terrain.depth), "a foot went through the bed"
+        # a sole resting on the rigid floor sits up to a few mm into it (MuJoCo's soft contact)
+        assert np.all(self.sinkage[-1] < self.cfg.terrain.depth + 0.01), "a foot went through the floor"
         z = self.sand_state.particle_q.numpy()[:, 2]
         assert np.all(np.isfinite(z)) and np.all(z > -self.cfg.terrain.depth - 2 * self.cfg.solver.voxel_size)
 
