@@ -29,6 +29,7 @@ def _parse(argv: list[str] | None) -> argparse.Namespace:
     p.add_argument("--num-episodes", type=int, default=100)
     p.add_argument("--episode-s", type=float, default=10.0)
     p.add_argument("--voxel", type=float, default=0.05)
+    p.add_argument("--iters", type=int, default=G1EvalCfg().solver.max_iterations, help="rheology iterations")
     p.add_argument("--bed-depth", type=float, default=G1EvalCfg.bed_depth, help="sand depth of flat / rough beds [m]")
     p.add_argument("--robots-per-batch", type=int, default=25)
     p.add_argument("--static-bed", action="store_true", help="naive baseline: a bed covering the course")
@@ -57,7 +58,7 @@ def main(argv: list[str] | None = None) -> None:
         episode_s=a.episode_s,
         window=SandWindowCfg(moving=not a.static_bed, length=a.window_length, width=a.window_width),
         robots_per_batch=a.robots_per_batch,
-        solver=replace(base.solver, voxel_size=a.voxel),
+        solver=replace(base.solver, voxel_size=a.voxel, max_iterations=a.iters),
         bed_depth=a.bed_depth,
         record_mcap=not a.no_mcap,
         max_minutes=a.max_minutes,
