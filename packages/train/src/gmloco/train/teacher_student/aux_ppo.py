@@ -111,4 +111,19 @@ class AuxLossPPO(PPO):
                 torch.distributed.broadcast(lr, src=0)
                 self.learning_rate = lr.item()
         for group in self.optimizer.param_groups:
-            group["lr"] = self.learning_rate
+            if not group.get("fixed_lr", False):
+                group["lr"] = self.learning_rate
+
+    def split_fixed_lr_group(self, modules: list[nn.Module], learning_rate: float) -> None:
+        """Give ``modules``' parameters their own Adam group at a fixed ``learning_rate`` [1/step].
+
+        The KL-adaptive schedule then leaves that group alone: it drives the policy's step size, and when the policy
+        moves fast (e.g. after a warm start) it falls to 1e-5..1e-4, which would all but stop a supervised head
+        such as the teacher's terrain encoder and decoder. Gradients and clipping are unchanged.
+        """
+        fixed = {id(p) for m in modules for p in m.parameters()}
+        rest = [p for p in self.optimizer.param_groups[0]["params"] if id(p) not in fixed]
+        heads = [p for m in modules for p in m.parameters()]
+        self.optimizer = type(self.optimizer)(
+            [{"params": rest}, {"params": heads, "lr": learning_rate, "fixed_lr": True}], lr=self.learning_rate
+        )
