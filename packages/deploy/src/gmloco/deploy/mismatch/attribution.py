@@ -169,6 +169,8 @@ def _lm(pb: Problem, hyp: Hypothesis, cfg: AttributionCfg) -> tuple[np.ndarray, 
         raise ValueError(f"AttributionCfg.max_iter must be >= 1 (the fit returns a Jacobian), got {cfg.max_iter}")
     theta = hyp.theta_lin.copy()
     r = pb.resid(_sim_params(spec, theta), m).ravel()
+    if spec.size == 1:
+        theta, r = _grid_start(pb, spec, theta, r)
     lam = 1e-3
     J = np.empty((r.size, spec.size))
     for _ in range(cfg.max_iter):
@@ -225,6 +227,32 @@ def _param_cov(J: np.ndarray, r: np.ndarray, blocks: np.ndarray, s2_eff: float) 
     cov_cl = len(ub) / (len(ub) - 1) * a_inv @ (g.T @ g) @ a_inv
     scale = np.sqrt(np.maximum(np.diag(cov_cl), np.diag(cov_gn)) / np.maximum(np.diag(cov_gn), 1e-300))
     return cov_gn * np.outer(scale, scale), float(student_t.ppf(0.975, len(ub) - 1))
+
+
+def _grid_start(pb: Problem, spec: EffectSpec, theta: np.ndarray, r: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Start point of a one-parameter fit: the linearised estimate, or a better point of a coarse grid.
+
+    Used only when the linearised estimate fits the training segments worse than the nominal simulator: a
+    threshold effect (a torque envelope that binds only beyond some droop) has zero sensitivity at zero, so the
+    linearised estimate is meaningless there (``shared/reference/mismatch-discovery.md`` 3.2 step 7: a
+    derivative-free fallback for non-smooth cases). The grid is geometric, 8 points per side of zero, within the
+    bounds; the best point (zero included) starts Levenberg-Marquardt.
+    """
+    m = pb.train
+    r_nom = pb.resid({}, m).ravel()
+    if r @ r < r_nom @ r_nom:
+        return theta, r
+    lo, hi = spec.bounds()
+    tol = float(spec.flat("tolerance")[0])
+    best, best_r = np.zeros(1), r_nom
+    for bound in (float(hi[0]), float(lo[0])):
+        if abs(bound) <= tol:
+            continue
+        for v in np.geomspace(tol, abs(bound), 8) * np.sign(bound):
+            rv = pb.resid(_sim_params(spec, np.array([v])), m).ravel()
+            if rv @ rv < best_r @ best_r:
+                best, best_r = np.array([v]), rv
+    return best, best_r
 
 
 def _boot_p(

@@ -134,24 +134,27 @@ def _joint_map(rec: Recording, cfg: ContractCfg) -> list[ContractIssue]:
 def _pd_pairing(rec: Recording, min_corr: float = 0.9) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Pair each command column with a state column through the motor law ``tau_est = kp (q* - q) + kd (dq* - dq)``.
 
-    For command joint j and state column k, ``err[j, k]`` is the median |tau_est_j - kp_j (q*_j - q_k) -
-    kd_j (dq*_j - dq_k) - tau_ff_j|. Returns two [29] boolean arrays: ``ok`` (the labelled column is the best
-    pairing, within 10 %, and the labelled PD torque correlates with tau_est above ``min_corr``) and ``swap``
-    (another column explains tau_est with less than half the labelled error), and the best column per joint.
-    ``ok`` and ``swap`` are False where tau_est is not logged or does not vary.
+    For command joint j and state column k, ``err[j, k]`` is the relative misfit of tau_est_j by the PD torque
+    built from state column k, after the best gain scale: ``sqrt(1 - c^2)`` with c the uncentred correlation
+    (a gain error or a torque-constant error rescales tau_est and must not look like a swap). Returns three [29]
+    arrays: ``ok`` (the labelled column fits best, within 10 %, with c > ``min_corr``), ``swap`` (another column
+    fits with less than half the labelled misfit and c > ``min_corr``) and the best column. ``ok`` and ``swap``
+    are False where tau_est is not logged or does not vary.
     """
     ok, swap, bests = np.zeros(29, bool), np.zeros(29, bool), np.arange(29)
     if np.allclose(rec.tau_est, 0.0):
         return ok, swap, bests
     base = rec.kp * rec.q_cmd + rec.kd * rec.dq_cmd + rec.tau_ff  # [N, 29]
     for j in range(29):
+        tau = rec.tau_est[:, j]
+        if tau.std() < 1e-3:
+            continue
         pd = base[:, j : j + 1] - rec.kp[:, j : j + 1] * rec.q - rec.kd[:, j : j + 1] * rec.dq  # [N, 29 cols]
-        err = np.median(np.abs(rec.tau_est[:, j : j + 1] - pd), axis=0)
-        a, b = pd[:, j] - pd[:, j].mean(), rec.tau_est[:, j] - rec.tau_est[:, j].mean()
-        corr = float(a @ b / max(np.sqrt((a @ a) * (b @ b)), 1e-300)) if b.std() > 1e-3 else 0.0
+        c = (tau @ pd) / np.maximum(np.sqrt((tau @ tau) * np.sum(pd * pd, axis=0)), 1e-300)
+        err = np.sqrt(np.clip(1.0 - c * c, 0.0, None))
         best = bests[j] = int(np.argmin(err))
-        ok[j] = err[j] <= 1.1 * err[best] and corr > min_corr
-        swap[j] = best != j and err[best] < 0.5 * err[j] and b.std() > 1e-3
+        ok[j] = err[j] <= 1.1 * err[best] + 1e-9 and c[j] > min_corr
+        swap[j] = best != j and err[best] < 0.5 * err[j] and c[best] > min_corr
     return ok, swap, bests
 
 
