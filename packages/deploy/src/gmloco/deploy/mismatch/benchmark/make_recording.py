@@ -6,7 +6,9 @@ Usage::
     python -m gmloco.deploy.mismatch.benchmark.make_recording --effect imu.gyro_bias
         --params '{"bias": [0.03, -0.02, 0.015]}' --out real.mcap --key /elsewhere/key.json
 
-Without ``--params`` the benchmark's mid strength is used. Only the channels a G1 logs are written (LowState,
+Without ``--params`` the benchmark's mid strength is used (the sand suite's with ``--sand``). ``--sand`` makes the
+recording on the project's 3D-RFT sand with the walking policy (``artifacts/ppo_rft3d/policy.onnx``) and logs
+odometry, as the sand suite does; analyse it with ``gmloco-mismatch --ground sand``. Only the channels a G1 logs are written (LowState,
 LowCmd, IMU; no odometry unless ``--odometry``). Give the MCAP to ``gmloco-mismatch --real``; keep the key away
 from it.
 """
@@ -22,8 +24,9 @@ __all__ = ["main"]
 
 def main(argv: list[str] | None = None) -> None:
     """Generate the recording and write the MCAP and the key."""
-    from gmloco.deploy.mismatch.benchmark.episodes import MID, OOL
+    from gmloco.deploy.mismatch.benchmark.episodes import MID, OOL, SAND_MID, SAND_OOL
     from gmloco.deploy.mismatch.benchmark.generator import EpisodeCfg, generate
+    from gmloco.deploy.mismatch.benchmark.policy_motion import PolicyMotionCfg
     from gmloco.deploy.mismatch.benchmark.truth import TruthEffect
     from gmloco.deploy.mismatch.io import write_recording
 
@@ -33,14 +36,23 @@ def main(argv: list[str] | None = None) -> None:
     p.add_argument("--duration", type=float, default=9.0, help="recording length [s]")
     p.add_argument("--seed", type=int, default=100)
     p.add_argument("--odometry", action="store_true", help="also log ground-truth base odometry")
+    p.add_argument("--sand", action="store_true", help="walking policy on 3D-RFT dry sand, with odometry")
     p.add_argument("--out", type=Path, required=True, help="MCAP to write")
     p.add_argument("--key", type=Path, required=True, help="truth key JSON (keep it where the tool cannot read it)")
     a = p.parse_args(argv)
-    params = json.loads(a.params) if a.params else {**MID, **OOL}.get(a.effect, {})
+    table = {**SAND_MID, **SAND_OOL} if a.sand else {**MID, **OOL}
+    params = json.loads(a.params) if a.params else table.get(a.effect, {})
     rec, key = generate(
-        EpisodeCfg(effect=TruthEffect(a.effect, params), duration=a.duration, seed=a.seed, odometry=a.odometry)
+        EpisodeCfg(
+            effect=TruthEffect(a.effect, params),
+            duration=a.duration,
+            seed=a.seed,
+            odometry=a.odometry or a.sand,
+            ground="sand" if a.sand else "plane",
+            policy=PolicyMotionCfg() if a.sand else None,
+        )
     )
-    write_recording(rec, a.out, controller="scripted_step", overwrite=True)
+    write_recording(rec, a.out, controller="policy:ppo_rft3d" if a.sand else "scripted_step", overwrite=True)
     a.key.parent.mkdir(parents=True, exist_ok=True)
     a.key.write_text(json.dumps(key, indent=2))
     print(json.dumps({"mcap": str(a.out), "key": str(a.key), "duration_s": rec.n * rec.dt}))
