@@ -30,9 +30,16 @@ __all__ = ["main", "run"]
 def _analysis_cfg(section: DictConfig) -> Any:
     """Return the package's ``AnalysisCfg`` for the stage's section."""
     from gmloco.deploy.mismatch.pipeline import AnalysisCfg
-    from gmloco.deploy.mismatch.replay import ReplayCfg
+    from gmloco.deploy.mismatch.replay import ReplayCfg, sand_replay_cfg
 
-    cfg = AnalysisCfg(replay=ReplayCfg(horizon=int(section.horizon)), mirror_check=bool(section.mirror_check))
+    # ``ground`` ("plane" or "sand[:MATERIAL]", as gmloco-mismatch --ground) once the stage schema carries it.
+    ground, _, material = (str(section.ground) if "ground" in section else "plane").partition(":")
+    replay = (
+        sand_replay_cfg(material or "dry_sand", horizon=int(section.horizon))
+        if ground == "sand"
+        else ReplayCfg(horizon=int(section.horizon))
+    )
+    cfg = AnalysisCfg(replay=replay, mirror_check=bool(section.mirror_check))
     cfg.attribution.effects = None if section.effects is None else tuple(str(e) for e in section.effects)
     cfg.attribution.n_boot = int(section.n_boot)
     return cfg

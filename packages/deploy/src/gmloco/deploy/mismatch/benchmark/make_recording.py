@@ -52,6 +52,7 @@ def main(argv: list[str] | None = None) -> None:
             policy=PolicyMotionCfg() if a.sand else None,
         )
     )
+    a.out.parent.mkdir(parents=True, exist_ok=True)
     write_recording(rec, a.out, controller="policy:ppo_rft3d" if a.sand else "scripted_step", overwrite=True)
     a.key.parent.mkdir(parents=True, exist_ok=True)
     a.key.write_text(json.dumps(key, indent=2))
