@@ -3,6 +3,7 @@
 
 from __future__ import annotations
 
+import copy
 from collections.abc import Callable
 from pathlib import Path
 from types import SimpleNamespace
@@ -15,6 +16,7 @@ pytest.importorskip("onnxruntime")
 
 from gmloco.deploy.export import (  # noqa: E402
     EncoderDroppedError,
+    ParityError,
     PolicyMetadata,
     export_policy_onnx,
     read_policy_metadata,
@@ -32,6 +34,11 @@ def test_export_matches_torch_including_the_history_input(
     path = export_policy_onnx(model, tmp_path / "student.onnx", make_metadata())
     wrapper = model.as_onnx(verbose=False)
     assert verify_parity(wrapper, path, atol=1e-5) <= 1e-5
+    drifted = copy.deepcopy(wrapper)
+    with torch.no_grad():
+        next(drifted.parameters()).add_(1e-2)  # a torch model that no longer matches the export
+    with pytest.raises(ParityError, match="max abs difference"):
+        verify_parity(drifted, path, atol=1e-5)
     session = ort.InferenceSession(str(path), providers=["CPUExecutionProvider"])
     assert [i.name for i in session.get_inputs()] == ["obs", "history"]
     assert [o.name for o in session.get_outputs()] == ["actions", "latent", "eta"]

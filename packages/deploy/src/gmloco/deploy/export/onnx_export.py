@@ -127,8 +127,13 @@ def export_policy_onnx(
 def verify_parity(wrapper: torch.nn.Module, path: str | Path, atol: float = 1e-5, batch: int = 8) -> float:
     """Run torch and onnxruntime on the same random ``obs``/``history``; return the max abs difference.
 
+    The tolerance scales with the outputs: ``atol * max(1, max |output|)``. Standard-normal probe inputs reach a
+    trained policy's normalizer un-normalised (some of its std are ~1e-2), so its outputs run to tens and float32
+    rounding with them (a GPU-trained student: 1.7e-5 absolute on outputs of that size). The rollout check on real
+    observations (``rollout_parity_check``) keeps an absolute tolerance.
+
     Raises:
-        ParityError: If any output differs by more than ``atol``.
+        ParityError: If any output differs by more than ``atol * max(1, max |output|)``.
     """
     import numpy as np
     import onnxruntime as ort
@@ -144,6 +149,9 @@ def verify_parity(wrapper: torch.nn.Module, path: str | Path, atol: float = 1e-5
     session = ort.InferenceSession(str(path), providers=["CPUExecutionProvider"])
     got = session.run(None, {"obs": obs.numpy(), "history": history.numpy()})
     err = max(float(np.max(np.abs(g - r.numpy()))) for g, r in zip(got, ref, strict=True))
-    if err > atol:
-        raise ParityError(f"onnxruntime vs torch max abs difference {err:.3g} > {atol:.1g} ({path}).")
+    scale = max(1.0, *(float(r.abs().max()) for r in ref))
+    if err > atol * scale:
+        raise ParityError(
+            f"onnxruntime vs torch max abs difference {err:.3g} > {atol:.1g} x max(1, max |output| = {scale:.3g}) ({path})."
+        )
     return err
