@@ -82,6 +82,13 @@ def _parse(argv: list[str] | None) -> argparse.Namespace:
         action="store_true",
         help="bring back the optimizer state too (default: a slim checkpoint.pt, ~1/3 of the size, for artifacts/)",
     )
+    p.add_argument(
+        "--post-only",
+        type=Path,
+        default=None,
+        help="no training: run step 3 (checks, student export) on this checkpoint, e.g. on a CPU when a chunk ended "
+        "before them; --runs-root/<run> holds the chunk's metrics.json and TensorBoard events",
+    )
     p.add_argument("--check-envs", type=int, default=64, help="envs of the post-training rollout")
     p.add_argument("--check-steps", type=int, default=250, help="steps of the post-training rollout (5 s)")
     p.add_argument("--check-warmup", type=int, default=50, help="steps after a reset left out of the eta metrics")
@@ -248,6 +255,36 @@ def _post_checks(args: argparse.Namespace, task: Any, checkpoint: Path, run_dir:
     return checks
 
 
+def _post_only(args: argparse.Namespace, run: str, run_dir: Path, t0: float) -> dict[str, Any]:
+    """Step 3 alone on ``--post-only``; the summary marks it, and takes metrics and curve from ``run_dir``."""
+    ckpt = args.post_only
+    _copy_checkpoint(ckpt, args.out / "checkpoint.pt", slim=not args.full_checkpoint)
+    task = _task(args)
+    checks = _post_checks(args, task, ckpt, run_dir)
+    metrics_file, cfg_file = run_dir / "metrics.json", run_dir / "train_cfg.json"
+    summary: dict[str, Any] = {
+        "script": "scripts/gpu/train_ts_chunk.py",
+        "run": run,
+        "stage": args.stage,
+        "post_only": str(ckpt),
+        "args": {k: str(v) for k, v in vars(args).items()},
+        "checkpoint": ckpt.name,
+        "metrics": json.loads(metrics_file.read_text()) if metrics_file.exists() else {},
+        "checks": checks,
+        "train_cfg": json.loads(cfg_file.read_text()) if cfg_file.exists() else {},
+        "curve": (curve := _curve(run_dir)),
+        "last_values": _last_values(curve),
+        "wall_s": time.monotonic() - t0,
+        "device": args.device,
+    }
+    from gmloco.train.evaluation_ts import finite_json
+
+    clean = finite_json({k: v for k, v in summary.items() if k != "curve"}) | {"curve": summary["curve"]}
+    (args.out / "summary.json").write_text(json.dumps(clean, indent=1, default=str))
+    print(json.dumps(finite_json({"checks": checks}), indent=1, default=str))
+    return summary
+
+
 def main(argv: list[str] | None = None) -> dict[str, Any]:
     """Run one chunk and write the files that come back; return the summary."""
     args = _parse(argv)
@@ -258,6 +295,8 @@ def main(argv: list[str] | None = None) -> dict[str, Any]:
     run_dir = args.runs_root / run
     run_dir.mkdir(parents=True, exist_ok=True)
     args.out.mkdir(parents=True, exist_ok=True)
+    if args.post_only is not None:
+        return _post_only(args, run, run_dir, t0)
     seeded = _seed_run_dir(run_dir, args.artifacts / run)
     init = None
     if args.stage == "student" and _newest(run_dir) is None:
