@@ -2,8 +2,8 @@
 
 Runs every task in one process so the numbers compare (same device, same driver, same warm-up):
 
-    python scripts/gpu/bench_tasks.py --tasks Mjlab-Velocity-Flat-Unitree-G1 [TASK ...] \
-        --num-envs 4096 --iterations 40 --out $OUT/bench.json
+    python scripts/gpu/bench_tasks.py --tasks Mjlab-Velocity-Flat-Unitree-G1 Gmloco-Velocity-Granular-G1 \
+        --import gmloco.train.tasks.registry --num-envs 4096 --iterations 40 --out $OUT/bench.json
 
 For each task it reports
 * ``sim_physics_steps_per_s``: ``env.sim.step()`` (one physics substep for every world, CUDA graph) timed
@@ -11,7 +11,8 @@ For each task it reports
 * ``ppo_env_steps_per_s``, ``ppo_s_per_iteration``, ``ppo_collection_s``, ``ppo_learning_s``: medians over
   the PPO iterations after the first ``--warmup`` ones, read from rsl-rl's own timers.
 
-Project tasks register themselves when their package is imported (``--import gmloco.train``).
+Project tasks register themselves when their registry is imported (``--import gmloco.train.tasks.registry``);
+unknown task ids stop the script before the first env build.
 """
 
 from __future__ import annotations
@@ -127,6 +128,11 @@ def main() -> None:
 
     for mod in args.imports:
         importlib.import_module(mod)
+    from mjlab.tasks.registry import list_tasks
+
+    missing = [t for t in args.tasks if t not in list_tasks()]
+    if missing:  # fail before the first (90 s) env build, not after it
+        sys.exit(f"tasks not registered: {missing}; project tasks need --import gmloco.train.tasks.registry")
     results: dict[str, object] = {
         "device": torch.cuda.get_device_name(0) if torch.cuda.is_available() else "cpu",
         "num_envs": args.num_envs,
