@@ -16,7 +16,10 @@ def _resample(t_src: np.ndarray, x: np.ndarray, t: np.ndarray, hold: bool) -> np
     """Resample columns of ``x`` [M, ...] from ``t_src`` onto ``t`` (linear, or zero-order hold)."""
     flat = x.reshape(len(x), -1)
     if hold:
-        idx = np.clip(np.searchsorted(t_src, t, side="right") - 1, 0, len(t_src) - 1)
+        # A message stamped at a grid time belongs to that sample: the grid (ts[0] + k / rate, float) and the
+        # nanosecond stamps differ by round-off, and without the 1 us tolerance a held command lands one sample
+        # late (a spurious 2 ms command delay at 500 Hz).
+        idx = np.clip(np.searchsorted(t_src, t + 1e-6, side="right") - 1, 0, len(t_src) - 1)
         out = flat[idx]
     else:
         out = np.stack([np.interp(t, t_src, flat[:, i]) for i in range(flat.shape[1])], axis=1)
