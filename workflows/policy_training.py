@@ -103,6 +103,7 @@ def teacher_cfg(section: DictConfig) -> Any:
         encoder_hidden_dims=tuple(int(d) for d in section.encoder_hidden_dims),
         latent_dim=int(section.latent_dim),
         kl_weight=float(section.kl_weight),
+        vae_learning_rate=None if section.vae_learning_rate is None else float(section.vae_learning_rate),
         ppo=ppo_cfg(section),
     )
 
@@ -123,7 +124,11 @@ def distill_overrides(cfg: DictConfig) -> dict[str, Any]:
         history_length=int(teacher_section.history_length),
         tcn_channels=tuple(int(c) for c in section.tcn_channels),  # type: ignore[arg-type]
     )
-    distill = DistillCfg(curriculum_finish=int(section.curriculum_finish), ppo=ppo_cfg(section))
+    distill = DistillCfg(
+        curriculum_finish=int(section.curriculum_finish),
+        decoder_loss_weight=float(section.decoder_loss_weight),
+        ppo=ppo_cfg(section),
+    )
     entries = distill.to_rsl_rl(teacher, student, ObsGroupsCfg())
     for key in ("class_name", "teacher_checkpoint"):
         entries.pop(key)

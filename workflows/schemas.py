@@ -215,8 +215,13 @@ class TrainTeacherCfg(PolicyTrainingCfg):
     """Actor and critic MLP widths (GM-Loco: 512, 256, 128)."""
     latent_dim: int = 16
     """Terrain latent size z of the VAE teacher (ours; the paper does not give it)."""
-    kl_weight: float = 1.0e-3
-    """beta, weight of the teacher's KL term (ours)."""
+    kl_weight: float = 1.0e-4
+    """beta, weight of the teacher's KL term (ours; see ``TeacherCfg.kl_weight``)."""
+    vae_learning_rate: float | None = 1.0e-3
+    """Fixed Adam learning rate of the teacher's encoder and decoder (null: the policy's adaptive rate)."""
+    warm_start_ppo: str | None = None
+    """vae_teacher: a vanilla-PPO checkpoint of the same task (e.g. ``artifacts/ppo_rft3d/checkpoint.pt``) whose
+    actor and critic start a fresh teacher run; null: from scratch."""
     encoder_hidden_dims: list[int] = field(default_factory=lambda: [256, 128, 64])
     """Teacher terrain encoder widths (paper)."""
     history_length: int = 50
@@ -235,6 +240,8 @@ class DistillCfg(PolicyTrainingCfg):
     """Iteration at which w_PPO and w_dist reach their end values (ours)."""
     tcn_channels: list[int] = field(default_factory=lambda: [32, 32, 32])
     """Output channels of the student's three 1-D convolutions (ours)."""
+    decoder_loss_weight: float = 1.0
+    """Weight of (psi(z) - psi(z_hat))^2 (paper: 1)."""
     ppo: PpoSettingsCfg = field(
         default_factory=lambda: PpoSettingsCfg(learning_rate=5.0e-4, schedule=PpoSchedule.fixed, entropy_coef=0.001)
     )

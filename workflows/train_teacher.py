@@ -42,6 +42,8 @@ def run(cfg: DictConfig) -> dict[str, float | None]:
         overrides = teacher_cfg(section).to_rsl_rl(ObsGroupsCfg())
         # The teacher is not deployed (the exported policy is the student), so no ONNX export here.
         run_cfg |= {"rsl_rl_overrides": overrides, "history_length": int(section.history_length), "export_onnx": False}
+        if section.warm_start_ppo is not None:
+            run_cfg["warm_start_ppo"] = str(section.warm_start_ppo)
     return run_training(cfg, "train_teacher", **run_cfg)
 
 
