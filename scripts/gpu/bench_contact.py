@@ -22,6 +22,17 @@ paths share update_state (one launch, no force pass); compute_and_update_state i
 max |W_unfused| after one compute on the benchmark state (float32 round-off expected, ~1e-6). ``rft3d_viscous``
 is 3D-RFT with ``static_friction=False`` (the cost of the stick anchors).
 
+Kernel variants (``--variants``, default ``default``; ``all`` = every one): the fused 3D-RFT kernels compiled with
+other register caps or the pre-``RFT3DModel`` argument layout (``gmloco.contact.kernels_rft3d.FUSED_VARIANTS``,
+``"legacy"``: compute() only), selected through ``model.fused_variant``. Each 3D-RFT fused record carries
+``variant``; every other variant gets its own record ``<key>/<variant>`` right after the default one (same process,
+same state): compute_s, step_s (not for ``legacy``: its step is the default kernel) and
+``max_rel_diff_vs_default``, the max relative difference of the wrench, the per-point outputs and every state array
+to the default kernels after compute() and then compute_and_update_state() from the benchmark state (0 expected).
+A variant comparison on the GPU, e.g. (about 3 min, mostly NVRTC compiles)::
+
+    python3 scripts/gpu/bench_contact.py --models rft3d --paths fused --variants all --skip-sim --out $OUT/variants
+
 Time box and resume: the JSON (``<out>/bench_contact.json``) is rewritten atomically after every record; a rerun
 with the same ``--out`` skips the records already there (``--force`` redoes them). The run stops starting new
 records after ``--max-minutes`` and exits with 3 (``"complete": false``); rerun the same command to continue.
@@ -44,6 +55,15 @@ MODELS = ("rft3d", "rft3d_viscous", "heuristic_rft", "cone_multi", "cone_single"
 """Benchmarked model variants (``rft3d_viscous``: 3D-RFT without static friction)."""
 PATHS = ("fused", "unfused")
 """Kernel paths of compute(): ``model.fused`` True / False."""
+VARIANT_MODELS = ("rft3d", "rft3d_viscous")
+"""Models whose fused path has kernel variants (``model.fused_variant``)."""
+
+
+def all_variants() -> tuple[str, ...]:
+    """Return every fused 3D-RFT kernel variant name, ``"default"`` first."""
+    from gmloco.contact.kernels_rft3d import FUSED_VARIANTS, LEGACY_VARIANT
+
+    return (*FUSED_VARIANTS, LEGACY_VARIANT)
 
 
 def _parse(argv: list[str] | None = None) -> argparse.Namespace:
@@ -54,6 +74,7 @@ def _parse(argv: list[str] | None = None) -> argparse.Namespace:
     p.add_argument("--skip-sim", action="store_true", help="do not build the G1 env for the step reference")
     p.add_argument("--paths", default=",".join(PATHS), help="comma list of compute() paths: fused, unfused")
     p.add_argument("--models", default=",".join(MODELS), help="comma list of model variants")
+    p.add_argument("--variants", default="default", help="comma list of fused 3D-RFT kernel variants, or all")
     p.add_argument("--out", type=Path, default=Path("bench_contact"), help="output folder (bench_contact.json)")
     p.add_argument("--max-minutes", type=float, default=9.0, help="start no new record after this [min]")
     p.add_argument("--force", action="store_true", help="redo records already in the JSON")
@@ -137,13 +158,17 @@ def _model_cfgs(faces: Literal["sole", "box"]) -> dict[str, Any]:
     }
 
 
-def _prepared_model(cfg: Any, num_worlds: int, device: str, fused: bool) -> tuple[Any, tuple[Any, ...]]:
+def _prepared_model(
+    cfg: Any, num_worlds: int, device: str, fused: bool, variant: str = "default"
+) -> tuple[Any, tuple[Any, ...]]:
     """Return a model on dry sand with its state at the benchmark pose (same branch mix as the timed loop)."""
     from gmloco.contact import MATERIAL_PRESETS, make_contact_model
 
     sand = MATERIAL_PRESETS["dry_sand"]
     model = make_contact_model(cfg, num_worlds, 2, device)
     model.fused = fused
+    if variant != "default":
+        model.fused_variant = variant  # pyright: ignore[reportAttributeAccessIssue] (3D-RFT models only)
     w = np.ones(num_worlds)
     model.set_materials(w * sand.rho_c, w * sand.mu_int, w * sand.mu_surf)
     state = _foot_state(num_worlds, device)
@@ -165,8 +190,13 @@ FACES: tuple[tuple[Literal["sole", "box"], int], ...] = (("sole", 25), ("box", 1
 """Collider faces and the points per foot they give at resolution 5."""
 
 
-def record_keys(models: list[str], paths: list[str]) -> list[tuple[str, str, Literal["sole", "box"], str]]:
-    """Return (key, model, faces, path) of every record, in run order."""
+def record_keys(
+    models: list[str], paths: list[str], variants: tuple[str, ...] = ("default",)
+) -> list[tuple[str, str, Literal["sole", "box"], str, str]]:
+    """Return (key, model, faces, path, variant) of every record, in run order.
+
+    Non-default ``variants`` add fused 3D-RFT records ``<key>/<variant>`` right after the default fused record.
+    """
     keys = []
     for faces, points in FACES:
         for name in models:
@@ -174,7 +204,9 @@ def record_keys(models: list[str], paths: list[str]) -> list[tuple[str, str, Lit
                 continue  # one point per foot whatever the collider
             for path in paths:
                 key = f"{name}/{points if name != 'cone_single' else 1}pt" + ("" if path == "fused" else f"/{path}")
-                keys.append((key, name, faces, path))
+                keys.append((key, name, faces, path, "default"))
+                if path == "fused" and name in VARIANT_MODELS:
+                    keys += [(f"{key}/{v}", name, faces, path, v) for v in variants if v != "default"]
     return keys
 
 
@@ -219,6 +251,44 @@ def _step_vs_two_calls(cfg: Any, num_worlds: int, device: str, fused: bool) -> f
     return max(float(np.abs(a - b).max() / max(np.abs(b).max(), 1e-30)) for a, b in zip(*out, strict=True))
 
 
+STATE_ARRAYS = ("depth_max", "ema_tau", "vel_prev", "anchor", "force_prev")
+POINT_ARRAYS = ("point_force", "point_depth", "point_vel")
+
+
+def _variant_vs_default(cfg: Any, num_worlds: int, device: str, variant: str) -> float:
+    """Max relative difference of a variant to the default fused kernels (0 expected).
+
+    From the benchmark state, compute() then compute_and_update_state() on both; compared after each: the wrench
+    and the per-point outputs, and after the step also every state array.
+    """
+    outs: list[list[np.ndarray]] = []
+    for v in ("default", variant):
+        model, state = _prepared_model(cfg, num_worlds, device, True, v)
+        arrays = []
+        model.compute(*state)
+        arrays += [state[5].numpy().copy(), *(getattr(model, n).numpy().copy() for n in POINT_ARRAYS)]
+        model.compute_and_update_state(*state)
+        arrays += [state[5].numpy().copy(), *(getattr(model, n).numpy().copy() for n in (*POINT_ARRAYS, *STATE_ARRAYS))]
+        outs.append([a.astype(np.float64) for a in arrays])
+    return max(float(np.abs(a - b).max() / max(np.abs(b).max(), 1e-30)) for b, a in zip(*outs, strict=True))
+
+
+def bench_variant_record(name: str, faces: Literal["sole", "box"], variant: str, args: argparse.Namespace) -> dict:
+    """Seconds per call of a fused 3D-RFT kernel variant's compute (and step), with its difference to the default."""
+    from gmloco.contact.kernels_rft3d import LEGACY_VARIANT
+
+    cfg = _model_cfgs(faces)[name]
+    model, state = _prepared_model(cfg, args.num_worlds, args.device, True, variant)
+    calls: dict[str, Callable[[], object]] = {"compute": lambda: model.compute(*state)}
+    if variant != LEGACY_VARIANT:  # legacy's step is the default step kernel
+        calls["step"] = lambda: model.compute_and_update_state(*state)
+    rec: dict[str, Any] = {"variant": variant}
+    rec.update({f"{k}_s": _time_graph(fn, args.reps, args.device) for k, fn in calls.items()})
+    rec["launches"] = {k: _launches(fn) for k, fn in calls.items()}
+    rec["max_rel_diff_vs_default"] = _variant_vs_default(cfg, args.num_worlds, args.device, variant)
+    return rec
+
+
 def bench_record(
     name: str, faces: Literal["sole", "box"], path: str, args: argparse.Namespace, paths: list[str]
 ) -> dict[str, Any]:
@@ -233,6 +303,8 @@ def bench_record(
         calls["update_state"] = lambda: model.update_state(*state[:5])
         calls["step"] = lambda: model.compute_and_update_state(*state)
     rec: dict[str, Any] = {f"{k}_s": _time_graph(fn, args.reps, args.device) for k, fn in calls.items()}
+    if path == "fused" and name in VARIANT_MODELS:
+        rec["variant"] = "default"
     rec["launches"] = {k: _launches(fn) for k, fn in calls.items()}
     if path == "fused" and "unfused" in paths:
         rec["wrench_max_rel_diff_vs_unfused"] = _wrench_rel_diff(cfg, args.num_worlds, args.device)
@@ -290,7 +362,8 @@ def _shares(res: dict[str, Any]) -> None:
     step = res.get("g1_substep_s")
     for rec in res["models"].values():
         if step:
-            rec["share_of_substep"] = (rec["compute_s"] + rec.get("update_state_s", 0.0)) / step
+            if "update_state_s" in rec or "max_rel_diff_vs_default" not in rec:  # variants: no update_state
+                rec["share_of_substep"] = (rec["compute_s"] + rec.get("update_state_s", 0.0)) / step
             if "step_s" in rec:
                 rec["share_of_substep_step"] = rec["step_s"] / step
 
@@ -304,9 +377,10 @@ def main(argv: list[str] | None = None) -> int:
 
     wp.init()
     paths, models = args.paths.split(","), args.models.split(",")
-    unknown = sorted({*paths} - {*PATHS}) + sorted({*models} - {*MODELS})
+    variants = all_variants() if args.variants == "all" else tuple(args.variants.split(","))
+    unknown = sorted({*paths} - {*PATHS}) + sorted({*models} - {*MODELS}) + sorted({*variants} - {*all_variants()})
     if unknown:
-        print(f"unknown path / model {unknown}: paths are {PATHS}, models {MODELS}", file=sys.stderr)
+        print(f"unknown path / model / variant {unknown}: paths are {PATHS}, models {MODELS}", file=sys.stderr)
         return 2
     args.out.mkdir(parents=True, exist_ok=True)
     out_file = args.out / "bench_contact.json"
@@ -315,19 +389,22 @@ def main(argv: list[str] | None = None) -> int:
     if res and {k: res.get(k) for k in setup} != setup:
         print(f"{out_file} holds another setup {[res.get(k) for k in setup]}; use --force or another --out")
         return 2
-    res.update(setup, paths=paths, models=res.get("models", {}), complete=False)
-    todo = [r for r in record_keys(models, paths) if r[0] not in res["models"]]
+    res.update(setup, paths=paths, variants=list(variants), models=res.get("models", {}), complete=False)
+    todo = [r for r in record_keys(models, paths, variants) if r[0] not in res["models"]]
     want_sim = not args.skip_sim and "g1_substep_s" not in res
-    for key, name, faces, path in todo:
+    for key, name, faces, path, variant in todo:
         if time.perf_counter() - t_start > 60.0 * args.max_minutes:
             break
-        res["models"][key] = bench_record(name, faces, path, args, paths)
+        if variant == "default":
+            res["models"][key] = bench_record(name, faces, path, args, paths)
+        else:
+            res["models"][key] = bench_variant_record(name, faces, variant, args)
         print(key, res["models"][key], flush=True)
         _write(out_file, res)
     else:
         if want_sim and time.perf_counter() - t_start < 60.0 * args.max_minutes:
             res.update(bench_step(args.num_worlds, args.device))
-        res["complete"] = all(k in res["models"] for k, *_ in record_keys(models, paths)) and (
+        res["complete"] = all(k in res["models"] for k, *_ in record_keys(models, paths, variants)) and (
             args.skip_sim or "g1_substep_s" in res
         )
     _shares(res)

@@ -48,3 +48,25 @@ def test_bench_refuses_a_foreign_setup(tmp_path: Path) -> None:
     assert bench.main(["--num-worlds", "2", *argv]) == 0
     assert bench.main(["--num-worlds", "5", *argv]) == 2
     assert bench.main(["--num-worlds", "2", *argv, "--paths", "fast"]) == 2
+
+
+def test_bench_times_every_kernel_variant_side_by_side(tmp_path: Path) -> None:
+    """--variants all: one record per fused 3D-RFT variant after the default one, each equal to it (diff 0)."""
+    bench = bench_module()
+    argv = ["--num-worlds", "2", "--reps", "1", "--device", "cpu", "--skip-sim", "--out", str(tmp_path)]
+    assert bench.main([*argv, "--models", "rft3d,cone_multi", "--paths", "fused", "--variants", "all"]) == 0
+    res = json.loads((tmp_path / "bench_contact.json").read_text())
+    variants = bench.all_variants()
+    assert res["variants"] == list(variants) and variants[0] == "default" and "legacy" in variants
+    keys = [k for k in res["models"] if k.startswith("rft3d/150pt")]
+    assert keys == ["rft3d/150pt", *(f"rft3d/150pt/{v}" for v in variants[1:])]  # side by side, in order
+    for points in (25, 150):
+        assert res["models"][f"rft3d/{points}pt"]["variant"] == "default"
+        for v in variants[1:]:
+            rec = res["models"][f"rft3d/{points}pt/{v}"]
+            assert rec["variant"] == v and rec["compute_s"] > 0.0 and rec["max_rel_diff_vs_default"] == 0.0
+            assert ("step_s" in rec) == (v != "legacy")
+    assert res["models"]["rft3d/150pt/legacy"]["launches"]["compute"] == ["rft3d_foot_wrench_legacy_kernel"]
+    assert res["models"]["rft3d/150pt/cap80"]["launches"]["step"] == ["rft3d_foot_step_kernel_maxreg80"]
+    assert "variant" not in res["models"]["cone_multi/25pt"] and "cone_multi/25pt/cap80" not in res["models"]
+    assert bench.main([*argv, "--models", "rft3d", "--variants", "fast"]) == 2

@@ -28,13 +28,17 @@ from gmloco.contact.kernels_state import (
     crater_friction,
     elastic_depth,
     point_kernel_data,
+    rft_element_model,
 )
 
 __all__ = [
+    "FUSED_VARIANTS",
+    "LEGACY_VARIANT",
     "RFT3DCoeffs",
     "RFT3DModel",
     "eval_rft3d_foot_wrench",
     "eval_rft3d_point_forces",
+    "fused_kernel",
     "rft3d_alpha",
     "rft3d_generic",
     "rft3d_model",
@@ -316,7 +320,7 @@ def eval_rft3d_point_forces(model: Any, inputs: tuple, nan_count_out: wp.array) 
     )
 
 
-def _rft3d_foot_wrench_kernel(advance: bool, name: str) -> wp.Kernel:
+def _rft3d_foot_wrench_kernel(advance: bool, name: str, max_registers: int | None) -> wp.Kernel:
     """Return the fused 3D-RFT kernel, compiled with (advance=True) or without the state update.
 
     Two specializations of one source (``wp.static``): the compute-only kernel carries no state-update code. On
@@ -324,9 +328,10 @@ def _rft3d_foot_wrench_kernel(advance: bool, name: str) -> wp.Kernel:
     of 5 warps per SM; the state update would raise that to 108 (3 blocks per SM). Recomputing x and n for the
     update (below) and a 96-register cap keep the step kernel at 96 registers with no spill (cuobjdump
     -res-usage: the same 32-byte stack, no local memory as the compute-only kernel), so it keeps the occupancy.
+    ``max_registers``: the per-thread register cap (``None``: the compiler's choice); see :data:`FUSED_VARIANTS`.
     """
 
-    @wp.kernel(name=name, module="unique", enable_backward=False, cuda_max_registers=96 if advance else None)
+    @wp.kernel(name=name, module="unique", enable_backward=False, cuda_max_registers=max_registers)
     def rft3d_foot_wrench_kernel(
         # Model:
         coeffs: RFT3DCoeffs,
@@ -389,21 +394,173 @@ def _rft3d_foot_wrench_kernel(advance: bool, name: str) -> wp.Kernel:
     return rft3d_foot_wrench_kernel
 
 
-rft3d_foot_wrench_kernel = _rft3d_foot_wrench_kernel(False, "rft3d_foot_wrench_kernel")
+FUSED_VARIANTS: dict[str, tuple[int | None, int | None]] = {
+    "default": (None, 96),
+    "nocap": (None, None),
+    "cap96": (96, 96),
+    "cap80": (80, 80),
+    "cap64": (64, 64),
+}
+"""Register caps (compute kernel, step kernel) of the fused 3D-RFT kernel variants, by name (``None``: no cap).
+
+Same source, same results bit for bit (only register allocation differs); ``"default"`` is what compute() and
+compute_and_update_state() launch unless a model's ``fused_variant`` says otherwise (benchmarks). ``"legacy"``
+(compute() only) is the pre-``RFT3DModel`` kernel, kept to time the argument layout against the struct.
+"""
+LEGACY_VARIANT = "legacy"
+"""Variant name of :data:`rft3d_foot_wrench_legacy_kernel` (compute() only; the step falls back to the default)."""
+
+_FUSED_KERNELS: dict[tuple[bool, int | None], wp.Kernel] = {}
+
+
+def fused_kernel(variant: str, advance: bool) -> wp.Kernel:
+    """Return the fused kernel of a variant (:data:`FUSED_VARIANTS` or ``"legacy"``), built once per register cap.
+
+    Kernels with the default variant's cap keep the plain names; others are suffixed ``_maxreg<cap>`` /
+    ``_maxregnone`` (one Warp module each, compiled on first launch).
+    """
+    if variant == LEGACY_VARIANT and not advance:
+        return rft3d_foot_wrench_legacy_kernel
+    if variant != LEGACY_VARIANT and variant not in FUSED_VARIANTS:
+        raise ValueError(f"unknown fused variant {variant!r}: {[*FUSED_VARIANTS, LEGACY_VARIANT]}")
+    default_cap = FUSED_VARIANTS["default"][advance]
+    cap = default_cap if variant == LEGACY_VARIANT else FUSED_VARIANTS[variant][advance]
+    if (advance, cap) not in _FUSED_KERNELS:
+        name = "rft3d_foot_step_kernel" if advance else "rft3d_foot_wrench_kernel"
+        if cap != default_cap:
+            name += f"_maxreg{cap if cap is not None else 'none'}"
+        _FUSED_KERNELS[advance, cap] = _rft3d_foot_wrench_kernel(advance, name, cap)
+    return _FUSED_KERNELS[advance, cap]
+
+
+rft3d_foot_wrench_kernel = fused_kernel("default", False)
 """Fused compute(): element forces + per-foot wrench, state read only."""
-rft3d_foot_step_kernel = _rft3d_foot_wrench_kernel(True, "rft3d_foot_step_kernel")
+rft3d_foot_step_kernel = fused_kernel("default", True)
 """Fused compute_and_update_state(): as :data:`rft3d_foot_wrench_kernel`, then each lane advances its elements."""
+
+
+@wp.func
+def _legacy_rft3d_element_force(
+    kin: wp.mat33,
+    depth: float,
+    area: float,
+    mat: wp.vec3,
+    gravity: float,
+    coeffs: RFT3DCoeffs,
+    v_eps: float,
+    sign_fix: int,
+    rest: AtRestParams,
+    state: ElementState,
+    w: int,
+    f: int,
+    p: int,
+) -> wp.vec3:
+    """:func:`rft3d_element_force` with the model data as separate arguments (the layout before RFT3DModel)."""
+    n = kin[1]
+    v = kin[2]
+    xi = media_scaling(mat[0], mat[1], gravity)
+    depth_max = state.depth_max[w, f, p]
+    force = wp.vec3(0.0)
+    if rest.mode == AT_REST_UNLOADING and depth > 0.0 and depth < depth_max:
+        offset = wp.vec3(0.0)
+        if rest.stick_distance > 0.0:
+            offset = kin[0] - state.anchor[w, f, p]
+        tau_rev = state.ema_tau[w, f, p]
+        force = rft3d_elastic_force(n, v, offset, depth, depth_max, area, xi, mat[2], coeffs, rest, tau_rev)
+    else:
+        force = rft3d_plastic_force(n, v, depth, area, xi, mat[2], coeffs, v_eps, sign_fix)
+    return at_rest_filter(force, v, depth, rest, state, w, f, p, 0)
+
+
+@wp.kernel(module="unique", enable_backward=False)
+def rft3d_foot_wrench_legacy_kernel(
+    # Model:
+    coeffs: RFT3DCoeffs,
+    points_b: wp.array[wp.vec3],
+    normals_b: wp.array[wp.vec3],
+    areas: wp.array[float],
+    rho_c: wp.array[float],
+    mu_int: wp.array[float],
+    mu_surf: wp.array[float],
+    terrain: TerrainData,
+    gravity: float,
+    v_eps: float,
+    sign_fix: int,
+    rest: AtRestParams,
+    # Data in:
+    foot_pos_in: wp.array2d[wp.vec3],
+    foot_mat_in: wp.array2d[wp.mat33],
+    foot_lin_vel_in: wp.array2d[wp.vec3],
+    foot_ang_vel_in: wp.array2d[wp.vec3],
+    foot_com_in: wp.array2d[wp.vec3],
+    state_in: ElementState,
+    # Data out:
+    point_force_out: wp.array3d[wp.vec3],
+    point_depth_out: wp.array3d[float],
+    point_vel_out: wp.array3d[wp.vec3],
+    wrench_out: wp.array2d[wp.spatial_vector],
+    nan_count_out: wp.array[int],
+) -> None:
+    """The fused compute() kernel of commit 9af447a (separate model arguments, inline element body), for timing.
+
+    Same outputs as :data:`rft3d_foot_wrench_kernel` bit for bit (same element functions, same order).
+    """
+    w, f, lane = wp.tid()
+    pos = foot_pos_in[w, f]
+    rot = foot_mat_in[w, f]
+    lin_vel = foot_lin_vel_in[w, f]
+    ang_vel = foot_ang_vel_in[w, f]
+    com = foot_com_in[w, f]
+    finite = foot_inputs_finite(pos, rot, lin_vel, ang_vel)
+    force_sum = wp.vec3(0.0)
+    torque_sum = wp.vec3(0.0)
+    for p in range(lane, points_b.shape[0], wp.block_dim()):
+        force = wp.vec3(0.0)
+        depth = 0.0
+        v = wp.vec3(0.0)
+        if finite:
+            kin = foot_point_kinematics(pos, rot, lin_vel, ang_vel, points_b[p], normals_b[p])
+            x = kin[0]
+            v = kin[2]
+            depth = terrain_height(terrain, x[0], x[1]) - x[2]
+            if depth > 0.0 or rest.mode == AT_REST_EMA:
+                mat = point_material(terrain, rho_c, mu_int, mu_surf, w, x[0])
+                force = _legacy_rft3d_element_force(
+                    kin, depth, areas[p], mat, gravity, coeffs, v_eps, sign_fix, rest, state_in, w, f, p
+                )
+                force_sum += force
+                torque_sum += wp.cross(x - com, force)
+        else:
+            wp.atomic_add(nan_count_out, 0, 1)
+        write_element(force, depth, v, point_force_out, point_depth_out, point_vel_out, w, f, p)
+    wrench = foot_wrench_block_sum(wp.spatial_vector(force_sum, torque_sum), pos, rot, com, lane, nan_count_out)
+    if lane == 0:
+        wrench_out[w, f] = wrench
 
 
 def eval_rft3d_foot_wrench(model: Any, inputs: tuple, wrench_out: wp.array, advance: bool = False) -> None:
     """Launch the fused 3D-RFT kernel over [num_worlds, num_feet] blocks of :func:`tile_block_dim` lanes.
 
     ``advance`` False: :data:`rft3d_foot_wrench_kernel` (compute()); True: :data:`rft3d_foot_step_kernel`, which
-    also advances the element state (compute() + update_state() in one launch).
+    also advances the element state (compute() + update_state() in one launch). ``model.fused_variant`` (default
+    ``"default"``) picks the kernel variant (:func:`fused_kernel`; all give the same results bit for bit).
     """
+    variant = getattr(model, "fused_variant", "default")
+    kernel = fused_kernel(variant, advance)
+    dim = (model.num_worlds, model.num_feet)
+    if kernel is rft3d_foot_wrench_legacy_kernel:
+        wp.launch_tiled(
+            kernel,
+            dim=dim,
+            inputs=[model.coeffs, *rft_element_model(model), int(model.cfg.sign_fix), model.rest, *inputs, model.state],
+            outputs=[model.point_force, model.point_depth, model.point_vel, wrench_out, model.nan_count],
+            block_dim=tile_block_dim(model.num_points),
+            device=model.device,
+        )
+        return
     wp.launch_tiled(
-        rft3d_foot_step_kernel if advance else rft3d_foot_wrench_kernel,
-        dim=(model.num_worlds, model.num_feet),
+        kernel,
+        dim=dim,
         inputs=[model.coeffs, rft3d_model(model), *inputs],
         outputs=[model.state, model.point_force, model.point_depth, model.point_vel, wrench_out, model.nan_count],
         block_dim=tile_block_dim(model.num_points),
