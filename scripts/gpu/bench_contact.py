@@ -29,9 +29,15 @@ other register caps or the pre-``RFT3DModel`` argument layout (``gmloco.contact.
 same state): compute_s, step_s (not for ``legacy``: its step is the default kernel) and
 ``max_rel_diff_vs_default``, the max relative difference of the wrench, the per-point outputs and every state array
 to the default kernels after compute() and then compute_and_update_state() from the benchmark state (0 expected).
-A variant comparison on the GPU, e.g. (about 3 min, mostly NVRTC compiles)::
+``nocap``'s compute kernel is the default one (both uncapped): a repeat measurement in the same run. A variant
+comparison on the GPU, e.g. (about 3 min, mostly NVRTC compiles)::
 
-    python3 scripts/gpu/bench_contact.py --models rft3d --paths fused --variants all --skip-sim --out $OUT/variants
+    python3 scripts/gpu/bench_contact.py --models rft3d --paths fused --variants all --skip-sim \
+        --reps 1000 --repeat 5 --warm-s 0.5 --out $OUT/variants
+
+Timing: ``--repeat`` timed graph launches per call, the median recorded as ``<call>_s`` (all of them as
+``<call>_s_runs`` when more than one), after untimed graph launches for ``--warm-s`` seconds (default: one, as
+before). On CUDA ``gpu_clocks[<key>]`` holds nvidia-smi's clocks, power and throttle reasons after each record.
 
 Time box and resume: the JSON (``<out>/bench_contact.json``) is rewritten atomically after every record; a rerun
 with the same ``--out`` skips the records already there (``--force`` redoes them). The run stops starting new
@@ -70,6 +76,8 @@ def _parse(argv: list[str] | None = None) -> argparse.Namespace:
     p = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     p.add_argument("--num-worlds", type=int, default=4096)
     p.add_argument("--reps", type=int, default=200, help="launches per timed CUDA graph")
+    p.add_argument("--repeat", type=int, default=1, help="timed graph launches per call (median recorded)")
+    p.add_argument("--warm-s", type=float, default=0.0, help="untimed graph launches for this long first [s]")
     p.add_argument("--device", default="cuda:0")
     p.add_argument("--skip-sim", action="store_true", help="do not build the G1 env for the step reference")
     p.add_argument("--paths", default=",".join(PATHS), help="comma list of compute() paths: fused, unfused")
@@ -81,29 +89,68 @@ def _parse(argv: list[str] | None = None) -> argparse.Namespace:
     return p.parse_args(argv)
 
 
-def _time_graph(fn: Callable[[], object], reps: int, device: str) -> float:
-    """Mean seconds per call of ``fn``; launched ``reps`` times inside one CUDA graph when on CUDA."""
+def _time_graph(fn: Callable[[], object], reps: int, device: str, repeat: int = 1, warm_s: float = 0.0) -> list[float]:
+    """Seconds per call of ``fn`` in each of ``repeat`` timed runs of ``reps`` calls (one CUDA graph when on CUDA).
+
+    One untimed graph launch first, repeated until ``warm_s`` seconds have passed (GPU clocks up from idle).
+    """
     import warp as wp
 
     fn()  # compile + warm up
     wp.synchronize()
+    graph = None
     if wp.get_device(device).is_cuda:
         with wp.ScopedCapture(device=device) as cap:
             for _ in range(reps):
                 fn()
         graph = cap.graph
         assert graph is not None
+        t_warm = time.perf_counter()
         wp.capture_launch(graph)  # warm
         wp.synchronize()
+        while time.perf_counter() - t_warm < warm_s:
+            wp.capture_launch(graph)
+            wp.synchronize()
+
+    def launch() -> None:
+        if graph is None:
+            for _ in range(reps):
+                fn()
+        else:
+            wp.capture_launch(graph)
+
+    runs = []
+    for _ in range(repeat):
         t0 = time.perf_counter()
-        wp.capture_launch(graph)
+        launch()
         wp.synchronize()
-        return (time.perf_counter() - t0) / reps
-    t0 = time.perf_counter()
-    for _ in range(reps):
-        fn()
-    wp.synchronize()
-    return (time.perf_counter() - t0) / reps
+        runs.append((time.perf_counter() - t0) / reps)
+    return runs
+
+
+def _timed(calls: dict[str, Callable[[], object]], args: argparse.Namespace) -> dict[str, Any]:
+    """Return ``<call>_s`` (median over ``--repeat`` timed runs) and, when repeat > 1, ``<call>_s_runs``."""
+    rec: dict[str, Any] = {}
+    for k, fn in calls.items():
+        runs = _time_graph(fn, args.reps, args.device, args.repeat, args.warm_s)
+        rec[f"{k}_s"] = float(np.median(runs))
+        if args.repeat > 1:
+            rec[f"{k}_s_runs"] = runs
+    return rec
+
+
+def _gpu_clocks() -> str | None:
+    """Return nvidia-smi's SM / max SM / memory clocks [MHz], power [W], temperature [C] and throttle reasons."""
+    import subprocess
+
+    query = "clocks.sm,clocks.max.sm,clocks.mem,power.draw,temperature.gpu,clocks_throttle_reasons.active"
+    try:
+        out = subprocess.run(
+            ["nvidia-smi", f"--query-gpu={query}", "--format=csv,noheader"], capture_output=True, text=True, timeout=20
+        )
+    except (OSError, subprocess.TimeoutExpired):
+        return None
+    return f"{query}: {out.stdout.strip()}" if out.returncode == 0 else None
 
 
 def _foot_state(num_worlds: int, device: str, seed: int = 0) -> tuple[Any, ...]:
@@ -283,7 +330,7 @@ def bench_variant_record(name: str, faces: Literal["sole", "box"], variant: str,
     if variant != LEGACY_VARIANT:  # legacy's step is the default step kernel
         calls["step"] = lambda: model.compute_and_update_state(*state)
     rec: dict[str, Any] = {"variant": variant}
-    rec.update({f"{k}_s": _time_graph(fn, args.reps, args.device) for k, fn in calls.items()})
+    rec.update(_timed(calls, args))
     rec["launches"] = {k: _launches(fn) for k, fn in calls.items()}
     rec["max_rel_diff_vs_default"] = _variant_vs_default(cfg, args.num_worlds, args.device, variant)
     return rec
@@ -302,7 +349,7 @@ def bench_record(
     if model.is_stateful:
         calls["update_state"] = lambda: model.update_state(*state[:5])
         calls["step"] = lambda: model.compute_and_update_state(*state)
-    rec: dict[str, Any] = {f"{k}_s": _time_graph(fn, args.reps, args.device) for k, fn in calls.items()}
+    rec: dict[str, Any] = _timed(calls, args)
     if path == "fused" and name in VARIANT_MODELS:
         rec["variant"] = "default"
     rec["launches"] = {k: _launches(fn) for k, fn in calls.items()}
@@ -386,6 +433,7 @@ def main(argv: list[str] | None = None) -> int:
     out_file = args.out / "bench_contact.json"
     res: dict[str, Any] = json.loads(out_file.read_text()) if out_file.exists() and not args.force else {}
     setup = {"device": _device_name(args.device), "num_worlds": args.num_worlds, "reps": args.reps}
+    setup.update(repeat=args.repeat, warm_s=args.warm_s)
     if res and {k: res.get(k) for k in setup} != setup:
         print(f"{out_file} holds another setup {[res.get(k) for k in setup]}; use --force or another --out")
         return 2
@@ -399,6 +447,8 @@ def main(argv: list[str] | None = None) -> int:
             res["models"][key] = bench_record(name, faces, path, args, paths)
         else:
             res["models"][key] = bench_variant_record(name, faces, variant, args)
+        if args.device.startswith("cuda"):  # clocks right after the record (lower SM clock: slower kernels)
+            res.setdefault("gpu_clocks", {})[key] = _gpu_clocks()
         print(key, res["models"][key], flush=True)
         _write(out_file, res)
     else:

@@ -51,11 +51,18 @@ def test_bench_refuses_a_foreign_setup(tmp_path: Path) -> None:
 
 
 def test_bench_times_every_kernel_variant_side_by_side(tmp_path: Path) -> None:
-    """--variants all: one record per fused 3D-RFT variant after the default one, each equal to it (diff 0)."""
+    """--variants all: one record per fused 3D-RFT variant after the default one, each equal to it (diff 0).
+
+    With --repeat 3 every call is timed three times and the median recorded.
+    """
     bench = bench_module()
     argv = ["--num-worlds", "2", "--reps", "1", "--device", "cpu", "--skip-sim", "--out", str(tmp_path)]
-    assert bench.main([*argv, "--models", "rft3d,cone_multi", "--paths", "fused", "--variants", "all"]) == 0
+    run = [*argv, "--models", "rft3d,cone_multi", "--paths", "fused", "--variants", "all", "--repeat", "3"]
+    assert bench.main(run) == 0
     res = json.loads((tmp_path / "bench_contact.json").read_text())
+    assert res["repeat"] == 3 and "gpu_clocks" not in res  # clocks only on CUDA
+    for rec in res["models"].values():  # median of the three timed runs
+        assert len(rec["compute_s_runs"]) == 3 and rec["compute_s"] == sorted(rec["compute_s_runs"])[1]
     variants = bench.all_variants()
     assert res["variants"] == list(variants) and variants[0] == "default" and "legacy" in variants
     keys = [k for k in res["models"] if k.startswith("rft3d/150pt")]
