@@ -472,7 +472,7 @@ def _legacy_rft3d_element_force(
     return at_rest_filter(force, v, depth, rest, state, w, f, p, 0)
 
 
-@wp.kernel(module="unique", enable_backward=False)
+@wp.kernel
 def rft3d_foot_wrench_legacy_kernel(
     # Model:
     coeffs: RFT3DCoeffs,
@@ -502,6 +502,8 @@ def rft3d_foot_wrench_legacy_kernel(
     nan_count_out: wp.array[int],
 ) -> None:
     """The fused compute() kernel of commit 9af447a (separate model arguments, inline element body), for timing.
+
+    In this file's module, as it was then (not a ``"unique"`` module like the current fused kernels).
 
     Same outputs as :data:`rft3d_foot_wrench_kernel` bit for bit (same element functions, same order).
     """
