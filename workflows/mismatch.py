@@ -32,8 +32,9 @@ def _analysis_cfg(section: DictConfig) -> Any:
     from gmloco.deploy.mismatch.pipeline import AnalysisCfg
     from gmloco.deploy.mismatch.replay import ReplayCfg, sand_replay_cfg
 
-    # ``ground`` ("plane" or "sand[:MATERIAL]", as gmloco-mismatch --ground) once the stage schema carries it.
-    ground, _, material = (str(section.ground) if "ground" in section else "plane").partition(":")
+    ground, _, material = str(section.ground).partition(":")  # "plane" or "sand[:MATERIAL]"
+    if ground not in ("plane", "sand") or (ground == "plane" and material):
+        raise ValueError(f"mismatch.ground={section.ground!r}: use 'plane', 'sand' or 'sand:<material preset>'")
     replay = (
         sand_replay_cfg(material or "dry_sand", horizon=int(section.horizon))
         if ground == "sand"

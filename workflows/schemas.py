@@ -328,6 +328,9 @@ class MismatchCfg(StageCfg):
     """Analyze only the first ``duration_s`` seconds [s] (at least ~5 s); None: the whole recording."""
     horizon: int = 30
     """Shooting horizon of the replay [samples]."""
+    ground: str = "plane"
+    """Nominal ground of the replay: ``plane`` (rigid) or ``sand[:MATERIAL]`` (3D-RFT sand, material preset, default
+    dry_sand), as ``gmloco-mismatch --ground``."""
     effects: list[str] | None = None
     """Effect ids to screen (``gmloco.deploy.mismatch.EFFECT_IDS``); None: the whole library."""
     n_boot: int = 400
