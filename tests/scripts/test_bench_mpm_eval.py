@@ -128,7 +128,8 @@ def test_resume_from_the_partial_h100_bench_runs_the_rest(tmp_path: Path, monkey
         return {**case, "particles": int(1.0 / v**3) * case["robots"], "graph": True, "capture_error": None,
                 "build_s": 1.0, "capture_s": 0.1, "frames": args.frames, "frames_per_s": 2.0 / v, "episodes_per_min": 1.0,
                 "batch_episode_s": 60.0, "sinkage_m": 0.02 + v, "max_sinkage_m": 0.05, "depth_m": 0.15,
-                "pelvis_z_m": 0.7, "fallen": 0, "through_floor": 0, "vx_mps": 1.0 + case.get("iters", 50) / 1e4}  # fmt: skip
+                "pelvis_z_m": 0.7, "fallen": 0, "through_floor": 0, "soles_on_floor": 0, "soles_below_floor": 0,
+                "vx_mps": 1.0 + case.get("iters", 50) / 1e4}  # fmt: skip
 
     monkeypatch.setattr(bench, "_run_case", fake_run)
     argv = ["bench", "--out", str(tmp_path), "--voxels", "0.05", "0.04", "0.03", "--robots", "32",
