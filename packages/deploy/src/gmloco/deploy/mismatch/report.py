@@ -5,10 +5,13 @@
 
 * ``verdict``: ``no_mismatch`` | ``explained`` | ``unexplained`` | ``invalid_input``.
 * ``winner``: effect id (vocabulary in :mod:`gmloco.deploy.mismatch.effects`) when ``explained``, else null.
+* ``nearest``: when ``unexplained``, the best passing library effect that nonetheless left a held-out residual
+  above the floor (it absorbs part of an out-of-library effect), else null.
 * ``contract``: list of ``{check, severity, message, detail}`` (joint map, units, time base, gaps, length).
 * ``recording``: ``{duration_s, rate_hz, base_state: odometry|leg_odometry, segments, n_eff}``.
 * ``noise_floor``: ``{source, per_signal: {q, dq, tau_est, gyro, acc}}`` (median sigma per signal, SI units).
-* ``mismatch``: ``{nominal_energy_ratio, explained_fraction, cells: [...], windows: [...]}``; a cell is
+* ``mismatch``: ``{nominal_energy_ratio, residual_ratio, explained_fraction, cells: [...], windows: [...]}``
+  (``residual_ratio``: held-out residual energy per element left by the best passing effect, floor = 1); a cell is
   ``{signal, joint, phase, energy_ratio, q_fdr, n}``, a window ``{signal, t: [t0, t1], energy_ratio, q_fdr}``.
 * ``hypotheses``: ranked list, each ``{id, rank, testable, dbic_screen, confirmed, dbic, heldout_gain,
   heldout_gain_lo, heldout_gain_lo_signals, p_boot, passed, corr_max, weight, params: {name: {value, ci95, unit}}, confusables, explanation}``;
@@ -130,6 +133,7 @@ def build_report(
         "schema": SCHEMA,
         "verdict": decision["verdict"],
         "winner": decision["winner"],
+        "nearest": decision.get("nearest"),
         "contract": [i.to_dict() for i in issues],
         "recording": {
             "duration_s": float(rec.t[-1] - rec.t[0]),
@@ -145,6 +149,7 @@ def build_report(
         },
         "mismatch": {
             "nominal_energy_ratio": decision["nominal_energy_ratio"],
+            "residual_ratio": decision.get("residual_ratio"),
             "explained_fraction": decision["explained_fraction"],
             "cells": loc["cells"],
             "windows": loc["windows"],

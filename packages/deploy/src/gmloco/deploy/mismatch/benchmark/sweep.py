@@ -77,6 +77,8 @@ def run_episode(
         row["trimmed"] = {"fell_at_s": key["fell_at_s"], "kept_s": key["kept_s"]}
     row["untested"] = [u["id"] for u in rep["untested"]]
     row["nominal_energy_ratio"] = rep.get("mismatch", {}).get("nominal_energy_ratio")
+    row["residual_ratio"] = rep.get("mismatch", {}).get("residual_ratio")
+    row["nearest"] = rep.get("nearest")
     keys_h = ("passed", "dbic", "heldout_gain", "heldout_gain_lo", "heldout_gain_lo_signals", "p_boot")
     row["confirmed"] = [
         {"id": h["id"], **{k: h.get(k) for k in keys_h}} for h in rep["hypotheses"] if h.get("confirmed")
