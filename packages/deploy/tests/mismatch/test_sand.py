@@ -113,3 +113,16 @@ def test_crater_memory_is_a_running_max_of_depth(sand_rec: object) -> None:
     assert np.all(zm >= 0.0) and np.any(zm > 0.002)  # a standing G1 sinks millimetres into dry sand
     inside = (zm[1:] > 0) & (zm[:-1] > 0)
     assert np.all(zm[1:][inside] >= zm[:-1][inside])
+
+
+def test_sand_defaults_follow_the_contact_models() -> None:
+    """SandCfg repeats ContactRFT3DCfg's defaults (the deploy package imports gmloco.contact lazily): keep them equal."""
+    from dataclasses import fields
+
+    from gmloco.contact.config import ContactRFT3DCfg
+
+    contact, sand = ContactRFT3DCfg(), SandCfg()
+    shared = {f.name for f in fields(SandCfg)} & {f.name for f in fields(ContactRFT3DCfg)}
+    assert {"unloading_ratio", "unloading_damping", "unloading_speed", "tangential_damping", "v_eps"} <= shared
+    for name in sorted(shared):
+        assert getattr(sand, name) == getattr(contact, name), name
