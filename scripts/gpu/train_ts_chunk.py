@@ -263,6 +263,15 @@ def _post_checks(args: argparse.Namespace, task: Any, checkpoint: Path, run_dir:
     return checks
 
 
+def _write_summary(out: Path, summary: dict[str, Any], printed: dict[str, Any]) -> None:
+    """Write ``summary.json`` (curves keep NaN, as train_chunk.py's, for collect_chunk.py) and print ``printed``."""
+    from gmloco.train.evaluation_ts import finite_json
+
+    clean = finite_json({k: v for k, v in summary.items() if k != "curve"}) | {"curve": summary["curve"]}
+    (out / "summary.json").write_text(json.dumps(clean, indent=1, default=str))
+    print(json.dumps(finite_json(printed), indent=1, default=str))
+
+
 def _guarded_post_checks(args: argparse.Namespace, task: Any, checkpoint: Path, run_dir: Path) -> dict[str, Any]:
     """Step 3, whose failure (e.g. an export parity error) is recorded instead of losing the chunk's summary."""
     try:
@@ -296,11 +305,7 @@ def _post_only(args: argparse.Namespace, run: str, run_dir: Path, t0: float) -> 
         "wall_s": time.monotonic() - t0,
         "device": args.device,
     }
-    from gmloco.train.evaluation_ts import finite_json
-
-    clean = finite_json({k: v for k, v in summary.items() if k != "curve"}) | {"curve": summary["curve"]}
-    (args.out / "summary.json").write_text(json.dumps(clean, indent=1, default=str))
-    print(json.dumps(finite_json({"checks": checks}), indent=1, default=str))
+    _write_summary(args.out, summary, {"checks": checks})
     return summary
 
 
@@ -364,12 +369,7 @@ def main(argv: list[str] | None = None) -> dict[str, Any]:
         "commit": subprocess.run(["git", "rev-parse", "HEAD"], capture_output=True, text=True).stdout.strip() or None,
         "device": torch.cuda.get_device_name(0) if torch.cuda.is_available() else "cpu",
     }
-    from gmloco.train.evaluation_ts import finite_json
-
-    # Curves keep NaN (iterations before the first finished episode), as train_chunk.py's, for collect_chunk.py.
-    clean = finite_json({k: v for k, v in summary.items() if k != "curve"}) | {"curve": summary["curve"]}
-    (args.out / "summary.json").write_text(json.dumps(clean, indent=1, default=str))
-    print(json.dumps(finite_json({"metrics": metrics, "checks": checks}), indent=1, default=str))
+    _write_summary(args.out, summary, {"metrics": metrics, "checks": checks})
     return summary
 
 
