@@ -121,9 +121,9 @@ class AuxLossPPO(PPO):
         moves fast (e.g. after a warm start) it falls to 1e-5..1e-4, which would all but stop a supervised head
         such as the teacher's terrain encoder and decoder. Gradients and clipping are unchanged.
         """
-        fixed = {id(p) for m in modules for p in m.parameters()}
-        rest = [p for p in self.optimizer.param_groups[0]["params"] if id(p) not in fixed]
         heads = [p for m in modules for p in m.parameters()]
+        fixed = {id(p) for p in heads}
+        rest = [p for p in self.optimizer.param_groups[0]["params"] if id(p) not in fixed]
         self.optimizer = type(self.optimizer)(
             [{"params": rest}, {"params": heads, "lr": learning_rate, "fixed_lr": True}], lr=self.learning_rate
         )
