@@ -39,3 +39,37 @@ def test_sweep_subset_writes_rows_summary_manifest_and_a_separate_key(tmp_path: 
     inv = manifest["invocations"][-1]
     assert inv["episodes"] == ["imu.gyro_bias-mid-0"] and "commit" in inv["git"]
     assert (tmp_path / "keys" / "imu.gyro_bias-mid-0.json").exists()
+
+
+def test_seed_offset_and_parts_split_the_lists_into_fresh_interleaved_replicates() -> None:
+    """The offset moves every seed and keeps the names; part i/2 takes seed i of each class and every other null."""
+    from gmloco.deploy.mismatch.benchmark.episodes import episode_list, sand_episode_list
+    from gmloco.deploy.mismatch.benchmark.sweep import _part
+
+    stock, fresh = sand_episode_list(2, 4), sand_episode_list(2, 4, seed_offset=10000)
+    assert [e["name"] for e in stock] == [e["name"] for e in fresh]
+    assert all(f["seed"] == s["seed"] + 10000 for s, f in zip(stock, fresh, strict=True))
+    # the stock single-seed list is unchanged (the session-3 sand suite's names and seeds)
+    ool = [e for e in sand_episode_list(1, 6) if e["effect"].startswith("ool.")]
+    assert [(e["name"], e["seed"]) for e in ool] == [
+        ("sand-ool.shank_length-0", 2100),
+        ("sand-ool.current_lag-0", 2100),
+    ]
+    for eps in (fresh, episode_list(2, 4, seed_offset=10000)):
+        p0, p1 = _part(eps, "0/2"), _part(eps, "1/2")
+        assert len(p0) + len(p1) == len(eps) and {e["name"] for e in p0}.isdisjoint(e["name"] for e in p1)
+        classes = {e["effect"] for e in eps if e["effect"] != "none"}
+        for part, idx in ((p0, "0"), (p1, "1")):
+            eff = [e for e in part if e["effect"] != "none"]
+            assert {e["effect"] for e in eff} == classes and all(e["name"].endswith(idx) for e in eff)
+            assert sum(e["effect"] == "none" for e in part) == 2
+
+
+def test_deadline_skips_unstarted_episodes_and_lists_them_as_missing(tmp_path: Path) -> None:
+    """Past the deadline no episode starts; nothing is written under rows/ and the summary lists the episodes."""
+    main(["--out", str(tmp_path), "--only", "none-", "--nulls", "2", "--workers", "1", "--deadline-s", "-1"])
+    summary = json.loads((tmp_path / "summary.json").read_text())
+    assert summary["missing"] == ["none-0", "none-1"] and summary["episodes_scored"] == 0
+    assert not (tmp_path / "rows").exists()
+    inv = json.loads((tmp_path / "manifest.json").read_text())["invocations"][-1]
+    assert set(inv["source_sha256"]) == {"mismatch", "contact"} and "mujoco" in inv

@@ -31,22 +31,49 @@ OOL: dict[str, dict[str, list[float]]] = {"ool.shank_length": {"dl": [0.03]}, "o
 """Out-of-library effects (the right answer is ``unexplained``)."""
 
 
-def episode_list(seeds: int = 1, nulls: int = 20, strengths: tuple[str, ...] = ("mid",)) -> list[dict]:
-    """Return episode dicts ``{name, effect, params, strength, seed}``."""
+def episode_list(
+    seeds: int = 1, nulls: int = 20, strengths: tuple[str, ...] = ("mid",), seed_offset: int = 0
+) -> list[dict]:
+    """Return episode dicts ``{name, effect, params, strength, seed}``.
+
+    ``seed_offset`` is added to every seed (fresh test seeds for a re-run; names are unchanged).
+    """
     eps = []
     for s in strengths:
         for eid, p in MID.items():
             for seed in range(seeds):
                 scaled = {k: [v * STRENGTHS[s] for v in vals] for k, vals in p.items()}
                 eps.append(
-                    {"name": f"{eid}-{s}-{seed}", "effect": eid, "params": scaled, "strength": s, "seed": 100 + seed}
+                    {
+                        "name": f"{eid}-{s}-{seed}",
+                        "effect": eid,
+                        "params": scaled,
+                        "strength": s,
+                        "seed": 100 + seed + seed_offset,
+                    }
                 )
     for seed in range(nulls):
         # Seeds 1000+ are disjoint from the nulls (200-211) that set the floors and ``weak_gain_min``.
-        eps.append({"name": f"none-{seed}", "effect": "none", "params": {}, "strength": "none", "seed": 1000 + seed})
+        eps.append(
+            {
+                "name": f"none-{seed}",
+                "effect": "none",
+                "params": {},
+                "strength": "none",
+                "seed": 1000 + seed + seed_offset,
+            }
+        )
     for eid, p in OOL.items():
         for seed in range(max(1, seeds)):
-            eps.append({"name": f"{eid}-{seed}", "effect": eid, "params": p, "strength": "mid", "seed": 300 + seed})
+            eps.append(
+                {
+                    "name": f"{eid}-{seed}",
+                    "effect": eid,
+                    "params": p,
+                    "strength": "mid",
+                    "seed": 300 + seed + seed_offset,
+                }
+            )
     return eps
 
 
@@ -71,23 +98,44 @@ SAND_OOL: dict[str, dict[str, list[float]]] = {
 """Out-of-library effects of the sand suite."""
 
 
-def sand_episode_list(seeds: int = 1, nulls: int = 6, material: str = "dry_sand") -> list[dict]:
+def sand_episode_list(seeds: int = 1, nulls: int = 6, material: str = "dry_sand", seed_offset: int = 0) -> list[dict]:
     """Episodes of the sand suite: the walking policy on 3D-RFT sand, logged odometry (mocap), 1 m/s.
 
-    Seeds 2000+ (effects, out of library) and 3000+ (nulls) are disjoint from the tuning nulls (200-203) that
-    set the sand floors.
+    Seeds 2000+ (effects), 2100+ (out of library) and 3000+ (nulls) are disjoint from the tuning nulls
+    (200-203) that set the sand floors; ``seed_offset`` is added to every seed (names are unchanged).
     """
     common = {"ground": "sand", "material": material, "policy": True, "odometry": True}
     eps = []
     for eid, p in SAND_MID.items():
         for seed in range(seeds):
             eps.append(
-                {"name": f"sand-{eid}-mid-{seed}", "effect": eid, "params": p, "strength": "mid", "seed": 2000 + seed}
+                {
+                    "name": f"sand-{eid}-mid-{seed}",
+                    "effect": eid,
+                    "params": p,
+                    "strength": "mid",
+                    "seed": 2000 + seed + seed_offset,
+                }
             )
     for seed in range(nulls):
         eps.append(
-            {"name": f"sand-none-{seed}", "effect": "none", "params": {}, "strength": "none", "seed": 3000 + seed}
+            {
+                "name": f"sand-none-{seed}",
+                "effect": "none",
+                "params": {},
+                "strength": "none",
+                "seed": 3000 + seed + seed_offset,
+            }
         )
     for eid, p in SAND_OOL.items():
-        eps.append({"name": f"sand-{eid}-0", "effect": eid, "params": p, "strength": "mid", "seed": 2100})
+        for seed in range(max(1, seeds)):
+            eps.append(
+                {
+                    "name": f"sand-{eid}-{seed}",
+                    "effect": eid,
+                    "params": p,
+                    "strength": "mid",
+                    "seed": 2100 + seed + seed_offset,
+                }
+            )
     return [{**e, **common} for e in eps]

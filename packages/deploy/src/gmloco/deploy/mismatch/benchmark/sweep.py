@@ -1,7 +1,9 @@
 # SPDX-License-Identifier: Apache-2.0
 """Run benchmark episodes in parallel processes and score them.
 
-Usage: ``python -m gmloco.deploy.mismatch.benchmark.sweep --out DIR [--workers N] [--seeds 2] [--nulls 8]``.
+Usage: ``python -m gmloco.deploy.mismatch.benchmark.sweep --out DIR [--workers N] [--seeds 2] [--nulls 8]``
+(``--seed-offset K`` for fresh seeds, ``--part I/N`` for one of N interleaved parts of the list,
+``--deadline-s S`` to start no episode after S seconds; ``--resume`` runs what is left).
 Each worker generates the "real" recording, writes the truth key under ``DIR/keys/`` (never passed to the
 tool), analyses the recording with the tool, and then computes the oracle held-out energy with the true
 parameters for the scorer.
@@ -19,7 +21,7 @@ from pathlib import Path
 
 import numpy as np
 
-__all__ = ["main", "run_episode"]
+__all__ = ["main", "run_episode", "source_sha256"]
 
 
 def run_episode(
@@ -97,16 +99,61 @@ def run_episode(
         ef = float(np.sum(pb.resid({w.spec.id: w.theta}, pb.held) ** 2)) if w is not None else e0
         row["energy"] = {"nominal": e0, "oracle": eo, "fitted": ef}
     (Path(out) / "rows").mkdir(parents=True, exist_ok=True)
-    (Path(out) / "rows" / f"{ep['name']}.json").write_text(json.dumps(row, default=float))
+    # Write then rename: a sweep killed mid-write (a wall-clock limit) leaves no truncated row for --resume.
+    tmp = Path(out) / "rows" / f".{ep['name']}.json.tmp"
+    tmp.write_text(json.dumps(row, default=float))
+    tmp.replace(Path(out) / "rows" / f"{ep['name']}.json")
     return row
 
 
 def _star(args: tuple) -> dict:
-    """Pool adapter."""
+    """Pool adapter: skips an episode not started by the deadline; a failed episode's row goes to ``OUT/errors``.
+
+    ``args`` is ``run_episode``'s arguments followed by the deadline (``time.time()`` value, or None).
+    """
+    *ep_args, deadline = args
+    ep, out = ep_args[0], ep_args[1]
+    if deadline is not None and time.time() > deadline:
+        return {**ep, "skipped": "not started before the deadline"}
     try:
-        return run_episode(*args)
+        row = run_episode(*ep_args)
     except Exception as exc:  # keep the sweep alive; the row records the failure
-        return {**args[0], "error": repr(exc)}
+        row = {**ep, "error": repr(exc)}
+    if "error" in row:
+        (Path(out) / "errors").mkdir(parents=True, exist_ok=True)
+        (Path(out) / "errors" / f"{ep['name']}.json").write_text(json.dumps(row, default=float))
+    return row
+
+
+def source_sha256() -> dict[str, str]:
+    """SHA-256 over the Python sources of the packages the benchmark's results depend on (provenance).
+
+    Keys: ``mismatch`` (the tool and the benchmark generator) and ``contact`` (the sand laws). Each hash covers
+    the sorted relative paths and bytes of every ``*.py`` file under the imported package.
+    """
+    import hashlib
+
+    import gmloco.contact
+    import gmloco.deploy.mismatch
+
+    out = {}
+    for name, mod in (("mismatch", gmloco.deploy.mismatch), ("contact", gmloco.contact)):
+        root = Path(mod.__file__ or "").parent
+        h = hashlib.sha256()
+        for f in sorted(root.rglob("*.py")):
+            h.update(f.relative_to(root).as_posix().encode() + b"\0" + f.read_bytes() + b"\0")
+        out[name] = h.hexdigest()
+    return out
+
+
+def _part(eps: list[dict], spec: str | None) -> list[dict]:
+    """Episodes at the positions ``i``, ``i + n``, ... of the list for ``spec`` = ``"i/n"`` (all for None)."""
+    if spec is None:
+        return eps
+    i, n = (int(x) for x in spec.split("/"))
+    if not 0 <= i < n:
+        raise ValueError(f"--part {spec}: need 0 <= i < n")
+    return eps[i::n]
 
 
 def _git_commit() -> dict:
@@ -127,6 +174,8 @@ def _manifest(
     import platform
     from dataclasses import asdict
 
+    import mujoco
+
     from gmloco.deploy.mismatch.benchmark.controller import MotionCfg
     from gmloco.deploy.mismatch.benchmark.generator import EpisodeCfg
     from gmloco.deploy.mismatch.pipeline import AnalysisCfg
@@ -135,6 +184,8 @@ def _manifest(
     ep_cfg.pop("effect")
     man = {
         "git": git,
+        "source_sha256": source_sha256(),
+        "mujoco": mujoco.__version__,
         "episodes_run_by_this_invocation": [e["name"] for e in todo],
         "command": "python -m gmloco.deploy.mismatch.benchmark.sweep " + " ".join(argv),
         "episode_cfg": ep_cfg,
@@ -183,6 +234,14 @@ def main(argv: list[str] | None = None) -> None:
     )
     p.add_argument("--resume", action="store_true", help="skip episodes whose row already exists under OUT/rows")
     p.add_argument("--effects", default=None, help="comma-separated effect ids the tool screens (default: all)")
+    p.add_argument("--seed-offset", type=int, default=0, help="added to every episode's seed (fresh test seeds)")
+    p.add_argument("--part", default=None, help="I/N: run only the episodes at positions I, I+N, ... of the list")
+    p.add_argument(
+        "--deadline-s",
+        type=float,
+        default=None,
+        help="start no episode later than this many seconds after the sweep began (the rest: --resume later)",
+    )
     argv = list(sys.argv[1:] if argv is None else argv)
     a = p.parse_args(argv)
     if a.score_only:
@@ -196,23 +255,32 @@ def main(argv: list[str] | None = None) -> None:
             (a.out / "summary_pooled.json").write_text(json.dumps(pooled, indent=2, default=float))
         return
     if a.suite == "sand":
-        eps = sand_episode_list(a.seeds, a.nulls)
+        eps = sand_episode_list(a.seeds, a.nulls, seed_offset=a.seed_offset)
     else:
-        eps = episode_list(a.seeds, a.nulls, tuple(a.strengths.split(",")))
+        eps = episode_list(a.seeds, a.nulls, tuple(a.strengths.split(",")), seed_offset=a.seed_offset)
+    eps = _part(eps, a.part)
     if a.only:
         eps = [e for e in eps if any(e["name"].startswith(s) for s in a.only.split(","))]
     a.out.mkdir(parents=True, exist_ok=True)
     todo = [e for e in eps if not (a.resume and (a.out / "rows" / f"{e['name']}.json").exists())]
     t0, git = time.time(), _git_commit()
+    deadline = None if a.deadline_s is None else t0 + a.deadline_s
     effects = tuple(a.effects.split(",")) if a.effects else None
+    args = [(e, str(a.out), a.duration, a.keep_before_fall, effects, deadline) for e in todo]
     with Pool(a.workers) as pool:
-        fresh = pool.map(_star, [(e, str(a.out), a.duration, a.keep_before_fall, effects) for e in todo], chunksize=1)
+        fresh = pool.map(_star, args, chunksize=1)
     cpu = sum(os.times()[2:4])
-    names = {e["name"] for e in eps}
-    by_name = {r["name"]: r for r in fresh}
-    rows = [by_name.get(n) or json.loads((a.out / "rows" / f"{n}.json").read_text()) for n in sorted(names)]
+    by_name = {r["name"]: r for r in fresh if "skipped" not in r}
+    rows, missing = [], []
+    for n in sorted(e["name"] for e in eps):
+        f = a.out / "rows" / f"{n}.json"
+        row = by_name.get(n) or (json.loads(f.read_text()) if f.exists() else None)
+        if row is None:
+            missing.append(n)
+        else:
+            rows.append(row)
     (a.out / "rows.json").write_text(json.dumps(rows, indent=1, default=float))
-    summary = {**score(rows), "episodes_scored": len(rows), "wall_s": time.time() - t0}
+    summary = {**score(rows), "episodes_scored": len(rows), "missing": missing, "wall_s": time.time() - t0}
     (a.out / "summary.json").write_text(json.dumps(summary, indent=2, default=float))
     _manifest(a.out, argv, eps, todo, time.time() - t0, cpu, git)
 
