@@ -129,16 +129,19 @@ def source_sha256() -> dict[str, str]:
     """SHA-256 over the Python sources of the packages the benchmark's results depend on (provenance).
 
     Keys: ``mismatch`` (the tool and the benchmark generator) and ``contact`` (the sand laws). Each hash covers
-    the sorted relative paths and bytes of every ``*.py`` file under the imported package.
+    the sorted relative paths and bytes of every ``*.py`` file of the package found on the path (located, not
+    imported: ``gmloco.contact`` would import Warp).
     """
     import hashlib
-
-    import gmloco.contact
-    import gmloco.deploy.mismatch
+    from importlib.util import find_spec
 
     out = {}
-    for name, mod in (("mismatch", gmloco.deploy.mismatch), ("contact", gmloco.contact)):
-        root = Path(mod.__file__ or "").parent
+    for name, mod in (("mismatch", "gmloco.deploy.mismatch"), ("contact", "gmloco.contact")):
+        spec = find_spec(mod)
+        if spec is None or spec.origin is None:
+            out[name] = "not found"
+            continue
+        root = Path(spec.origin).parent
         h = hashlib.sha256()
         for f in sorted(root.rglob("*.py")):
             h.update(f.relative_to(root).as_posix().encode() + b"\0" + f.read_bytes() + b"\0")
