@@ -27,6 +27,7 @@ from scipy.stats import beta
 
 from gmloco.deploy.mismatch.benchmark.episodes import episode_list, sand_episode_list
 from gmloco.deploy.mismatch.benchmark.scorer import EXCITED_GAIN, _param_err, score
+from gmloco.deploy.mismatch.benchmark.sweep import in_source_hash
 from gmloco.deploy.mismatch.effects import EFFECT_IDS
 
 HERE = Path(__file__).parent
@@ -48,7 +49,8 @@ def hash_at_commit(commit: str) -> dict[str, str]:
     out = {}
     for name, root in PKGS.items():
         h = hashlib.sha256()
-        files = sorted(f for f in _git("ls-tree", "-r", "--name-only", commit, root).split() if f.endswith(".py"))
+        files = _git("ls-tree", "-r", "--name-only", commit, root).split()
+        files = [f for f in files if in_source_hash(name, Path(f).relative_to(root).as_posix())]
         for f in sorted(files, key=lambda p: Path(p).relative_to(root).parts):  # the order of sorted Paths
             data = subprocess.run(["git", "show", f"{commit}:{f}"], capture_output=True, check=True, cwd=REPO).stdout
             h.update(Path(f).relative_to(root).as_posix().encode() + b"\0" + data + b"\0")
@@ -57,9 +59,12 @@ def hash_at_commit(commit: str) -> dict[str, str]:
 
 
 def tool_diff(commit: str) -> list[str]:
-    """Files of the tool and the sand laws that differ between the protocol commit and ``commit``."""
+    """Files of the tool and the sand laws (as hashed) that differ between the protocol commit and ``commit``."""
     excl = [f":(exclude){PKGS['mismatch']}/{b}" for b in BOOKKEEPING]
-    return _git("diff", "--name-only", PROTOCOL_COMMIT, commit, "--", *PKGS.values(), *excl).split()
+    changed = _git("diff", "--name-only", PROTOCOL_COMMIT, commit, "--", *PKGS.values(), *excl).split()
+    return [
+        f for f in changed if any(f.startswith(r + "/") and in_source_hash(n, f[len(r) + 1 :]) for n, r in PKGS.items())
+    ]
 
 
 def load_suite(d: Path, expected: list[dict]) -> tuple[list[dict], dict[str, Any]]:

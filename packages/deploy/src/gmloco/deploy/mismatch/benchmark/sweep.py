@@ -21,7 +21,7 @@ from pathlib import Path
 
 import numpy as np
 
-__all__ = ["main", "run_episode", "source_sha256"]
+__all__ = ["HASH_SKIP", "in_source_hash", "main", "run_episode", "source_sha256"]
 
 
 def run_episode(
@@ -125,12 +125,23 @@ def _star(args: tuple) -> dict:
     return row
 
 
-def source_sha256() -> dict[str, str]:
-    """SHA-256 over the Python sources of the packages the benchmark's results depend on (provenance).
+HASH_SKIP: dict[str, tuple[str, ...]] = {"contact": ("kernels_", "models.py", "model_base.py")}
+"""Per package, file-name prefixes left out of the source hash: the Warp (GPU) implementation of the contact
+models, which the benchmark's CPU truth and replay never call (they use ``gmloco.contact.reference``, the
+materials, colliders, coefficients and configs)."""
 
-    Keys: ``mismatch`` (the tool and the benchmark generator) and ``contact`` (the sand laws). Each hash covers
-    the sorted relative paths and bytes of every ``*.py`` file of the package found on the path (located, not
-    imported: ``gmloco.contact`` would import Warp).
+
+def in_source_hash(package: str, rel: str) -> bool:
+    """Whether the file at ``rel`` (a path relative to the package root) enters ``package``'s source hash."""
+    return rel.endswith(".py") and not Path(rel).name.startswith(HASH_SKIP.get(package, ()))
+
+
+def source_sha256() -> dict[str, str]:
+    """SHA-256 over the Python sources the benchmark's results depend on (provenance).
+
+    Keys: ``mismatch`` (the tool and the benchmark generator) and ``contact`` (the sand laws; without the Warp
+    kernels, ``HASH_SKIP``). Each hash covers the sorted relative paths and bytes of the package's ``*.py``
+    files found on the path (located, not imported: ``gmloco.contact`` would import Warp).
     """
     import hashlib
     from importlib.util import find_spec
@@ -144,7 +155,9 @@ def source_sha256() -> dict[str, str]:
         root = Path(spec.origin).parent
         h = hashlib.sha256()
         for f in sorted(root.rglob("*.py")):
-            h.update(f.relative_to(root).as_posix().encode() + b"\0" + f.read_bytes() + b"\0")
+            rel = f.relative_to(root).as_posix()
+            if in_source_hash(name, rel):
+                h.update(rel.encode() + b"\0" + f.read_bytes() + b"\0")
         out[name] = h.hexdigest()
     return out
 
