@@ -71,11 +71,22 @@ def load_suite(d: Path, expected: list[dict]) -> tuple[list[dict], dict[str, Any
     """Rows of one suite directory, in the protocol's order, with the status of every expected episode.
 
     A row under ``errors/`` whose truth key exists is a tool error (kept, ``tool_error``); without a key it is a
-    generation error (excluded). An unreadable row file counts as missing.
+    generation error (excluded). An unreadable row file counts as missing. An ``errors/`` file of an episode that
+    also has a good row under ``rows/`` (same seed) is a failed earlier attempt that a later invocation re-ran:
+    the good row is scored and the file is listed under ``superseded_error`` (not counted).
     """
     rows, status = [], {"generation_error": [], "tool_error": [], "missing": [], "seed_mismatch": []}
+    status["superseded_error"] = []
     for ep in expected:
         n = ep["name"]
+        good, err = d / "rows" / f"{n}.json", d / "errors" / f"{n}.json"
+        if good.exists() and err.exists():
+            try:
+                same_seed = json.loads(err.read_text()).get("seed") == json.loads(good.read_text()).get("seed")
+            except json.JSONDecodeError:
+                same_seed = False
+            if same_seed:
+                status["superseded_error"].append(n)
         row = None
         for sub in ("rows", "errors"):
             f = d / sub / f"{n}.json"
@@ -243,6 +254,14 @@ def provenance(dirs: dict[str, Path], code_commit: str | None) -> dict[str, Any]
         out["hash_at_code_commit"] = ref
         out["tool_files_changed_since_protocol"] = tool_diff(code_commit)
         out["all_invocations_match_code_commit"] = all(i.get("source_sha256") == ref for v in invs.values() for i in v)
+    # An invocation killed by its timeout appends no manifest entry, though the rows it finished are complete.
+    out["rows_without_manifest_invocation"] = {
+        s: sorted(
+            {f.stem for f in (d / "rows").glob("*.json")}
+            - {n for i in invs[s] for n in i["episodes_run_by_this_invocation"]}
+        )
+        for s, d in dirs.items()
+    }
     return out
 
 
@@ -304,6 +323,17 @@ def markdown(s: dict[str, Any]) -> str:
     st = s["status"]
     lines += ["", f"Missing: {st['missing'] or 'none'}. Generation errors: {st['generation_error'] or 'none'}. "]
     lines[-1] += f"Tool errors: {st['tool_error'] or 'none'}. Fresh false positives: {nu['fresh_false_positives']}."
+    if st.get("superseded_error"):
+        lines[-1] += (
+            f" Not counted: {len(st['superseded_error'])} `errors/` files of a failed earlier attempt at episodes "
+            "that a later invocation re-ran with the same seed (the good row is scored)."
+        )
+    orphans = {k: len(v) for k, v in s["provenance"].get("rows_without_manifest_invocation", {}).items() if v}
+    if orphans:
+        lines[-1] += (
+            f" Rows that no manifest entry lists (an invocation killed by its timeout writes none), per suite: "
+            f"{orphans}; names in `summary.json` → `provenance`."
+        )
     return "\n".join(lines) + "\n"
 
 
