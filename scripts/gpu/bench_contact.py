@@ -69,7 +69,18 @@ def all_variants() -> tuple[str, ...]:
     """Return every fused 3D-RFT kernel variant name, ``"default"`` first."""
     from gmloco.contact.kernels_rft3d import FUSED_VARIANTS, LEGACY_VARIANT
 
-    return (*FUSED_VARIANTS, LEGACY_VARIANT)
+    return (*FUSED_VARIANTS, LEGACY_VARIANT, *(v + NOPOINTS for v in FUSED_VARIANTS))
+
+
+NOPOINTS = "-nopoints"
+"""Variant-name suffix: the same kernel variant with ``model.point_outputs`` False (no per-point stores)."""
+
+
+def split_variant(variant: str) -> tuple[str, bool]:
+    """Return (kernel variant, point_outputs) of a benchmark variant name (``<variant>[-nopoints]``)."""
+    if variant.endswith(NOPOINTS):
+        return variant.removesuffix(NOPOINTS), False
+    return variant, True
 
 
 def _parse(argv: list[str] | None = None) -> argparse.Namespace:
@@ -214,8 +225,9 @@ def _prepared_model(
     sand = MATERIAL_PRESETS["dry_sand"]
     model = make_contact_model(cfg, num_worlds, 2, device)
     model.fused = fused
-    if variant != "default":
-        model.fused_variant = variant  # pyright: ignore[reportAttributeAccessIssue] (3D-RFT models only)
+    kernel_variant, model.point_outputs = split_variant(variant)
+    if kernel_variant != "default":
+        model.fused_variant = kernel_variant  # pyright: ignore[reportAttributeAccessIssue] (3D-RFT models only)
     w = np.ones(num_worlds)
     model.set_materials(w * sand.rho_c, w * sand.mu_int, w * sand.mu_surf)
     state = _foot_state(num_worlds, device)
@@ -309,13 +321,14 @@ def _variant_vs_default(cfg: Any, num_worlds: int, device: str, variant: str) ->
     and the per-point outputs, and after the step also every state array.
     """
     outs: list[list[np.ndarray]] = []
+    points = POINT_ARRAYS if split_variant(variant)[1] else ()  # without point outputs: wrench and state only
     for v in ("default", variant):
         model, state = _prepared_model(cfg, num_worlds, device, True, v)
         arrays = []
         model.compute(*state)
-        arrays += [state[5].numpy().copy(), *(getattr(model, n).numpy().copy() for n in POINT_ARRAYS)]
+        arrays += [state[5].numpy().copy(), *(getattr(model, n).numpy().copy() for n in points)]
         model.compute_and_update_state(*state)
-        arrays += [state[5].numpy().copy(), *(getattr(model, n).numpy().copy() for n in (*POINT_ARRAYS, *STATE_ARRAYS))]
+        arrays += [state[5].numpy().copy(), *(getattr(model, n).numpy().copy() for n in (*points, *STATE_ARRAYS))]
         outs.append([a.astype(np.float64) for a in arrays])
     return max(float(np.abs(a - b).max() / max(np.abs(b).max(), 1e-30)) for b, a in zip(*outs, strict=True))
 
@@ -327,7 +340,7 @@ def bench_variant_record(name: str, faces: Literal["sole", "box"], variant: str,
     cfg = _model_cfgs(faces)[name]
     model, state = _prepared_model(cfg, args.num_worlds, args.device, True, variant)
     calls: dict[str, Callable[[], object]] = {"compute": lambda: model.compute(*state)}
-    if variant != LEGACY_VARIANT:  # legacy's step is the default step kernel
+    if split_variant(variant)[0] != LEGACY_VARIANT:  # legacy's step is the default step kernel
         calls["step"] = lambda: model.compute_and_update_state(*state)
     rec: dict[str, Any] = {"variant": variant}
     rec.update(_timed(calls, args))

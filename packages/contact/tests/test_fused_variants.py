@@ -82,10 +82,30 @@ def test_variant_kernels() -> None:
     """Each register cap is one kernel (default names kept); legacy has its own compute kernel; unknown refused."""
     assert fused_kernel("default", False).key == "rft3d_foot_wrench_kernel"
     assert fused_kernel("default", True).key == "rft3d_foot_step_kernel"
-    assert fused_kernel("nocap", False) is fused_kernel("default", False)  # both uncapped
+    assert fused_kernel("cap96", False) is fused_kernel("default", False)  # both capped at 96
+    assert fused_kernel("nocap", False).key == "rft3d_foot_wrench_kernel_maxregnone"
     assert fused_kernel("nocap", True).key == "rft3d_foot_step_kernel_maxregnone"
+    assert fused_kernel("default", True, points=False).key == "rft3d_foot_step_kernel_nopoints"
+    assert fused_kernel("cap80", False, points=False).key == "rft3d_foot_wrench_kernel_maxreg80_nopoints"
     assert fused_kernel("cap80", True).key == "rft3d_foot_step_kernel_maxreg80"
     assert fused_kernel(LEGACY_VARIANT, False).key == "rft3d_foot_wrench_legacy_kernel"
     assert fused_kernel(LEGACY_VARIANT, True) is fused_kernel("default", True)
     with pytest.raises(ValueError, match="unknown fused variant"):
         fused_kernel("fast", False)
+
+
+def test_without_point_outputs_same_wrench_and_state(device: str) -> None:
+    """``point_outputs`` False: the same wrench and state bit for bit, and the per-point arrays stay unwritten."""
+    ref, var = model("default"), model("default")
+    var.point_outputs = False
+    for feet in sequence():
+        for step in (False, True):
+            outs = [wp.zeros((W, F), dtype=wp.spatial_vectorf, device="cpu") for _ in range(2)]
+            for m, out in zip((ref, var), outs, strict=True):
+                (m.compute_and_update_state if step else m.compute)(*feet, out)
+            np.testing.assert_array_equal(outs[1].numpy(), outs[0].numpy(), err_msg=f"wrench step={step}")
+            for name in COMPARED[3:]:
+                np.testing.assert_array_equal(getattr(var, name).numpy(), getattr(ref, name).numpy(), err_msg=name)
+    assert np.abs(ref.point_force.numpy()).max() > 0.0
+    for name in COMPARED[:3]:
+        assert not getattr(var, name).numpy().any(), name

@@ -320,14 +320,20 @@ def eval_rft3d_point_forces(model: Any, inputs: tuple, nan_count_out: wp.array) 
     )
 
 
-def _rft3d_foot_wrench_kernel(advance: bool, name: str, max_registers: int | None) -> wp.Kernel:
+def _rft3d_foot_wrench_kernel(advance: bool, points: bool, name: str, max_registers: int | None) -> wp.Kernel:
     """Return the fused 3D-RFT kernel, compiled with (advance=True) or without the state update.
 
+    ``points`` False leaves out the per-point outputs (``point_force`` / ``point_depth`` / ``point_vel``, 28 B of
+    stores per element): the wrench and the state are the same bit for bit; for callers that read only the wrench
+    (training, see ``ContactModel.point_outputs``).
+
     Two specializations of one source (``wp.static``): the compute-only kernel carries no state-update code. On
-    sm_90 (NVRTC, block 160 for 150 points) the compute-only kernel uses 96 registers per thread, i.e. 4 blocks
-    of 5 warps per SM; the state update would raise that to 108 (3 blocks per SM). Recomputing x and n for the
-    update (below) and a 96-register cap keep the step kernel at 96 registers with no spill (cuobjdump
-    -res-usage: the same 32-byte stack, no local memory as the compute-only kernel), so it keeps the occupancy.
+    sm_90 (NVRTC, block 160 for 150 points) 96 registers per thread give 4 blocks of 5 warps per SM; the state
+    update would raise the step kernel to 108 (3 blocks per SM). Recomputing x and n for the update (below) and a
+    96-register cap keep the step kernel at 96 registers with no spill (cuobjdump -res-usage: the same 32-byte
+    stack, no local memory as the compute-only kernel), so it keeps the occupancy. Both kernels are capped at 96
+    by default: on an H100 (4,096 worlds, 150 points) the uncapped compute kernel took 85.7 us against 70.4 us
+    capped (``results/benchmarks``, fourth run).
     ``max_registers``: the per-thread register cap (``None``: the compiler's choice); see :data:`FUSED_VARIANTS`.
     """
 
@@ -381,7 +387,8 @@ def _rft3d_foot_wrench_kernel(advance: bool, name: str, max_registers: int | Non
                     torque_sum += wp.cross(kin[0] - com, force)
             else:
                 wp.atomic_add(nan_count_out, 0, 1)
-            write_element(force, depth, kin[2], point_force_out, point_depth_out, point_vel_out, w, f, p)
+            if wp.static(points):
+                write_element(force, depth, kin[2], point_force_out, point_depth_out, point_vel_out, w, f, p)
             if wp.static(advance):
                 # x and n recomputed with the same function instead of kept live across the force evaluation
                 # (registers, see above); unused for a non-finite foot (depth 0: no anchor update)
@@ -395,7 +402,7 @@ def _rft3d_foot_wrench_kernel(advance: bool, name: str, max_registers: int | Non
 
 
 FUSED_VARIANTS: dict[str, tuple[int | None, int | None]] = {
-    "default": (None, 96),
+    "default": (96, 96),
     "nocap": (None, None),
     "cap96": (96, 96),
     "cap80": (80, 80),
@@ -403,21 +410,22 @@ FUSED_VARIANTS: dict[str, tuple[int | None, int | None]] = {
 }
 """Register caps (compute kernel, step kernel) of the fused 3D-RFT kernel variants, by name (``None``: no cap).
 
-Same source, same results bit for bit (only register allocation differs); ``"default"`` is what compute() and
+Same source, same results bit for bit (only register allocation differs); ``"default"`` (= ``"cap96"``) is what compute() and
 compute_and_update_state() launch unless a model's ``fused_variant`` says otherwise (benchmarks). ``"legacy"``
 (compute() only) is the pre-``RFT3DModel`` kernel, kept to time the argument layout against the struct.
 """
 LEGACY_VARIANT = "legacy"
 """Variant name of :data:`rft3d_foot_wrench_legacy_kernel` (compute() only; the step falls back to the default)."""
 
-_FUSED_KERNELS: dict[tuple[bool, int | None], wp.Kernel] = {}
+_FUSED_KERNELS: dict[tuple[bool, bool, int | None], wp.Kernel] = {}
 
 
-def fused_kernel(variant: str, advance: bool) -> wp.Kernel:
+def fused_kernel(variant: str, advance: bool, points: bool = True) -> wp.Kernel:
     """Return the fused kernel of a variant (:data:`FUSED_VARIANTS` or ``"legacy"``), built once per register cap.
 
     Kernels with the default variant's cap keep the plain names; others are suffixed ``_maxreg<cap>`` /
-    ``_maxregnone`` (one Warp module each, compiled on first launch).
+    ``_maxregnone`` (one Warp module each, compiled on first launch). ``points`` False: the kernel without the
+    per-point outputs (suffix ``_nopoints``; the legacy variant always writes them).
     """
     if variant == LEGACY_VARIANT and not advance:
         return rft3d_foot_wrench_legacy_kernel
@@ -425,12 +433,14 @@ def fused_kernel(variant: str, advance: bool) -> wp.Kernel:
         raise ValueError(f"unknown fused variant {variant!r}: {[*FUSED_VARIANTS, LEGACY_VARIANT]}")
     default_cap = FUSED_VARIANTS["default"][advance]
     cap = default_cap if variant == LEGACY_VARIANT else FUSED_VARIANTS[variant][advance]
-    if (advance, cap) not in _FUSED_KERNELS:
+    if (advance, points, cap) not in _FUSED_KERNELS:
         name = "rft3d_foot_step_kernel" if advance else "rft3d_foot_wrench_kernel"
         if cap != default_cap:
             name += f"_maxreg{cap if cap is not None else 'none'}"
-        _FUSED_KERNELS[advance, cap] = _rft3d_foot_wrench_kernel(advance, name, cap)
-    return _FUSED_KERNELS[advance, cap]
+        if not points:
+            name += "_nopoints"
+        _FUSED_KERNELS[advance, points, cap] = _rft3d_foot_wrench_kernel(advance, points, name, cap)
+    return _FUSED_KERNELS[advance, points, cap]
 
 
 rft3d_foot_wrench_kernel = fused_kernel("default", False)
@@ -545,10 +555,11 @@ def eval_rft3d_foot_wrench(model: Any, inputs: tuple, wrench_out: wp.array, adva
 
     ``advance`` False: :data:`rft3d_foot_wrench_kernel` (compute()); True: :data:`rft3d_foot_step_kernel`, which
     also advances the element state (compute() + update_state() in one launch). ``model.fused_variant`` (default
-    ``"default"``) picks the kernel variant (:func:`fused_kernel`; all give the same results bit for bit).
+    ``"default"``) picks the kernel variant (:func:`fused_kernel`; all give the same results bit for bit);
+    ``model.point_outputs`` False launches the kernel that leaves the per-point outputs unwritten.
     """
     variant = getattr(model, "fused_variant", "default")
-    kernel = fused_kernel(variant, advance)
+    kernel = fused_kernel(variant, advance, getattr(model, "point_outputs", True))
     dim = (model.num_worlds, model.num_feet)
     if kernel is rft3d_foot_wrench_legacy_kernel:
         wp.launch_tiled(

@@ -83,7 +83,8 @@ class ContactModel:
         point_depth: Element depth below the local free surface [m], wp.array3d[float] [W, F, P].
         point_force: Element force of the medium on the foot [N], wp.array3d[wp.vec3] [W, F, P].
         point_vel: Element velocity [m/s], wp.array3d[wp.vec3] [W, F, P]. point_depth / point_force / point_vel
-            are written by compute() (the last call's inputs); update_state() does not rewrite them.
+            are written by compute() (the last call's inputs; not on the fused path with ``point_outputs`` False);
+            update_state() does not rewrite them.
         force_prev: Previous substep's element force [N], [W, F, P]: kept only in ``at_rest="ema"``, the only
             mode that reads it.
         anchor: Stick anchor of each submerged element, world frame [m], [W, F, P] (3D-RFT static friction).
@@ -99,6 +100,10 @@ class ContactModel:
     kept as the parity oracle of the tile sums and for benchmarks; both paths evaluate each element with the
     same functions (same results to float32 round-off in the sum order). update_state() is one path;
     compute_and_update_state() is one launch on the fused 3D-RFT path, else compute() then update_state()."""
+    point_outputs: bool = True
+    """Whether compute() writes ``point_force`` / ``point_depth`` / ``point_vel`` (per-element diagnostics).
+    False (training: only the wrench is read) skips those stores on the fused 3D-RFT path; the wrench and the
+    state are unchanged bit for bit. Other paths need the per-point arrays and always write them."""
     _vertical_only: int = 0
     _eval_points: Callable[[Any, tuple, wp.array], None]
     _eval_fused: Callable[..., None] | None = None
