@@ -186,3 +186,60 @@ def test_foot_wrenches_push_the_robot_as_in_mujoco_c(device: str) -> None:
     impulse = n * DT * wrenches[:, :3].sum(axis=0)
     np.testing.assert_allclose(momentum, np.broadcast_to(impulse, (2, 3)), atol=0.01 * np.linalg.norm(impulse))
     assert source.updates == n
+
+
+def _sand_run(one_launch: bool, device: str, steps: int) -> tuple[np.ndarray, list[np.ndarray]]:
+    """Step the G1 dropped 3 cm into 3D-RFT dry sand; return qpos and the model's state arrays after ``steps``."""
+    from gmloco.contact import MATERIAL_PRESETS, ContactRFT3DCfg, make_contact_model
+
+    model = _g1_model(9.81)
+    sim = _simulation(model, 2, device)
+    feet = [model.body(n).id for n in FEET]
+    contact = make_contact_model(ContactRFT3DCfg(), 2, len(feet), device)
+    sand = MATERIAL_PRESETS["dry_sand"]
+    contact.set_materials(np.full(2, sand.rho_c), np.full(2, sand.mu_int), np.full(2, sand.mu_surf))
+    contact.point_outputs = False
+    coupling = ContactCoupling(contact, sim, feet, stateful=True, one_launch=one_launch)
+    assert coupling.one_launch == one_launch
+    coupling.install()
+    data = mujoco.MjData(model)
+    mujoco.mj_forward(model, data)
+    sole_z = min(data.xpos[f][2] for f in feet)  # foot origins; the soles sit a few cm below them
+    qpos = np.broadcast_to(model.qpos0, (2, model.nq)).copy()
+    qpos[:, 2] = model.qpos0[2] - sole_z - 0.01  # origins 1 cm above the surface: sole elements submerged
+    qpos[1, 0] = 0.05  # the second world differs, so per-world bookkeeping shows
+    sim.data.qpos[:] = torch.as_tensor(qpos, dtype=torch.float32, device=sim.data.qpos.device)
+    sim.forward()
+    for _ in range(steps):
+        sim.step()
+        sim.forward()  # forward passes in between must not advance the state
+    state = [a.numpy().copy() for a in (contact.depth_max, contact.ema_tau, contact.vel_prev, contact.anchor)]
+    return sim.data.qpos.cpu().numpy(), state
+
+
+def test_one_launch_step_equals_compute_then_update_state(device: str) -> None:
+    """The one-launch path (state advanced inside the step's callback) gives the two-launch trajectory and state.
+
+    30 substeps of a G1 sinking into 3D-RFT dry sand (elements in both branches, sticking anchors), with a
+    ``sim.forward()`` after every step: qpos and every state array agree to float32 round-off, and the state is
+    not trivially zero (the comparison would otherwise prove nothing).
+    """
+    q1, s1 = _sand_run(True, device, 30)
+    q2, s2 = _sand_run(False, device, 30)
+    np.testing.assert_allclose(q1, q2, atol=1e-6)
+    for a, b in zip(s1, s2, strict=True):
+        np.testing.assert_allclose(a, b, atol=1e-6)
+    assert s1[0].max() > 1e-3  # some element reached more than 1 mm depth
+
+
+def test_one_launch_is_off_for_models_without_it(device: str) -> None:
+    """A model without compute_and_update_state keeps the two-launch path (update_state after each step)."""
+    model = _g1_model(0.0)
+    sim = _simulation(model, 1, device)
+    source = ConstantWrench(np.zeros((2, 6)))
+    coupling = ContactCoupling(source, sim, [model.body(n).id for n in FEET])
+    assert not coupling.one_launch
+    coupling.install()
+    for _ in range(3):
+        sim.step()
+    assert source.updates == 3

@@ -60,6 +60,7 @@ def test_standing_robot_sinks_as_rft_predicts(make_env) -> None:  # noqa: ANN001
     task = replace(task, material=replace(task.material, preset="dry_sand"))
     task.terrain.floor.enabled = False
     env = make_env(task, num_envs=1)
+    env.sand.model.point_outputs = True  # the per-point depths are read below (CPU: no captured graph to redo)
     env.reset()
     weight = float(env.sim.mj_model.body_subtreemass[env.scene["robot"].indexing.root_body_id] * 9.81)
     fz, depth = [], []

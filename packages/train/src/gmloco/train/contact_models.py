@@ -45,10 +45,14 @@ def contact_terrain_cfg(terrain: SandTerrainCfg) -> Any:
 
 
 def build_contact_model(task: GranularTaskCfg, num_envs: int, device: wp.context.Device) -> tuple[Any, bool]:
-    """Build the task's contact model for ``num_envs`` worlds; returns ``(model, stateful)``."""
+    """Build the task's contact model for ``num_envs`` worlds; returns ``(model, stateful)``.
+
+    The model skips its per-point outputs (``point_outputs`` False): the environment reads only the foot wrenches.
+    """
     cfg = contact_model_cfg(task.contact_model)
     terrain = contact_terrain_cfg(task.terrain)
     model = gc.make_contact_model(cfg, num_envs, NUM_FEET, str(device), terrain=terrain)
+    model.point_outputs = False  # training reads only the wrenches (set True before install() to inspect points)
     return model, bool(getattr(model, "is_stateful", True))
 
 
