@@ -23,14 +23,14 @@ max |W_unfused| after one compute on the benchmark state (float32 round-off expe
 is 3D-RFT with ``static_friction=False`` (the cost of the stick anchors).
 
 Kernel variants (``--variants``, default ``default``; ``all`` = every one): the fused 3D-RFT kernels compiled with
-other register caps or the pre-``RFT3DModel`` argument layout (``gmloco.contact.kernels_rft3d.FUSED_VARIANTS``,
-``"legacy"``: compute() only), selected through ``model.fused_variant``. Each 3D-RFT fused record carries
-``variant``; every other variant gets its own record ``<key>/<variant>`` right after the default one (same process,
-same state): compute_s, step_s (not for ``legacy``: its step is the default kernel) and
-``max_rel_diff_vs_default``, the max relative difference of the wrench, the per-point outputs and every state array
-to the default kernels after compute() and then compute_and_update_state() from the benchmark state (0 expected).
-``nocap``'s compute kernel is the default one (both uncapped): a repeat measurement in the same run. A variant
-comparison on the GPU, e.g. (about 3 min, mostly NVRTC compiles)::
+other register caps (``gmloco.contact.kernels_rft3d.FUSED_VARIANTS``), selected through ``model.fused_variant``,
+and each of them with the suffix ``-nopoints`` (``model.point_outputs`` False: no per-point stores). Each 3D-RFT
+fused record carries ``variant``; every other variant gets its own record ``<key>/<variant>`` right after the
+default one (same process, same state): compute_s, step_s and ``max_rel_diff_vs_default``, the max relative
+difference of the wrench, the per-point outputs (not for ``-nopoints``) and every state array to the default kernels
+after compute() and then compute_and_update_state() from the benchmark state (0 expected). ``cap96``'s kernels are
+the default ones (both capped at 96): a repeat measurement in the same run. A variant comparison on the GPU, e.g.
+(about 3 min, mostly NVRTC compiles)::
 
     python3 scripts/gpu/bench_contact.py --models rft3d --paths fused --variants all --skip-sim \
         --reps 1000 --repeat 5 --warm-s 0.5 --out $OUT/variants
@@ -67,9 +67,9 @@ VARIANT_MODELS = ("rft3d", "rft3d_viscous")
 
 def all_variants() -> tuple[str, ...]:
     """Return every fused 3D-RFT kernel variant name, ``"default"`` first."""
-    from gmloco.contact.kernels_rft3d import FUSED_VARIANTS, LEGACY_VARIANT
+    from gmloco.contact.kernels_rft3d import FUSED_VARIANTS
 
-    return (*FUSED_VARIANTS, LEGACY_VARIANT, *(v + NOPOINTS for v in FUSED_VARIANTS))
+    return (*FUSED_VARIANTS, *(v + NOPOINTS for v in FUSED_VARIANTS))
 
 
 NOPOINTS = "-nopoints"
@@ -335,13 +335,12 @@ def _variant_vs_default(cfg: Any, num_worlds: int, device: str, variant: str) ->
 
 def bench_variant_record(name: str, faces: Literal["sole", "box"], variant: str, args: argparse.Namespace) -> dict:
     """Seconds per call of a fused 3D-RFT kernel variant's compute (and step), with its difference to the default."""
-    from gmloco.contact.kernels_rft3d import LEGACY_VARIANT
-
     cfg = _model_cfgs(faces)[name]
     model, state = _prepared_model(cfg, args.num_worlds, args.device, True, variant)
-    calls: dict[str, Callable[[], object]] = {"compute": lambda: model.compute(*state)}
-    if split_variant(variant)[0] != LEGACY_VARIANT:  # legacy's step is the default step kernel
-        calls["step"] = lambda: model.compute_and_update_state(*state)
+    calls: dict[str, Callable[[], object]] = {
+        "compute": lambda: model.compute(*state),
+        "step": lambda: model.compute_and_update_state(*state),
+    }
     rec: dict[str, Any] = {"variant": variant}
     rec.update(_timed(calls, args))
     rec["launches"] = {k: _launches(fn) for k, fn in calls.items()}

@@ -64,7 +64,7 @@ def test_bench_times_every_kernel_variant_side_by_side(tmp_path: Path) -> None:
     for rec in res["models"].values():  # median of the three timed runs
         assert len(rec["compute_s_runs"]) == 3 and rec["compute_s"] == sorted(rec["compute_s_runs"])[1]
     variants = bench.all_variants()
-    assert res["variants"] == list(variants) and variants[0] == "default" and "legacy" in variants
+    assert res["variants"] == list(variants) and variants[0] == "default" and "default-nopoints" in variants
     keys = [k for k in res["models"] if k.startswith("rft3d/150pt")]
     assert keys == ["rft3d/150pt", *(f"rft3d/150pt/{v}" for v in variants[1:])]  # side by side, in order
     for points in (25, 150):
@@ -72,8 +72,8 @@ def test_bench_times_every_kernel_variant_side_by_side(tmp_path: Path) -> None:
         for v in variants[1:]:
             rec = res["models"][f"rft3d/{points}pt/{v}"]
             assert rec["variant"] == v and rec["compute_s"] > 0.0 and rec["max_rel_diff_vs_default"] == 0.0
-            assert ("step_s" in rec) == (v != "legacy")
-    assert res["models"]["rft3d/150pt/legacy"]["launches"]["compute"] == ["rft3d_foot_wrench_legacy_kernel"]
+            assert "step_s" in rec
+    assert res["models"]["rft3d/150pt/default-nopoints"]["launches"]["step"] == ["rft3d_foot_step_kernel_nopoints"]
     assert res["models"]["rft3d/150pt/cap80"]["launches"]["step"] == ["rft3d_foot_step_kernel_maxreg80"]
     assert "variant" not in res["models"]["cone_multi/25pt"] and "cone_multi/25pt/cap80" not in res["models"]
     assert bench.main([*argv, "--models", "rft3d", "--variants", "fast"]) == 2

@@ -1,11 +1,10 @@
 # SPDX-License-Identifier: Apache-2.0
-"""Fused 3D-RFT kernel variants (register caps, the pre-RFT3DModel argument layout): same results bit for bit.
+"""Fused 3D-RFT kernel variants (register caps, without per-point outputs): same results bit for bit.
 
 The variants exist for benchmarks (scripts/gpu/bench_contact.py ``--variants``). Each must give what the default
 kernels give: wrench, per-point outputs and state compared with ``assert_array_equal`` over a substep sequence with
 pressing, unloading (elastic branch), sliding, lift-off and a non-finite foot. On the CPU the register caps are
-no-ops (the CPU build ignores them), so there the check covers the variant plumbing and the legacy kernel's
-separate source; the GPU benchmark records each variant's difference to the default (``max_rel_diff_vs_default``).
+no-ops (the CPU build ignores them), so there the check covers the variant plumbing; the GPU benchmark records each variant's difference to the default (``max_rel_diff_vs_default``).
 """
 
 from __future__ import annotations
@@ -15,7 +14,7 @@ import pytest
 import warp as wp
 
 from gmloco.contact import ContactModel, ContactRFT3DCfg, g1_foot_box_cfg, make_contact_model
-from gmloco.contact.kernels_rft3d import FUSED_VARIANTS, LEGACY_VARIANT, fused_kernel
+from gmloco.contact.kernels_rft3d import FUSED_VARIANTS, fused_kernel
 
 W, F = 3, 2
 SOLE_Z = -0.03539
@@ -55,7 +54,7 @@ def model(variant: str) -> ContactModel:
     return m
 
 
-@pytest.mark.parametrize("variant", [v for v in (*FUSED_VARIANTS, LEGACY_VARIANT) if v != "default"])
+@pytest.mark.parametrize("variant", [v for v in FUSED_VARIANTS if v != "default"])
 def test_variant_equals_default(device: str, variant: str) -> None:
     """compute() and compute_and_update_state() of a variant equal the default kernels' bit for bit."""
     ref, var = model("default"), model(variant)
@@ -79,7 +78,7 @@ def test_variant_equals_default(device: str, variant: str) -> None:
 
 
 def test_variant_kernels() -> None:
-    """Each register cap is one kernel (default names kept); legacy has its own compute kernel; unknown refused."""
+    """Each register cap is one kernel (default names kept); unknown refused."""
     assert fused_kernel("default", False).key == "rft3d_foot_wrench_kernel"
     assert fused_kernel("default", True).key == "rft3d_foot_step_kernel"
     assert fused_kernel("cap96", False) is fused_kernel("default", False)  # both capped at 96
@@ -88,8 +87,6 @@ def test_variant_kernels() -> None:
     assert fused_kernel("default", True, points=False).key == "rft3d_foot_step_kernel_nopoints"
     assert fused_kernel("cap80", False, points=False).key == "rft3d_foot_wrench_kernel_maxreg80_nopoints"
     assert fused_kernel("cap80", True).key == "rft3d_foot_step_kernel_maxreg80"
-    assert fused_kernel(LEGACY_VARIANT, False).key == "rft3d_foot_wrench_legacy_kernel"
-    assert fused_kernel(LEGACY_VARIANT, True) is fused_kernel("default", True)
     with pytest.raises(ValueError, match="unknown fused variant"):
         fused_kernel("fast", False)
 

@@ -28,12 +28,10 @@ from gmloco.contact.kernels_state import (
     crater_friction,
     elastic_depth,
     point_kernel_data,
-    rft_element_model,
 )
 
 __all__ = [
     "FUSED_VARIANTS",
-    "LEGACY_VARIANT",
     "RFT3DCoeffs",
     "RFT3DModel",
     "eval_rft3d_foot_wrench",
@@ -411,28 +409,23 @@ FUSED_VARIANTS: dict[str, tuple[int | None, int | None]] = {
 """Register caps (compute kernel, step kernel) of the fused 3D-RFT kernel variants, by name (``None``: no cap).
 
 Same source, same results bit for bit (only register allocation differs); ``"default"`` (= ``"cap96"``) is what compute() and
-compute_and_update_state() launch unless a model's ``fused_variant`` says otherwise (benchmarks). ``"legacy"``
-(compute() only) is the pre-``RFT3DModel`` kernel, kept to time the argument layout against the struct.
+compute_and_update_state() launch unless a model's ``fused_variant`` says otherwise (benchmarks).
 """
-LEGACY_VARIANT = "legacy"
-"""Variant name of :data:`rft3d_foot_wrench_legacy_kernel` (compute() only; the step falls back to the default)."""
 
 _FUSED_KERNELS: dict[tuple[bool, bool, int | None], wp.Kernel] = {}
 
 
 def fused_kernel(variant: str, advance: bool, points: bool = True) -> wp.Kernel:
-    """Return the fused kernel of a variant (:data:`FUSED_VARIANTS` or ``"legacy"``), built once per register cap.
+    """Return the fused kernel of a variant (:data:`FUSED_VARIANTS`), built once per register cap.
 
     Kernels with the default variant's cap keep the plain names; others are suffixed ``_maxreg<cap>`` /
     ``_maxregnone`` (one Warp module each, compiled on first launch). ``points`` False: the kernel without the
-    per-point outputs (suffix ``_nopoints``; the legacy variant always writes them).
+    per-point outputs (suffix ``_nopoints``).
     """
-    if variant == LEGACY_VARIANT and not advance:
-        return rft3d_foot_wrench_legacy_kernel
-    if variant != LEGACY_VARIANT and variant not in FUSED_VARIANTS:
-        raise ValueError(f"unknown fused variant {variant!r}: {[*FUSED_VARIANTS, LEGACY_VARIANT]}")
+    if variant not in FUSED_VARIANTS:
+        raise ValueError(f"unknown fused variant {variant!r}: {list(FUSED_VARIANTS)}")
     default_cap = FUSED_VARIANTS["default"][advance]
-    cap = default_cap if variant == LEGACY_VARIANT else FUSED_VARIANTS[variant][advance]
+    cap = FUSED_VARIANTS[variant][advance]
     if (advance, points, cap) not in _FUSED_KERNELS:
         name = "rft3d_foot_step_kernel" if advance else "rft3d_foot_wrench_kernel"
         if cap != default_cap:
@@ -449,107 +442,6 @@ rft3d_foot_step_kernel = fused_kernel("default", True)
 """Fused compute_and_update_state(): as :data:`rft3d_foot_wrench_kernel`, then each lane advances its elements."""
 
 
-@wp.func
-def _legacy_rft3d_element_force(
-    kin: wp.mat33,
-    depth: float,
-    area: float,
-    mat: wp.vec3,
-    gravity: float,
-    coeffs: RFT3DCoeffs,
-    v_eps: float,
-    sign_fix: int,
-    rest: AtRestParams,
-    state: ElementState,
-    w: int,
-    f: int,
-    p: int,
-) -> wp.vec3:
-    """:func:`rft3d_element_force` with the model data as separate arguments (the layout before RFT3DModel)."""
-    n = kin[1]
-    v = kin[2]
-    xi = media_scaling(mat[0], mat[1], gravity)
-    depth_max = state.depth_max[w, f, p]
-    force = wp.vec3(0.0)
-    if rest.mode == AT_REST_UNLOADING and depth > 0.0 and depth < depth_max:
-        offset = wp.vec3(0.0)
-        if rest.stick_distance > 0.0:
-            offset = kin[0] - state.anchor[w, f, p]
-        tau_rev = state.ema_tau[w, f, p]
-        force = rft3d_elastic_force(n, v, offset, depth, depth_max, area, xi, mat[2], coeffs, rest, tau_rev)
-    else:
-        force = rft3d_plastic_force(n, v, depth, area, xi, mat[2], coeffs, v_eps, sign_fix)
-    return at_rest_filter(force, v, depth, rest, state, w, f, p, 0)
-
-
-@wp.kernel
-def rft3d_foot_wrench_legacy_kernel(
-    # Model:
-    coeffs: RFT3DCoeffs,
-    points_b: wp.array[wp.vec3],
-    normals_b: wp.array[wp.vec3],
-    areas: wp.array[float],
-    rho_c: wp.array[float],
-    mu_int: wp.array[float],
-    mu_surf: wp.array[float],
-    terrain: TerrainData,
-    gravity: float,
-    v_eps: float,
-    sign_fix: int,
-    rest: AtRestParams,
-    # Data in:
-    foot_pos_in: wp.array2d[wp.vec3],
-    foot_mat_in: wp.array2d[wp.mat33],
-    foot_lin_vel_in: wp.array2d[wp.vec3],
-    foot_ang_vel_in: wp.array2d[wp.vec3],
-    foot_com_in: wp.array2d[wp.vec3],
-    state_in: ElementState,
-    # Data out:
-    point_force_out: wp.array3d[wp.vec3],
-    point_depth_out: wp.array3d[float],
-    point_vel_out: wp.array3d[wp.vec3],
-    wrench_out: wp.array2d[wp.spatial_vector],
-    nan_count_out: wp.array[int],
-) -> None:
-    """The fused compute() kernel of commit 9af447a (separate model arguments, inline element body), for timing.
-
-    In this file's module, as it was then (not a ``"unique"`` module like the current fused kernels).
-
-    Same outputs as :data:`rft3d_foot_wrench_kernel` bit for bit (same element functions, same order).
-    """
-    w, f, lane = wp.tid()
-    pos = foot_pos_in[w, f]
-    rot = foot_mat_in[w, f]
-    lin_vel = foot_lin_vel_in[w, f]
-    ang_vel = foot_ang_vel_in[w, f]
-    com = foot_com_in[w, f]
-    finite = foot_inputs_finite(pos, rot, lin_vel, ang_vel)
-    force_sum = wp.vec3(0.0)
-    torque_sum = wp.vec3(0.0)
-    for p in range(lane, points_b.shape[0], wp.block_dim()):
-        force = wp.vec3(0.0)
-        depth = 0.0
-        v = wp.vec3(0.0)
-        if finite:
-            kin = foot_point_kinematics(pos, rot, lin_vel, ang_vel, points_b[p], normals_b[p])
-            x = kin[0]
-            v = kin[2]
-            depth = terrain_height(terrain, x[0], x[1]) - x[2]
-            if depth > 0.0 or rest.mode == AT_REST_EMA:
-                mat = point_material(terrain, rho_c, mu_int, mu_surf, w, x[0])
-                force = _legacy_rft3d_element_force(
-                    kin, depth, areas[p], mat, gravity, coeffs, v_eps, sign_fix, rest, state_in, w, f, p
-                )
-                force_sum += force
-                torque_sum += wp.cross(x - com, force)
-        else:
-            wp.atomic_add(nan_count_out, 0, 1)
-        write_element(force, depth, v, point_force_out, point_depth_out, point_vel_out, w, f, p)
-    wrench = foot_wrench_block_sum(wp.spatial_vector(force_sum, torque_sum), pos, rot, com, lane, nan_count_out)
-    if lane == 0:
-        wrench_out[w, f] = wrench
-
-
 def eval_rft3d_foot_wrench(model: Any, inputs: tuple, wrench_out: wp.array, advance: bool = False) -> None:
     """Launch the fused 3D-RFT kernel over [num_worlds, num_feet] blocks of :func:`tile_block_dim` lanes.
 
@@ -561,16 +453,6 @@ def eval_rft3d_foot_wrench(model: Any, inputs: tuple, wrench_out: wp.array, adva
     variant = getattr(model, "fused_variant", "default")
     kernel = fused_kernel(variant, advance, getattr(model, "point_outputs", True))
     dim = (model.num_worlds, model.num_feet)
-    if kernel is rft3d_foot_wrench_legacy_kernel:
-        wp.launch_tiled(
-            kernel,
-            dim=dim,
-            inputs=[model.coeffs, *rft_element_model(model), int(model.cfg.sign_fix), model.rest, *inputs, model.state],
-            outputs=[model.point_force, model.point_depth, model.point_vel, wrench_out, model.nan_count],
-            block_dim=tile_block_dim(model.num_points),
-            device=model.device,
-        )
-        return
     wp.launch_tiled(
         kernel,
         dim=dim,

@@ -44,7 +44,7 @@ class ContactRFT3D(ContactModel):
     _eval_points = staticmethod(eval_rft3d_point_forces)
     _eval_fused = staticmethod(eval_rft3d_foot_wrench)
     fused_variant: str = "default"
-    """Fused kernel variant (:data:`~gmloco.contact.kernels_rft3d.FUSED_VARIANTS` or ``"legacy"``): register caps /
+    """Fused kernel variant (:data:`~gmloco.contact.kernels_rft3d.FUSED_VARIANTS`): register caps /
     argument layout for benchmarks; every variant gives the same results bit for bit."""
 
     def __init__(
