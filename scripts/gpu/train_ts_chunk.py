@@ -10,7 +10,8 @@
 2. Trains with :func:`gmloco.train.train` (``TeacherPPO`` / ``StudentPPO``; time box ``--max-minutes`` minus
    ``--post-minutes`` kept for step 3). The DR leaves out the held-out (rho_c, mu_int) region
    (:data:`gmloco.train.teacher_student.DEFAULT_HELD_OUT`) unless ``--no-held-out``.
-3. Rebuilds the newest checkpoint on a small play-mode env and rolls it out on the training DR: R^2 / MAE of the
+3. Rebuilds the newest checkpoint on a small play-mode env and rolls it out on the training DR's materials in deep
+   sand (no hard floor, as the evaluations; the curriculum's floor would sit at the surface in play mode): R^2 / MAE of the
    decoded eta (teacher: psi(mu); student: psi(z_hat) and the teacher's psi(mu) on the student's states) and the
    student-vs-teacher action error. For the student it also exports ``policy.onnx`` (+ ``policy.json``) with deploy
    metadata and checks it against torch on random inputs and in a rollout with env resets (``OnnxPolicyRunner``).
@@ -233,7 +234,8 @@ def _last_values(curve: dict[str, list[float]], window: int = 10) -> dict[str, f
 
 
 def _post_checks(args: argparse.Namespace, task: Any, checkpoint: Path, run_dir: Path) -> dict[str, Any]:
-    """Decoded-eta rollout on the DR; for the student also the ONNX export and its parity checks."""
+    """Decoded-eta rollout on the DR (deep sand, no floor); for the student also the ONNX export and parity checks."""
+    from gmloco.train.evaluation import RolloutCriteriaCfg
     from gmloco.train.evaluation_ts import decoded_eta_check
     from gmloco.train.teacher_student.export_student import (
         build_runner,
@@ -242,7 +244,9 @@ def _post_checks(args: argparse.Namespace, task: Any, checkpoint: Path, run_dir:
         student_policy_metadata,
     )
 
-    play = replace(task, play=True)
+    # Deep sand as in the evaluations: in play mode there is no floor curriculum, so the training floor would stay
+    # at level 0 (at the surface) and the feet would never sink (nothing for the student to sense eta from).
+    play = replace(task, play=True, terrain=replace(task.terrain, floor=RolloutCriteriaCfg().floor))
     runner = build_runner(
         play, _entries(args), args.history_length, checkpoint, args.device, args.check_envs, args.seed + 1
     )
