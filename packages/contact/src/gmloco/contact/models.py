@@ -44,8 +44,8 @@ class ContactRFT3D(ContactModel):
     _eval_points = staticmethod(eval_rft3d_point_forces)
     _eval_fused = staticmethod(eval_rft3d_foot_wrench)
     fused_variant: str = "default"
-    """Fused kernel variant (:data:`~gmloco.contact.kernels_rft3d.FUSED_VARIANTS`): register caps /
-    argument layout for benchmarks; every variant gives the same results bit for bit."""
+    """Fused kernel variant (:data:`~gmloco.contact.kernels_rft3d.FUSED_VARIANTS`): register caps for benchmarks;
+    every variant gives the same results bit for bit."""
 
     def __init__(
         self, cfg: ContactRFT3DCfg, num_worlds: int, num_feet: int, device: str, terrain: TerrainCfg | None = None
