@@ -98,19 +98,28 @@ SAND_OOL: dict[str, dict[str, list[float]]] = {
 """Out-of-library effects of the sand suite."""
 
 
-def sand_episode_list(seeds: int = 1, nulls: int = 6, material: str = "dry_sand", seed_offset: int = 0) -> list[dict]:
-    """Episodes of the sand suite: the walking policy on 3D-RFT sand, logged odometry (mocap), 1 m/s.
+def sand_episode_list(
+    seeds: int = 1, nulls: int = 6, material: str = "dry_sand", seed_offset: int = 0, motion: str = "walk"
+) -> list[dict]:
+    """Episodes of the sand suite: the walking policy on 3D-RFT sand, logged odometry (mocap).
 
-    Seeds 2000+ (effects), 2100+ (out of library) and 3000+ (nulls) are disjoint from the tuning nulls
-    (200-203) that set the sand floors; ``seed_offset`` is added to every seed (names are unchanged).
+    ``motion`` names the command schedule (``policy_motion.MOTIONS``): ``walk`` (1 m/s, the suite through v3;
+    names ``sand-*``) or ``composite`` (stand, three speeds, a turn; names ``sandc-*``). Every episode carries
+    its ``motion``. Seeds 2000+ (effects), 2100+ (out of library) and 3000+ (nulls) are disjoint from the tuning
+    nulls (200-203) that set the sand floors; ``seed_offset`` is added to every seed (names are unchanged).
     """
-    common = {"ground": "sand", "material": material, "policy": True, "odometry": True}
+    from gmloco.deploy.mismatch.benchmark.policy_motion import MOTIONS
+
+    if motion not in MOTIONS:
+        raise ValueError(f"unknown motion {motion!r}; known: {sorted(MOTIONS)}")
+    pre = "sand" if motion == "walk" else "sandc"
+    common = {"ground": "sand", "material": material, "policy": True, "odometry": True, "motion": motion}
     eps = []
     for eid, p in SAND_MID.items():
         for seed in range(seeds):
             eps.append(
                 {
-                    "name": f"sand-{eid}-mid-{seed}",
+                    "name": f"{pre}-{eid}-mid-{seed}",
                     "effect": eid,
                     "params": p,
                     "strength": "mid",
@@ -120,7 +129,7 @@ def sand_episode_list(seeds: int = 1, nulls: int = 6, material: str = "dry_sand"
     for seed in range(nulls):
         eps.append(
             {
-                "name": f"sand-none-{seed}",
+                "name": f"{pre}-none-{seed}",
                 "effect": "none",
                 "params": {},
                 "strength": "none",
@@ -131,7 +140,7 @@ def sand_episode_list(seeds: int = 1, nulls: int = 6, material: str = "dry_sand"
         for seed in range(max(1, seeds)):
             eps.append(
                 {
-                    "name": f"sand-{eid}-{seed}",
+                    "name": f"{pre}-{eid}-{seed}",
                     "effect": eid,
                     "params": p,
                     "strength": "mid",

@@ -8,7 +8,7 @@ Usage::
 
 Without ``--params`` the benchmark's mid strength is used (the sand suite's with ``--sand``). ``--sand`` makes the
 recording on the project's 3D-RFT sand with the walking policy (``artifacts/ppo_rft3d/policy.onnx``) and logs
-odometry, as the sand suite does; analyse it with ``gmloco-mismatch --ground sand``. Only the channels a G1 logs are written (LowState,
+odometry, as the sand suite does (``--motion composite``: stand, three speeds and a turn, 18 s); analyse it with ``gmloco-mismatch --ground sand``. Only the channels a G1 logs are written (LowState,
 LowCmd, IMU; no odometry unless ``--odometry``). Give the MCAP to ``gmloco-mismatch --real``; keep the key away
 from it.
 """
@@ -26,30 +26,34 @@ def main(argv: list[str] | None = None) -> None:
     """Generate the recording and write the MCAP and the key."""
     from gmloco.deploy.mismatch.benchmark.episodes import MID, OOL, SAND_MID, SAND_OOL
     from gmloco.deploy.mismatch.benchmark.generator import EpisodeCfg, generate
-    from gmloco.deploy.mismatch.benchmark.policy_motion import PolicyMotionCfg
+    from gmloco.deploy.mismatch.benchmark.policy_motion import MOTIONS, motion_cfg
     from gmloco.deploy.mismatch.benchmark.truth import TruthEffect
     from gmloco.deploy.mismatch.io import write_recording
 
     p = argparse.ArgumentParser(prog="make_recording", description=__doc__)
     p.add_argument("--effect", default="none", help="effect id, 'none', or an ool.* id")
     p.add_argument("--params", default=None, help="JSON dict of parameter lists (default: mid strength)")
-    p.add_argument("--duration", type=float, default=9.0, help="recording length [s]")
+    p.add_argument(
+        "--duration", type=float, default=None, help="recording length [s] (default 9; with --sand the motion's)"
+    )
     p.add_argument("--seed", type=int, default=100)
     p.add_argument("--odometry", action="store_true", help="also log ground-truth base odometry")
     p.add_argument("--sand", action="store_true", help="walking policy on 3D-RFT dry sand, with odometry")
+    p.add_argument("--motion", choices=sorted(MOTIONS), default="walk", help="with --sand: walk (1 m/s) or composite")
     p.add_argument("--out", type=Path, required=True, help="MCAP to write")
     p.add_argument("--key", type=Path, required=True, help="truth key JSON (keep it where the tool cannot read it)")
     a = p.parse_args(argv)
     table = {**SAND_MID, **SAND_OOL} if a.sand else {**MID, **OOL}
     params = json.loads(a.params) if a.params else table.get(a.effect, {})
+    duration = a.duration if a.duration is not None else MOTIONS[a.motion] if a.sand else 9.0
     rec, key = generate(
         EpisodeCfg(
             effect=TruthEffect(a.effect, params),
-            duration=a.duration,
+            duration=duration,
             seed=a.seed,
             odometry=a.odometry or a.sand,
             ground="sand" if a.sand else "plane",
-            policy=PolicyMotionCfg() if a.sand else None,
+            policy=motion_cfg(a.motion) if a.sand else None,
         )
     )
     a.out.parent.mkdir(parents=True, exist_ok=True)

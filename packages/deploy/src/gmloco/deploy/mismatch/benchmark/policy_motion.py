@@ -15,7 +15,21 @@ import numpy as np
 
 from gmloco.deploy.logs.g1 import G1_JOINT_NAMES
 
-__all__ = ["PolicyMotion", "PolicyMotionCfg"]
+__all__ = ["COMPOSITE_SCHEDULE", "MOTIONS", "PolicyMotion", "PolicyMotionCfg", "motion_cfg"]
+
+Segment = tuple[float, float, float, float]
+"""One command-schedule segment: (start time [s], forward speed [m/s], lateral speed [m/s], yaw rate [rad/s])."""
+
+COMPOSITE_SCHEDULE: tuple[Segment, ...] = (
+    (0.0, 0.0, 0.0, 0.0),
+    (3.0, 0.5, 0.0, 0.0),
+    (7.0, 1.0, 0.0, 0.0),
+    (11.0, 1.5, 0.0, 0.0),
+    (14.0, 0.8, 0.0, 0.5),
+)
+"""The composite motion: stand 3 s, walk at 0.5, 1.0 and 1.5 m/s, then a 0.5 rad/s left turn at 0.8 m/s (to the
+end of the recording; 18 s in all). Within the policy's training ranges (forward up to 1.7 m/s and yaw rate up to
+0.7 rad/s from the second command stage on)."""
 
 
 @dataclass
@@ -25,9 +39,36 @@ class PolicyMotionCfg:
     path: str = "artifacts/ppo_rft3d/policy.onnx"
     """Exported policy (``gmloco.train`` export metadata: gains, default pose, history, action scale)."""
     speed: float = 1.0
-    """Commanded forward speed [m/s]."""
+    """Commanded forward speed [m/s] (when ``schedule`` is None)."""
     stand_time: float = 0.5
-    """Zero command before walking [s]."""
+    """Zero command before walking [s] (when ``schedule`` is None)."""
+    schedule: tuple[Segment, ...] | None = None
+    """Piecewise-constant command schedule, segments sorted by start time, the first at 0 s; each holds until the
+    next starts (the last to the end). None: zero for ``stand_time``, then ``speed`` forward."""
+
+    def command(self, t: float) -> np.ndarray:
+        """Velocity command (forward [m/s], lateral [m/s], yaw rate [rad/s]) at time ``t`` [s], shape [3]."""
+        if self.schedule is None:
+            return np.array([self.speed if t >= self.stand_time else 0.0, 0.0, 0.0])
+        cur = self.schedule[0]
+        for seg in self.schedule:
+            if t + 1e-9 >= seg[0]:
+                cur = seg
+        return np.array(cur[1:], float)
+
+
+MOTIONS: dict[str, float] = {"walk": 8.0, "composite": 18.0}
+"""Named sand-suite motions and their recording lengths [s]: ``walk`` (1 m/s after 0.5 s standing, the suite's
+motion through v3) and ``composite`` (:data:`COMPOSITE_SCHEDULE`)."""
+
+
+def motion_cfg(name: str = "walk") -> PolicyMotionCfg:
+    """The policy motion called ``name`` (a key of :data:`MOTIONS`)."""
+    if name == "walk":
+        return PolicyMotionCfg()
+    if name == "composite":
+        return PolicyMotionCfg(schedule=COMPOSITE_SCHEDULE)
+    raise ValueError(f"unknown motion {name!r}; known: {sorted(MOTIONS)}")
 
 
 class PolicyMotion:
@@ -68,7 +109,7 @@ class PolicyMotion:
         w, x, y, z = quat
         # projected gravity: R^T (0, 0, -1) for the body rotation R of quaternion (w, x, y, z)
         grav = -np.array([2 * (x * z - w * y), 2 * (y * z + w * x), 1 - 2 * (x * x + y * y)])
-        cmd = np.array([self.cfg.speed if t >= self.cfg.stand_time else 0.0, 0.0, 0.0])
+        cmd = self.cfg.command(t)
         terms = {
             "base_ang_vel": gyro,
             "projected_gravity": grav,

@@ -36,7 +36,7 @@ def run_episode(
     ``effects`` limits the tool's screening to a subset of the library (quick checks); None screens all.
     """
     from gmloco.deploy.mismatch.benchmark.generator import EpisodeCfg, generate
-    from gmloco.deploy.mismatch.benchmark.policy_motion import PolicyMotionCfg
+    from gmloco.deploy.mismatch.benchmark.policy_motion import motion_cfg
     from gmloco.deploy.mismatch.benchmark.truth import TruthEffect
     from gmloco.deploy.mismatch.effects import EFFECT_IDS
     from gmloco.deploy.mismatch.pipeline import AnalysisCfg, analyze
@@ -54,7 +54,7 @@ def run_episode(
                 keep_before_fall=keep_before_fall,
                 ground="sand" if sand else "plane",
                 material=ep.get("material", "dry_sand"),
-                policy=PolicyMotionCfg() if ep.get("policy") else None,
+                policy=motion_cfg(ep.get("motion", "walk")) if ep.get("policy") else None,
                 odometry=bool(ep.get("odometry", False)),
             )
         )
@@ -183,9 +183,19 @@ def _git_commit() -> dict:
 
 
 def _manifest(
-    out: Path, argv: list[str], eps: list[dict], todo: list[dict], wall: float, cpu: float, git: dict
+    out: Path,
+    argv: list[str],
+    eps: list[dict],
+    todo: list[dict],
+    wall: float,
+    cpu: float,
+    git: dict,
+    policy_motion: str | None = None,
 ) -> None:
-    """Append this invocation to ``manifest.json``: commit, command line, configuration and timing."""
+    """Append this invocation to ``manifest.json``: commit, command line, configuration and timing.
+
+    ``policy_motion``: the sand suite's motion name (its command schedule is recorded), None for the plane.
+    """
     import os
     import platform
     from dataclasses import asdict
@@ -194,6 +204,7 @@ def _manifest(
 
     from gmloco.deploy.mismatch.benchmark.controller import MotionCfg
     from gmloco.deploy.mismatch.benchmark.generator import EpisodeCfg
+    from gmloco.deploy.mismatch.benchmark.policy_motion import motion_cfg
     from gmloco.deploy.mismatch.pipeline import AnalysisCfg
 
     ep_cfg = asdict(EpisodeCfg())
@@ -206,6 +217,9 @@ def _manifest(
         "command": "python -m gmloco.deploy.mismatch.benchmark.sweep " + " ".join(argv),
         "episode_cfg": ep_cfg,
         "motion": asdict(MotionCfg()),
+        "policy_motion": None
+        if policy_motion is None
+        else {"name": policy_motion, **asdict(motion_cfg(policy_motion))},
         "analysis_cfg": asdict(AnalysisCfg()),
         "episodes": [e["name"] for e in eps],
         "wall_s_this_invocation": wall,
@@ -224,6 +238,7 @@ def _manifest(
 def main(argv: list[str] | None = None) -> None:
     """Run the sweep and write ``summary.json`` and ``manifest.json``."""
     from gmloco.deploy.mismatch.benchmark.episodes import episode_list, sand_episode_list
+    from gmloco.deploy.mismatch.benchmark.policy_motion import MOTIONS
     from gmloco.deploy.mismatch.benchmark.scorer import score
 
     p = argparse.ArgumentParser()
@@ -231,7 +246,18 @@ def main(argv: list[str] | None = None) -> None:
     p.add_argument("--workers", type=int, default=2)
     p.add_argument("--seeds", type=int, default=1)
     p.add_argument("--nulls", type=int, default=20)
-    p.add_argument("--duration", type=float, default=8.0)
+    p.add_argument(
+        "--duration",
+        type=float,
+        default=None,
+        help="recording length [s] (default: 8 on the plane, the motion's length on sand: walk 8, composite 18)",
+    )
+    p.add_argument(
+        "--motion",
+        choices=("walk", "composite"),
+        default="walk",
+        help="sand suite's policy command schedule (walk: 1 m/s; composite: stand, 0.5/1.0/1.5 m/s, a turn)",
+    )
     p.add_argument("--strengths", default="mid")
     p.add_argument("--suite", choices=("plane", "sand"), default="plane", help="plane: scripted stepping; sand: policy")
     p.add_argument(
@@ -271,7 +297,7 @@ def main(argv: list[str] | None = None) -> None:
             (a.out / "summary_pooled.json").write_text(json.dumps(pooled, indent=2, default=float))
         return
     if a.suite == "sand":
-        eps = sand_episode_list(a.seeds, a.nulls, seed_offset=a.seed_offset)
+        eps = sand_episode_list(a.seeds, a.nulls, seed_offset=a.seed_offset, motion=a.motion)
     else:
         eps = episode_list(a.seeds, a.nulls, tuple(a.strengths.split(",")), seed_offset=a.seed_offset)
     eps = _part(eps, a.part)
@@ -282,7 +308,8 @@ def main(argv: list[str] | None = None) -> None:
     t0, git = time.time(), _git_commit()
     deadline = None if a.deadline_s is None else t0 + a.deadline_s
     effects = tuple(a.effects.split(",")) if a.effects else None
-    args = [(e, str(a.out), a.duration, a.keep_before_fall, effects, deadline) for e in todo]
+    duration = a.duration if a.duration is not None else MOTIONS[a.motion] if a.suite == "sand" else 8.0
+    args = [(e, str(a.out), duration, a.keep_before_fall, effects, deadline) for e in todo]
     with Pool(a.workers) as pool:
         fresh = pool.map(_star, args, chunksize=1)
     cpu = sum(os.times()[2:4])
@@ -298,7 +325,7 @@ def main(argv: list[str] | None = None) -> None:
     (a.out / "rows.json").write_text(json.dumps(rows, indent=1, default=float))
     summary = {**score(rows), "episodes_scored": len(rows), "missing": missing, "wall_s": time.time() - t0}
     (a.out / "summary.json").write_text(json.dumps(summary, indent=2, default=float))
-    _manifest(a.out, argv, eps, todo, time.time() - t0, cpu, git)
+    _manifest(a.out, argv, eps, todo, time.time() - t0, cpu, git, a.motion if a.suite == "sand" else None)
 
 
 if __name__ == "__main__":
