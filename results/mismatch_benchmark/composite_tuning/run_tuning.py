@@ -40,12 +40,17 @@ def main() -> None:
         help="JSON parameters replacing the suite's mid strength (one effect); rows go to OUT/<motion>_<tag>/",
     )
     p.add_argument("--tag", default=None, help="folder suffix for --params runs")
+    p.add_argument(
+        "--seed-index", type=int, default=0, help="k: seeds EFFECT_SEED + k and NULL_SEED + k (names end -k)"
+    )
     a = p.parse_args()
     for eid in a.episodes.split(","):
         for motion in a.motions.split(","):
             eps = sand_episode_list(1, 1, motion=motion)
             ep = next(e for e in eps if e["effect"] == eid)
-            ep = {**ep, "seed": NULL_SEED if eid == "none" else EFFECT_SEED}
+            k = a.seed_index
+            name = ep["name"].rsplit("-", 1)[0] + f"-{k}"
+            ep = {**ep, "name": name, "seed": (NULL_SEED if eid == "none" else EFFECT_SEED) + k}
             out = a.out / motion
             if a.params is not None:
                 if a.tag is None:
