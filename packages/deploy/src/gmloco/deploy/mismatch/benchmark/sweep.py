@@ -166,7 +166,10 @@ def _part(eps: list[dict], spec: str | None) -> list[dict]:
     """Episodes at the positions ``i``, ``i + n``, ... of the list for ``spec`` = ``"i/n"`` (all for None)."""
     if spec is None:
         return eps
-    i, n = (int(x) for x in spec.split("/"))
+    try:
+        i, n = (int(x) for x in spec.split("/"))
+    except ValueError:
+        raise ValueError(f"--part {spec!r}: give I/N with whole numbers, e.g. --part 0/2") from None
     if not 0 <= i < n:
         raise ValueError(f"--part {spec}: need 0 <= i < n")
     return eps[i::n]
@@ -254,7 +257,7 @@ def main(argv: list[str] | None = None) -> None:
     )
     p.add_argument(
         "--motion",
-        choices=("walk", "composite"),
+        choices=sorted(MOTIONS),
         default="walk",
         help="sand suite's policy command schedule (walk: 1 m/s; composite: stand, 0.5/1.0/1.5 m/s, a turn)",
     )
