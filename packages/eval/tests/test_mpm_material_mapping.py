@@ -14,17 +14,18 @@ import numpy as np
 import pytest
 
 from gmloco.contact.materials import MATERIAL_PRESETS
-from gmloco.eval.mpm.materials import mpm_material
+from gmloco.eval.mpm.materials import drucker_prager_friction, mpm_material
 
 
 def test_mapping_fields_and_newton_attributes() -> None:
-    """rho_c -> density, mu_int -> friction, mu_surf -> collider friction; every written attribute exists in Newton."""
+    """rho_c -> density, mu_int -> DP friction, mu_surf -> collider friction; every attribute exists in Newton."""
     import newton
 
     m = MATERIAL_PRESETS["dry_sand"]
     mat = mpm_material(m)
     assert mat.density == pytest.approx(m.rho_c) and mat.density == pytest.approx(1500.0)
-    assert mat.friction == pytest.approx(m.mu_int) and mat.collider_friction == pytest.approx(m.mu_surf)
+    assert mat.friction == pytest.approx(drucker_prager_friction(m.mu_int)) and mat.friction == pytest.approx(0.7171, abs=1e-4)
+    assert mat.collider_friction == pytest.approx(m.mu_surf)
     builder = newton.ModelBuilder()
     newton.solvers.SolverImplicitMPM.register_custom_attributes(builder)
     builder.add_particle((0.0, 0.0, 0.0), (0.0, 0.0, 0.0), mass=1.0, radius=0.01)
@@ -33,6 +34,21 @@ def test_mapping_fields_and_newton_attributes() -> None:
         assert hasattr(model.mpm, name), name
     # hardening must stay 0: Newton scales the yield pressure by sinh(-h log Jp), which is 0 at Jp = 1 (fresh bed)
     assert mat.hardening == 0.0
+
+
+def test_drucker_prager_friction_matches_mohr_coulomb_compression() -> None:
+    """The cone through Mohr-Coulomb's compression corners: hand values, zero at zero, increasing, bad input refused."""
+    assert drucker_prager_friction(0.0) == 0.0
+    assert drucker_prager_friction(math.tan(math.radians(30.0))) == pytest.approx(6 * 0.5 / (math.sqrt(3) * 2.5))
+    mus = np.linspace(0.0, 1.5, 31)
+    assert np.all(np.diff([drucker_prager_friction(float(m)) for m in mus]) > 0.0)
+    # in triaxial compression (s2 = s3 = p - q/3, s1 = p + 2q/3) Mohr-Coulomb's limit q/p equals the cone's sqrt(3) mu
+    phi = math.atan(0.6)
+    q_over_p = 6 * math.sin(phi) / (3 - math.sin(phi))
+    assert math.sqrt(3.0) * drucker_prager_friction(0.6) == pytest.approx(q_over_p)
+    for bad in (-0.1, float("nan")):
+        with pytest.raises(ValueError, match="mu_int"):
+            drucker_prager_friction(bad)
 
 
 YieldProbe = Callable[..., np.ndarray]
