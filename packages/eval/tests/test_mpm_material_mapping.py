@@ -24,7 +24,9 @@ def test_mapping_fields_and_newton_attributes() -> None:
     m = MATERIAL_PRESETS["dry_sand"]
     mat = mpm_material(m)
     assert mat.density == pytest.approx(m.rho_c) and mat.density == pytest.approx(1500.0)
-    assert mat.friction == pytest.approx(drucker_prager_friction(m.mu_int)) and mat.friction == pytest.approx(0.7171, abs=1e-4)
+    assert mat.friction == pytest.approx(drucker_prager_friction(m.mu_int)) and mat.friction == pytest.approx(
+        0.7171, abs=1e-4
+    )
     assert mat.collider_friction == pytest.approx(m.mu_surf)
     builder = newton.ModelBuilder()
     newton.solvers.SolverImplicitMPM.register_custom_attributes(builder)

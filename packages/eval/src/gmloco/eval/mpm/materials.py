@@ -118,8 +118,10 @@ def mpm_material(material: GranularMaterial, **overrides: Any) -> MpmMaterialCfg
 
 
 def drucker_prager_friction(mu_int: float) -> float:
-    """Return Newton's ``mpm:friction`` for an internal friction coefficient: the Drucker-Prager cone through the
-    Mohr-Coulomb triaxial-compression corners, 6 sin(phi) / (sqrt(3) (3 - sin(phi))) with phi = atan(mu_int) [-].
+    """Return Newton's ``mpm:friction`` [-] for an internal friction coefficient mu_int = tan(phi).
+
+    The Drucker-Prager cone through the Mohr-Coulomb triaxial-compression corners:
+    6 sin(phi) / (sqrt(3) (3 - sin(phi))).
 
     Args:
         mu_int: Internal friction coefficient tan(phi) [-], >= 0.
