@@ -73,3 +73,29 @@ def test_deadline_skips_unstarted_episodes_and_lists_them_as_missing(tmp_path: P
     assert not (tmp_path / "rows").exists()
     inv = json.loads((tmp_path / "manifest.json").read_text())["invocations"][-1]
     assert set(inv["source_sha256"]) == {"mismatch", "contact"} and "mujoco" in inv
+
+
+def test_strength_table_v4_with_parts_and_resume(tmp_path: Path) -> None:
+    """``--strength-table v4 --part 3/8 --resume``: part 3's 12 sand episodes; an existing row is not run again.
+
+    The row already there is scored; the manifest records the table (depth hardening at 150 1/m).
+    """
+    from gmloco.deploy.mismatch.benchmark.episodes import sand_episode_list
+    from gmloco.deploy.mismatch.benchmark.sweep import _part
+
+    args = ["--out", str(tmp_path), "--suite", "sand", "--motion", "composite", "--strength-table", "v4"]
+    args += ["--seeds", "2", "--seed-offset", "20000", "--nulls", "64", "--part", "3/8", "--resume"]
+    args += ["--workers", "1", "--deadline-s", "-1"]
+    part = _part(sand_episode_list(2, 64, seed_offset=20000, motion="composite", table="v4"), "3/8")
+    null = next(e for e in part if e["effect"] == "none")
+    (tmp_path / "rows").mkdir(parents=True)
+    (tmp_path / "rows" / f"{null['name']}.json").write_text(json.dumps({**null, "verdict": "no_mismatch"}))
+    main(args)
+    summary = json.loads((tmp_path / "summary.json").read_text())
+    assert summary["episodes_scored"] == 1 and summary["overall"]["null_episodes"] == 1
+    assert sorted(summary["missing"]) == sorted(e["name"] for e in part if e is not null)
+    inv = json.loads((tmp_path / "manifest.json").read_text())["invocations"][-1]
+    assert inv["episodes"] == [e["name"] for e in part] and len(part) == 12
+    assert null["name"] not in inv["episodes_run_by_this_invocation"]
+    assert inv["strength_table"]["name"] == "v4"
+    assert inv["strength_table"]["mid"]["terrain.depth_hardening"] == {"kappa": [150.0]}

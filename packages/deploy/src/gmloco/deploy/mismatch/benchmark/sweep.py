@@ -3,7 +3,8 @@
 
 Usage: ``python -m gmloco.deploy.mismatch.benchmark.sweep --out DIR [--workers N] [--seeds 2] [--nulls 8]``
 (``--seed-offset K`` for fresh seeds, ``--part I/N`` for one of N interleaved parts of the list,
-``--deadline-s S`` to start no episode after S seconds; ``--resume`` runs what is left).
+``--deadline-s S`` to start no episode after S seconds; ``--resume`` runs what is left; ``--strength-table v4``
+for benchmark v4's mid strengths).
 Each worker generates the "real" recording, writes the truth key under ``DIR/keys/`` (never passed to the
 tool), analyses the recording with the tool, and then computes the oracle held-out energy with the true
 parameters for the scorer.
@@ -194,10 +195,12 @@ def _manifest(
     cpu: float,
     git: dict,
     policy_motion: str | None = None,
+    strength_table: dict | None = None,
 ) -> None:
     """Append this invocation to ``manifest.json``: commit, command line, configuration and timing.
 
     ``policy_motion``: the sand suite's motion name (its command schedule is recorded), None for the plane.
+    ``strength_table``: the name and the mid strengths of the suite's strength table.
     """
     import os
     import platform
@@ -223,6 +226,7 @@ def _manifest(
         "policy_motion": None
         if policy_motion is None
         else {"name": policy_motion, **asdict(motion_cfg(policy_motion))},
+        "strength_table": strength_table,
         "analysis_cfg": asdict(AnalysisCfg()),
         "episodes": [e["name"] for e in eps],
         "wall_s_this_invocation": wall,
@@ -240,7 +244,7 @@ def _manifest(
 
 def main(argv: list[str] | None = None) -> None:
     """Run the sweep and write ``summary.json`` and ``manifest.json``."""
-    from gmloco.deploy.mismatch.benchmark.episodes import episode_list, sand_episode_list
+    from gmloco.deploy.mismatch.benchmark.episodes import STRENGTH_TABLES, episode_list, sand_episode_list
     from gmloco.deploy.mismatch.benchmark.policy_motion import MOTIONS
     from gmloco.deploy.mismatch.benchmark.scorer import score
 
@@ -261,7 +265,13 @@ def main(argv: list[str] | None = None) -> None:
         default="walk",
         help="sand suite's policy command schedule (walk: 1 m/s; composite: stand, 0.5/1.0/1.5 m/s, a turn)",
     )
-    p.add_argument("--strengths", default="mid")
+    p.add_argument("--strengths", default="mid", help="plane: comma-separated strength levels (low, mid, high)")
+    p.add_argument(
+        "--strength-table",
+        choices=sorted(STRENGTH_TABLES),
+        default="v3",
+        help="mid-strength table (v3: the stock strengths; v4: every mid strength >= 1.5x the effect's tolerance)",
+    )
     p.add_argument("--suite", choices=("plane", "sand"), default="plane", help="plane: scripted stepping; sand: policy")
     p.add_argument(
         "--keep-before-fall",
@@ -300,9 +310,11 @@ def main(argv: list[str] | None = None) -> None:
             (a.out / "summary_pooled.json").write_text(json.dumps(pooled, indent=2, default=float))
         return
     if a.suite == "sand":
-        eps = sand_episode_list(a.seeds, a.nulls, seed_offset=a.seed_offset, motion=a.motion)
+        eps = sand_episode_list(a.seeds, a.nulls, seed_offset=a.seed_offset, motion=a.motion, table=a.strength_table)
     else:
-        eps = episode_list(a.seeds, a.nulls, tuple(a.strengths.split(",")), seed_offset=a.seed_offset)
+        eps = episode_list(
+            a.seeds, a.nulls, tuple(a.strengths.split(",")), seed_offset=a.seed_offset, table=a.strength_table
+        )
     eps = _part(eps, a.part)
     if a.only:
         eps = [e for e in eps if any(e["name"].startswith(s) for s in a.only.split(","))]
@@ -328,7 +340,8 @@ def main(argv: list[str] | None = None) -> None:
     (a.out / "rows.json").write_text(json.dumps(rows, indent=1, default=float))
     summary = {**score(rows), "episodes_scored": len(rows), "missing": missing, "wall_s": time.time() - t0}
     (a.out / "summary.json").write_text(json.dumps(summary, indent=2, default=float))
-    _manifest(a.out, argv, eps, todo, time.time() - t0, cpu, git, a.motion if a.suite == "sand" else None)
+    table = {"name": a.strength_table, "mid": STRENGTH_TABLES[a.strength_table][a.suite]}
+    _manifest(a.out, argv, eps, todo, time.time() - t0, cpu, git, a.motion if a.suite == "sand" else None, table)
 
 
 if __name__ == "__main__":
