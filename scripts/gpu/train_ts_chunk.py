@@ -72,6 +72,14 @@ def _parse(argv: list[str] | None) -> argparse.Namespace:
         "decoded-eta error, so the TCN learned z's non-terrain part first)",
     )
     p.add_argument("--no-held-out", action="store_true", help="let the DR draw the held-out region too")
+    p.add_argument(
+        "--reward-weight",
+        action="append",
+        default=[],
+        metavar="NAME=WEIGHT",
+        help="override one reward term's weight (repeatable; 0 drops the term), e.g. foot_clearance_l2=-50; "
+        "pass the same overrides to every chunk of a run (the task is rebuilt from the arguments each chunk)",
+    )
     p.add_argument("--teacher-checkpoint", type=Path, default=None)
     p.add_argument(
         "--warm-start-ppo",
@@ -171,12 +179,29 @@ def _curriculum_scale(args: argparse.Namespace) -> float | None:
     return None
 
 
+def reward_weights(items: list[str]) -> dict[str, float]:
+    """Parse ``--reward-weight NAME=WEIGHT`` items into ``GranularTaskCfg.reward_weights``; exit on a malformed one."""
+    out: dict[str, float] = {}
+    for item in items:
+        name, sep, value = item.partition("=")
+        try:
+            if not sep or not name.strip():
+                raise ValueError(item)
+            out[name.strip()] = float(value)
+        except ValueError:
+            sys.exit(f"--reward-weight {item!r}: expected NAME=WEIGHT with a number, e.g. foot_clearance_l2=-50")
+    return out
+
+
 def _task(args: argparse.Namespace) -> Any:
     """The granular task: one actor frame (history goes through the encoders), DR without the held-out region."""
     from gmloco.train import g1_granular_task
     from gmloco.train.teacher_student.heldout import with_held_out
 
     task = replace(g1_granular_task(args.contact_model, args.terrain), policy_history_length=1)
+    weights = reward_weights(args.reward_weight)
+    if weights:
+        task = replace(task, reward_weights=weights)
     scale = _curriculum_scale(args)
     if scale is not None:
         task = replace(task, curriculum_scale=scale)

@@ -1,0 +1,44 @@
+# SPDX-License-Identifier: Apache-2.0
+"""scripts/gpu/train_ts_chunk.py: ``--reward-weight`` overrides reach the task (fast, no env built)."""
+
+from __future__ import annotations
+
+import importlib.util
+from pathlib import Path
+from types import ModuleType
+
+import pytest
+
+SCRIPT = Path(__file__).resolve().parents[2] / "scripts" / "gpu" / "train_ts_chunk.py"
+
+
+def _load() -> ModuleType:
+    spec = importlib.util.spec_from_file_location("train_ts_chunk", SCRIPT)
+    assert spec is not None and spec.loader is not None
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    return module
+
+
+def test_reward_weight_items_parse_and_reach_the_task() -> None:
+    """Repeated NAME=WEIGHT items become the task's reward_weights; without any the task keeps its defaults."""
+    chunk = _load()
+    assert chunk.reward_weights(["foot_clearance_l2=-50", " feet_air_time = 1.5"]) == {
+        "foot_clearance_l2": -50.0,
+        "feet_air_time": 1.5,
+    }
+    base = ["--stage", "teacher", "--out", "unused", "--no-held-out"]
+    task = chunk._task(chunk._parse([*base, "--reward-weight", "foot_clearance_l2=-50"]))
+    assert task.reward_weights == {"foot_clearance_l2": -50.0}
+    assert chunk._task(chunk._parse(base)).reward_weights == {}
+
+    from gmloco.train.tasks.g1_granular.rewards_cfg import make_rewards_cfg
+
+    assert make_rewards_cfg(task)["foot_clearance_l2"].weight == -50.0
+
+
+@pytest.mark.parametrize("item", ["foot_clearance_l2", "=3", "foot_clearance_l2=high"])
+def test_malformed_reward_weight_exits_with_the_expected_form(item: str) -> None:
+    """A malformed item stops the script and says which form is expected."""
+    with pytest.raises(SystemExit, match="NAME=WEIGHT"):
+        _load().reward_weights([item])
