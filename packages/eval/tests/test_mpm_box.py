@@ -17,9 +17,9 @@ GRAVITY = 9.81
 
 def test_material_mapping() -> None:
     """rho_c -> particle density, mu_int -> Drucker-Prager friction, mu_surf -> collider friction; cohesionless."""
-    mat = MATERIAL_PRESETS["dry_sand"]  # bulk 2500 x packing 0.6 -> rho_c 1500
+    mat = MATERIAL_PRESETS["dry_sand"]  # bulk 2500 x packing 0.6 -> rho_c 1500; mu_int 0.6 -> DP cone 0.717
     m = mpm_material(mat)
-    np.testing.assert_allclose([m.density, m.friction, m.collider_friction], [1500.0, 0.6, 0.4])
+    np.testing.assert_allclose([m.density, m.friction, m.collider_friction], [1500.0, 0.7171, 0.4], atol=1e-4)
     assert m.yield_stress == 0.0 and m.tensile_yield_ratio == 0.0 and m.critical_fraction == 0.0
 
 
