@@ -3,21 +3,15 @@
 
 from __future__ import annotations
 
-import importlib.util
-from pathlib import Path
 from types import ModuleType
 
 import pytest
 
-SCRIPT = Path(__file__).resolve().parents[2] / "scripts" / "gpu" / "train_ts_chunk.py"
+from tests.contact.by_path import load_module
 
 
 def _load() -> ModuleType:
-    spec = importlib.util.spec_from_file_location("train_ts_chunk", SCRIPT)
-    assert spec is not None and spec.loader is not None
-    module = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(module)
-    return module
+    return load_module("gpu_train_ts_chunk", "scripts/gpu/train_ts_chunk.py")
 
 
 def test_reward_weight_items_parse_and_reach_the_task() -> None:
