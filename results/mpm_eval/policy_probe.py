@@ -5,7 +5,9 @@ The scratch probe behind ``G1_SINKAGE.md``'s "policy on sand, 1 s" rows, made re
 (mjlab actor or gmloco student, ``gmloco.eval.g1_eval_policy.load_policy``). Same scene: ``G1MpmScene`` on
 ``terrain_cfg("dry_sand", depth)``, 5 cm voxels, 50 Gauss-Seidel iterations, sparse grid, 100 Hz frames, 200 Hz
 physics; a static 0.6 x 0.5 m window (``--window small``) or the evaluation's moving 1.8 x 1.0 m window
-(``--window eval``). ``--rigid``: no sand, the soles stand on the rigid floor (MuJoCo contact), as the probe's
+(``--window eval``). The numerics are defaults that ``--frame-dt``, ``--substeps``, ``--effective-mass`` and
+``--grid`` change. Rows also log the x sand force per foot and the sand height ahead of each sole (heave).
+``--rigid``: no sand, the soles stand on the rigid floor (MuJoCo contact), as the probe's
 rigid-floor control did. Appends one JSON record per run to ``--log``; prints the rows and a summary.
 
     uv run python results/mpm_eval/policy_probe.py --policy artifacts/ppo_rft3d/policy.onnx --label rft3d_v0
@@ -23,7 +25,7 @@ import numpy as np
 
 from gmloco.eval.g1_eval_policy import StudentOnnxPolicy, load_policy
 from gmloco.eval.mpm.box_scene import MpmSolverCfg
-from gmloco.eval.mpm.g1_scene import G1MpmScene, G1MpmSceneCfg
+from gmloco.eval.mpm.g1_scene import G1MpmScene, G1MpmSceneCfg, SoleCfg
 from gmloco.eval.mpm.window import SandWindowCfg
 from gmloco.eval.mpm.window_terrain import terrain_cfg
 
@@ -38,7 +40,14 @@ def make(policy: Any, args: argparse.Namespace) -> G1MpmScene:
     cfg = G1MpmSceneCfg(
         terrain=terrain_cfg("dry_sand", depth=depth),
         window=window,
-        solver=MpmSolverCfg(voxel_size=args.voxel, frame_dt=0.01, rigid_substeps=2, max_iterations=args.iterations),
+        solver=MpmSolverCfg(
+            voxel_size=args.voxel,
+            frame_dt=args.frame_dt,
+            rigid_substeps=args.substeps,
+            max_iterations=args.iterations,
+            grid_type=args.grid,
+        ),
+        sole=SoleCfg(effective_mass=args.effective_mass),
         commands=((args.vx, 0.0, 0.0),),
         # rigid floor: the soles start 5 mm above the floor at z = -depth
         drop_height=-(depth - 0.005) if args.rigid else 0.005,
@@ -85,6 +94,17 @@ def snap(scene: G1MpmScene, policy: Any) -> dict[str, Any]:
         pitch=[round(float(v), 1) for v in pitch], fz=[round(float(v), 1) for v in st["foot_force"][0, :, 2]],
         roll_deg=round(float(np.degrees(roll)), 1), pitch_deg=round(float(np.degrees(bpitch)), 1),
     )  # fmt: skip
+    row["fx"] = [round(float(v), 1) for v in st["foot_force"][0, :, 0]]
+    if hasattr(scene, "sand_state") and scene.sand_state is not None:
+        # sand heave: highest particle within 12 cm ahead of each sole's front edge (|dy| < 6 cm) and in the window
+        pq = scene.sand_state.particle_q.numpy()
+        ahead = []
+        for i in range(2):
+            front, y = c[i, :, 0].max(), c[i, :, 1].mean()
+            sel = (pq[:, 0] > front) & (pq[:, 0] < front + 0.12) & (np.abs(pq[:, 1] - y) < 0.06)
+            ahead.append(round(float(pq[sel, 2].max()), 4) if sel.any() else None)
+        row["sand_ahead_z"] = ahead
+        row["sand_max_z"] = round(float(pq[:, 2].max()), 4)
     if isinstance(policy, StudentOnnxPolicy) and policy.runner.eta is not None:
         row["eta"] = round(float(np.asarray(policy.runner.eta).reshape(-1)[0]), 4)
     return row
@@ -103,20 +123,27 @@ def main() -> None:
     p.add_argument("--iterations", type=int, default=50)
     p.add_argument("--window", choices=("small", "eval"), default="small")
     p.add_argument("--rigid", action="store_true", help="no sand: rigid floor only")
+    p.add_argument("--frame-dt", type=float, default=0.01, help="MPM frame = coupling period [s]")
+    p.add_argument("--substeps", type=int, default=2, help="rigid substeps per frame (physics dt = frame-dt / this)")
+    p.add_argument("--effective-mass", type=float, default=None, help="SoleCfg.effective_mass [kg]; default m / 2")
+    p.add_argument("--grid", choices=("sparse", "dense"), default="sparse", help="MPM grid type")
+    p.add_argument("--duration", type=float, default=None, help="simulated time [s]; overrides --frames")
     p.add_argument("--log", type=Path, default=Path("results/mpm_eval/policies_cpu.jsonl"))
     args = p.parse_args()
 
+    if args.duration is not None:
+        args.frames = round(args.duration / args.frame_dt)
     t = time.time()
     policy = load_policy(args.policy)
     scene = make(policy, args)
     if args.rigid:
         rigid_only(scene)
     mg = scene.robot_mass * 9.81
-    rows: list[dict[str, Any]] = [{"f": 0, **snap(scene, policy)}]
+    rows: list[dict[str, Any]] = [{"f": 0, "t": 0.0, **snap(scene, policy)}]
     for k in range(args.frames):
         scene.step()
         if (k + 1) % args.every == 0:
-            rows.append({"f": k + 1, **snap(scene, policy)})
+            rows.append({"f": k + 1, "t": round((k + 1) * args.frame_dt, 4), **snap(scene, policy)})
     for r in rows:
         print(args.label, r, flush=True)
     fz = np.array([sum(r["fz"]) for r in rows[len(rows) // 2 :]]) / mg
@@ -129,6 +156,7 @@ def main() -> None:
     rec = dict(
         label=args.label, policy=str(args.policy), vx_cmd=args.vx, window=args.window, rigid=args.rigid,
         depth=0.1 if args.rigid else args.depth, voxel=args.voxel, iterations=args.iterations, frames=args.frames,
+        frame_dt=args.frame_dt, substeps=args.substeps, effective_mass=args.effective_mass, grid=args.grid,
         mass=round(scene.robot_mass, 2), particles=scene.particle_count, rows=rows,
         support2=round(float(fz.mean()), 2), support_50hz=round(float(scene.support_ratio()[0]), 2),
         pelvis_min=round(min(float(bq[:, 2].min()), min(r["pz"] for r in rows)), 4), max_abs_sole_pitch=max(abs(v) for r in rows for v in r["pitch"]),
