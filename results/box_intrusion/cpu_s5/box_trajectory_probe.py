@@ -10,13 +10,9 @@ time [s], box centre x and z [m] (resting height on the undisturbed surface 0.1 
 from __future__ import annotations
 
 import argparse
-from dataclasses import replace
 
 import numpy as np
-
-from gmloco.contact import MaterialCfg
-from gmloco.eval.box_study import BoxStudyCfg, sample_media
-from gmloco.eval.mpm.box_scene import MpmBoxScene, MpmBoxSceneCfg, MpmSolverCfg
+from trial_scene import trial_scene  # this folder: the scripts run as `uv run python <path>`
 
 
 def main() -> None:
@@ -25,23 +21,13 @@ def main() -> None:
     p.add_argument("--trial", type=int, default=4)
     p.add_argument("--duration", type=float, default=1.0)
     args = p.parse_args()
-    study = BoxStudyCfg()
-    media = sample_media(replace(study, num_trials=args.trial + 1))
-    mat = MaterialCfg(*(float(media[k][args.trial]) for k in ("bulk_density", "packing", "mu_int", "mu_surf")))
-    cfg = MpmBoxSceneCfg(
-        box=replace(study.box, duration=args.duration),
-        bed=study.bed,
-        solver=MpmSolverCfg(voxel_size=0.05, max_iterations=250),
-        device="cpu",
-        rigid_solver="semi_implicit",
-    )
-    scene = MpmBoxScene(cfg, [mat])
+    _, scene = trial_scene(args.trial, args.duration)
     scene.run()
     q = np.array([b[0] for b in scene.body_q_all])
     x, y, z, w = q[:, 3], q[:, 4], q[:, 5], q[:, 6]
     pitch = np.degrees(np.arccos(np.clip(1 - 2 * (x * x + y * y), -1, 1))) * np.sign(2 * (x * z + w * y))
     for i in range(0, len(q), 3):
-        print(f"t={cfg.solver.frame_dt * (i + 1):.2f} x={q[i, 0]:.3f} z={q[i, 2]:.3f} pitch={pitch[i]:6.1f}")
+        print(f"t={scene.frame_dt * (i + 1):.2f} x={q[i, 0]:.3f} z={q[i, 2]:.3f} pitch={pitch[i]:6.1f}")
 
 
 if __name__ == "__main__":

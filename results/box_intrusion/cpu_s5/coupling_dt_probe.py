@@ -14,26 +14,19 @@ from __future__ import annotations
 import argparse
 import json
 import time
-from dataclasses import replace
 from pathlib import Path
 
 import numpy as np
+from trial_scene import trial_scene  # this folder: the scripts run as `uv run python <path>`
 
-from gmloco.contact import MaterialCfg
-from gmloco.eval.box_study import BoxStudyCfg, sample_media
-from gmloco.eval.mpm.box_scene import MpmBoxScene, MpmBoxSceneCfg, MpmSolverCfg
+from gmloco.eval.mpm.box_scene import MpmSolverCfg
 
 
 def run_one(trial: int, frame_dt: float, substeps: int, voxel: float, iterations: int, duration: float) -> dict:
     """Run one setting and summarise the box's path [m, m/s, N]."""
-    study = BoxStudyCfg()
-    media = sample_media(replace(study, num_trials=max(trial + 1, 1)))
-    mat = MaterialCfg(*(float(media[k][trial]) for k in ("bulk_density", "packing", "mu_int", "mu_surf")))
     solver = MpmSolverCfg(voxel_size=voxel, max_iterations=iterations, frame_dt=frame_dt, rigid_substeps=substeps)
-    cfg = MpmBoxSceneCfg(box=replace(study.box, duration=duration), bed=study.bed, solver=solver, device="cpu",
-                         rigid_solver="semi_implicit")  # fmt: skip
     t0 = time.perf_counter()
-    scene = MpmBoxScene(cfg, [mat])
+    mat, scene = trial_scene(trial, duration, solver)
     scene.run()
     q = np.array([b[0] for b in scene.body_q_all])
     t = frame_dt * np.arange(1, len(q) + 1)

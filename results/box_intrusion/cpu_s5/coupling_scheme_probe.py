@@ -19,16 +19,13 @@ launch, ``rest`` the box placed on the surface at rest. Prints the box centre x 
 from __future__ import annotations
 
 import argparse
-from dataclasses import replace
 from typing import Any
 
 import numpy as np
 import warp as wp
+from trial_scene import trial_scene  # this folder: the scripts run as `uv run python <path>`
 
 import gmloco.eval.mpm.kernels_coupling as coupling
-from gmloco.contact import MaterialCfg
-from gmloco.eval.box_study import BoxStudyCfg, sample_media
-from gmloco.eval.mpm.box_scene import MpmBoxScene, MpmBoxSceneCfg, MpmSolverCfg
 
 
 def _actual(inv_m: Any, inv_i: Any, dt: float, q: Any, qd: Any, w: Any, out: Any) -> None:
@@ -50,21 +47,10 @@ def main() -> None:
     args = p.parse_args()
     if args.scheme != "rewind":  # the scene imports the launcher at call time, so patching the module works
         coupling.eval_rewind_body_velocity = _actual if args.scheme == "actual" else _predicted  # type: ignore[assignment]
-    study = BoxStudyCfg()
-    media = sample_media(replace(study, num_trials=args.trial + 1))
-    mat = MaterialCfg(*(float(media[k][args.trial]) for k in ("bulk_density", "packing", "mu_int", "mu_surf")))
-    box = study.box if args.case == "launch" else replace(study.box, velocity=(0.0, 0.0), drop_height=0.0)
-    cfg = MpmBoxSceneCfg(
-        box=replace(box, duration=0.8),
-        bed=study.bed,
-        solver=MpmSolverCfg(voxel_size=0.05, max_iterations=250),
-        device="cpu",
-        rigid_solver="semi_implicit",
-    )
-    scene = MpmBoxScene(cfg, [mat])
+    _, scene = trial_scene(args.trial, 0.8, at_rest=args.case == "rest")
     scene.run()
     q = np.array([b[0] for b in scene.body_q_all])
-    cells = " ".join(f"{cfg.solver.frame_dt * (i + 1):.2f}:{q[i, 0]:.3f}/{q[i, 2]:.3f}" for i in range(0, len(q), 8))
+    cells = " ".join(f"{scene.frame_dt * (i + 1):.2f}:{q[i, 0]:.3f}/{q[i, 2]:.3f}" for i in range(0, len(q), 8))
     print(args.scheme, args.case, f"trial {args.trial}", cells)
 
 
