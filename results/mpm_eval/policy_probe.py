@@ -130,7 +130,11 @@ def main() -> None:
     p.add_argument("--duration", type=float, default=None, help="simulated time [s]; overrides --frames")
     p.add_argument("--log", type=Path, default=Path("results/mpm_eval/policies_cpu.jsonl"))
     args = p.parse_args()
-
+    per_policy = 0.02 / args.frame_dt if args.frame_dt > 0.0 else 0.0  # the policy runs at 50 Hz on whole frames
+    if per_policy < 1.0 or abs(per_policy - round(per_policy)) > 1e-6:
+        p.error(f"--frame-dt {args.frame_dt} s must divide the 0.02 s policy step (e.g. 0.01, 0.005, 0.0025)")
+    if args.substeps < 1:
+        p.error(f"--substeps {args.substeps} must be >= 1 (rigid steps per MPM frame)")
     if args.duration is not None:
         args.frames = round(args.duration / args.frame_dt)
     t = time.time()
