@@ -46,6 +46,7 @@ def make(policy: Any, args: argparse.Namespace) -> G1MpmScene:
             rigid_substeps=args.substeps,
             max_iterations=args.iterations,
             grid_type=args.grid,
+            velocity_handover=args.handover,
         ),
         sole=SoleCfg(effective_mass=args.effective_mass),
         commands=((args.vx, 0.0, 0.0),),
@@ -127,6 +128,12 @@ def main() -> None:
     p.add_argument("--substeps", type=int, default=2, help="rigid substeps per frame (physics dt = frame-dt / this)")
     p.add_argument("--effective-mass", type=float, default=None, help="SoleCfg.effective_mass [kg]; default m / 2")
     p.add_argument("--grid", choices=("sparse", "dense"), default="sparse", help="MPM grid type")
+    p.add_argument(
+        "--handover",
+        choices=("predict", "rewind", "actual"),
+        default="predict",
+        help="coupling: collider velocity MPM sees (MpmSolverCfg.velocity_handover; before session 6: rewind)",
+    )
     p.add_argument("--duration", type=float, default=None, help="simulated time [s]; overrides --frames")
     p.add_argument("--log", type=Path, default=Path("results/mpm_eval/policies_cpu.jsonl"))
     args = p.parse_args()
@@ -161,6 +168,7 @@ def main() -> None:
         label=args.label, policy=str(args.policy), vx_cmd=args.vx, window=args.window, rigid=args.rigid,
         depth=0.1 if args.rigid else args.depth, voxel=args.voxel, iterations=args.iterations, frames=args.frames,
         frame_dt=args.frame_dt, substeps=args.substeps, effective_mass=args.effective_mass, grid=args.grid,
+        handover=args.handover,
         mass=round(scene.robot_mass, 2), particles=scene.particle_count, rows=rows,
         support2=round(float(fz.mean()), 2), support_50hz=round(float(scene.support_ratio()[0]), 2),
         pelvis_min=round(min(float(bq[:, 2].min()), min(r["pz"] for r in rows)), 4), max_abs_sole_pitch=max(abs(v) for r in rows for v in r["pitch"]),

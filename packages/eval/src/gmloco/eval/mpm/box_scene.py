@@ -2,10 +2,14 @@
 """MPM box scene: a rigid box (Newton + MuJoCo) coupled two-way with an implicit-MPM sand bed.
 
 Coupling (semi-implicit, one MPM step per frame): the rigid solver integrates the box over ``rigid_substeps``
-with the sand wrench of the previous frame; MPM then sees the box with that wrench's velocity change removed
-and solves the frictional contact implicitly against the box's mass and inertia (the body is a *dynamic*
-collider, ``SolverImplicitMPM.setup_collider(model=..)``); the collider-node impulses of that step divided by
-the frame time are the new sand wrench. Pattern learnt from Newton's ``example_mpm_twoway_coupling``.
+with the sand wrench of the previous frame; MPM then sees the box at the velocity it would reach after one more
+frame without sand (``velocity_handover="predict"``: velocity + g frame_dt) and solves the frictional contact
+implicitly against the box's mass and inertia (the body is a *dynamic* collider,
+``SolverImplicitMPM.setup_collider(model=..)``); the collider-node impulses of that step divided by the frame time
+are the new sand wrench, applied over the next frame, which ends the box at the velocity MPM solved for. Newton's
+``example_mpm_twoway_coupling`` instead removes the lagged wrench's velocity change (``"rewind"``): MPM then
+re-solves an impact the box has already received and returns it a second time (a landing box bounces back,
+restitution ~1; ``results/box_intrusion/cpu_s5/``).
 
 Batching: given a list of media, the scene holds one walled bed per medium ("region"), side by side in one MPM
 solve, each with its own box. Regions are separated by their walls and a gap of several voxels, so no grid node
@@ -18,7 +22,7 @@ from __future__ import annotations
 import time
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field, replace
-from typing import Any, Literal
+from typing import Any, Literal, get_args
 
 import numpy as np
 
@@ -32,9 +36,14 @@ __all__ = [
     "MpmBoxScene",
     "MpmBoxSceneCfg",
     "MpmSolverCfg",
+    "VelocityHandover",
     "emit_bed_particles",
+    "model_gravity",
     "region_offsets",
 ]
+
+VelocityHandover = Literal["predict", "rewind", "actual"]
+"""Coupling schemes: which collider velocity the MPM solve sees (``MpmSolverCfg.velocity_handover``)."""
 
 MIN_RHEOLOGY_ITERATIONS = 25
 """Newton 1.5.2's Gauss-Seidel ``solve_granularity``: the eager solver loop runs ``max_iterations // 25`` batches."""
@@ -64,9 +73,17 @@ class MpmSolverCfg:
     """Active-cell capacity; raise it at fine voxels or the fixed grid overflows (issue 5 timings)."""
     strain_basis: str = "P0"
     """Strain basis (Newton's coupled example: P0)."""
+    velocity_handover: VelocityHandover = "predict"
+    """Collider velocity the MPM solve sees (the coupling scheme; :func:`hand_over_velocity`): ``"predict"``
+    (velocity + g frame_dt), ``"rewind"`` (velocity minus the lagged sand wrench's change; every MPM result before
+    session 6 used it: it returns an impact twice, restitution ~1) or ``"actual"`` (the velocity as it is)."""
 
     def __post_init__(self) -> None:
         """Refuse settings under which Newton's eager (CPU / no-graph) rheology loop would not iterate."""
+        if self.velocity_handover not in get_args(VelocityHandover):
+            raise ValueError(
+                f"velocity_handover={self.velocity_handover!r}: choose one of {get_args(VelocityHandover)}"
+            )
         if self.max_iterations < MIN_RHEOLOGY_ITERATIONS:
             raise ValueError(
                 f"max_iterations={self.max_iterations}: SolverImplicitMPM runs max_iterations // "
@@ -130,6 +147,7 @@ class MpmBoxScene:
         self.frame_dt, self.sim_dt = s.frame_dt, s.frame_dt / s.rigid_substeps
         with wp.ScopedDevice(self.device):
             self.model = self._build_rigid_model(newton, wp)
+            self.gravity = model_gravity(self.model)
             self.sand_model, self.particle_count = self._build_sand_model(newton)
             self._build_solvers(newton)
             self._allocate_states(newton, wp)
@@ -238,18 +256,18 @@ class MpmBoxScene:
         """Advance one frame: rigid substeps with the lagged sand wrench, then one coupled MPM step."""
         import warp as wp
 
-        from gmloco.eval.mpm.kernels_coupling import eval_body_sand_wrench, eval_rewind_body_velocity
+        from gmloco.eval.mpm.kernels_coupling import eval_body_sand_wrench, hand_over_velocity
 
         for _ in range(self.cfg.solver.rigid_substeps):
             self.state_0.clear_forces()
             wp.copy(self.state_0.body_f, self.sand_wrench)
             self.rigid.step(self.state_0, self.state_1, self.control, self.contacts, self.sim_dt)
             self.state_0, self.state_1 = self.state_1, self.state_0
-        # MPM sees the box pose and its velocity without the lagged wrench, and re-solves the contact
+        # MPM sees the box pose and the coupling scheme's velocity, and solves the contact against the box's mass
         wp.copy(self.sand_state.body_q, self.state_0.body_q)
-        eval_rewind_body_velocity(
-            self.model.body_inv_mass, self.model.body_inv_inertia, self.frame_dt, self.state_0.body_q,
-            self.state_0.body_qd, self.sand_wrench, self.sand_state.body_qd,
+        hand_over_velocity(
+            self.cfg.solver.velocity_handover, self.gravity, self.model.body_inv_mass, self.model.body_inv_inertia,
+            self.frame_dt, self.state_0.body_q, self.state_0.body_qd, self.sand_wrench, self.sand_state.body_qd,
         )  # fmt: skip
         self.mpm.step(self.sand_state, self.sand_state, None, None, self.frame_dt)
         eval_body_sand_wrench(
@@ -324,6 +342,12 @@ class MpmBoxScene:
             "floor_tolerance_z": floor,
             "box_z": np.asarray(q)[:, 2].tolist(),
         }
+
+
+def model_gravity(model: Any) -> tuple[float, float, float]:
+    """The global gravity vector of a Newton model [m/s^2] (the last entry of ``model.gravity``)."""
+    g = np.asarray(model.gravity.numpy()).reshape(-1, 3)[-1]
+    return float(g[0]), float(g[1]), float(g[2])
 
 
 def emit_bed_particles(

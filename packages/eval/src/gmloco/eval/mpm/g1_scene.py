@@ -16,8 +16,8 @@
 * Feet: every MJCF geom is hidden from the particles; each ankle-roll link gets a sole box (``SoleCfg``,
   no mass, no rigid contact) that only the particles resolve (thin foot capsules fall through a coarse bed).
 * Coupling: the box scene's semi-implicit scheme (:mod:`gmloco.eval.mpm.box_scene`): rigid substeps with the
-  lagged sand wrench, MPM sees the feet with that wrench's velocity change removed and solves the contact
-  implicitly against each foot's *effective* mass (``SoleCfg.effective_mass``: in stance a foot carries the
+  lagged sand wrench, MPM sees the feet at the scheme's velocity (``MpmSolverCfg.velocity_handover``; default
+  the predicted one, velocity + g frame_dt) and solves the contact implicitly against each foot's *effective* mass (``SoleCfg.effective_mass``: in stance a foot carries the
   robot), the collider impulses / dt are the new wrench.
 * Joint armature: kp / (2 pi 10 Hz)^2, mjlab's rotor inertia (the MJCF has none; without it the explicit PD
   on the light ankle links is unstable at 200 Hz).
@@ -39,7 +39,7 @@ from typing import Any
 import numpy as np
 
 from gmloco.eval.g1_eval_policy import MjlabOnnxPolicy, PolicySpec, StudentOnnxPolicy
-from gmloco.eval.mpm.box_scene import MpmSolverCfg
+from gmloco.eval.mpm.box_scene import MpmSolverCfg, model_gravity
 from gmloco.eval.mpm.coupled_setup import make_coupled_states, make_mpm_solver
 from gmloco.eval.mpm.window import SandWindow, SandWindowCfg
 from gmloco.eval.mpm.window_terrain import TerrainCfg, terrain_materials, terrain_surface_height
@@ -153,6 +153,7 @@ class G1MpmScene:
         self.lane_y = np.arange(n) * cfg.lane_spacing
         with wp.ScopedDevice(self.device):
             self.model = self._build_robots(newton, wp)
+            self.gravity = model_gravity(self.model)
             self._build_sand(newton, wp)
             self._build_solvers(newton, wp)
         self.frame = 0
@@ -391,7 +392,7 @@ class G1MpmScene:
         from gmloco.eval.mpm.kernels_coupling import (
             eval_body_sand_wrench,
             eval_pd_joint_force,
-            eval_rewind_body_velocity,
+            hand_over_velocity,
         )
 
         for _ in range(self.cfg.solver.rigid_substeps):
@@ -406,9 +407,9 @@ class G1MpmScene:
         wp.copy(self.sand_state.body_q, self.state_0.body_q, count=self.wall_body_offset)
         if self.cfg.wall_colliders:
             self.window.place_walls(self.wall_body_offset, self.sand_state.body_q, self.sand_state.body_qd)
-        eval_rewind_body_velocity(
-            self.eff_inv_mass, self.eff_inv_inertia, self.frame_dt, self.state_0.body_q,
-            self.state_0.body_qd, self.sand_wrench, self.sand_state.body_qd,
+        hand_over_velocity(
+            self.cfg.solver.velocity_handover, self.gravity, self.eff_inv_mass, self.eff_inv_inertia,
+            self.frame_dt, self.state_0.body_q, self.state_0.body_qd, self.sand_wrench, self.sand_state.body_qd,
         )  # fmt: skip
         self.mpm.step(self.sand_state, self.sand_state, None, None, self.frame_dt)
         self.window.apply_walls()

@@ -1,11 +1,17 @@
 # SPDX-License-Identifier: Apache-2.0
-"""Warp kernels of the rigid-body <-> implicit-MPM two-way coupling (impulse harvest, lagged-force rewind)."""
+"""Warp kernels of the rigid-body <-> implicit-MPM two-way coupling (impulse harvest, collider velocity hand-over)."""
 
 from __future__ import annotations
 
 import warp as wp
 
-__all__ = ["eval_body_sand_wrench", "eval_pd_joint_force", "eval_rewind_body_velocity"]
+__all__ = [
+    "eval_body_sand_wrench",
+    "eval_pd_joint_force",
+    "eval_predict_body_velocity",
+    "eval_rewind_body_velocity",
+    "hand_over_velocity",
+]
 
 
 @wp.kernel
@@ -104,6 +110,83 @@ def eval_rewind_body_velocity(
         outputs=[body_qd_out],
         device=body_qd.device,
     )
+
+
+@wp.kernel
+def _predict_body_velocity(
+    # Data in:
+    gravity: wp.vec3,
+    dt: float,
+    body_qd_in: wp.array[wp.spatial_vector],
+    # Data out:
+    body_qd_out: wp.array[wp.spatial_vector],
+) -> None:
+    """Velocity a body would reach after one more frame of free fall: linear part + g dt, angular unchanged."""
+    b = wp.tid()
+    qd = body_qd_in[b]
+    body_qd_out[b] = wp.spatial_vector(wp.spatial_top(qd) + gravity * dt, wp.spatial_bottom(qd))
+
+
+def eval_predict_body_velocity(
+    gravity: tuple[float, float, float],
+    dt: float,
+    body_qd: wp.array,
+    body_qd_out: wp.array,
+) -> None:
+    """Write the collider velocity MPM should solve against: qd + (g dt, 0) (predicted hand-over).
+
+    The impulse MPM returns is applied over the *next* frame, during which the body also falls under gravity; a
+    body supported by the sand (a box, a stance foot carrying the robot) would reach this velocity without the
+    sand, so MPM's contact solve ends it at the velocity the body really has after that frame.
+
+    Args:
+        gravity: Gravity [m/s^2].
+        dt: Frame time [s].
+        body_qd: Body (linear, angular) velocities [m/s, rad/s], [B].
+        body_qd_out: Output velocities, [B] (may not alias ``body_qd``).
+    """
+    wp.launch(
+        _predict_body_velocity,
+        dim=body_qd.shape[0],
+        inputs=[wp.vec3(*gravity), dt, body_qd],
+        outputs=[body_qd_out],
+        device=body_qd.device,
+    )
+
+
+def hand_over_velocity(
+    scheme: str,
+    gravity: tuple[float, float, float],
+    inv_mass: wp.array,
+    inv_inertia: wp.array,
+    dt: float,
+    body_q: wp.array,
+    body_qd: wp.array,
+    body_wrench: wp.array,
+    body_qd_out: wp.array,
+) -> None:
+    """Write the collider velocities of the MPM step under coupling ``scheme`` (``MpmSolverCfg.velocity_handover``).
+
+    Args:
+        scheme: ``"predict"`` (:func:`eval_predict_body_velocity`), ``"rewind"`` (:func:`eval_rewind_body_velocity`)
+            or ``"actual"`` (a copy).
+        gravity: Gravity [m/s^2] (``"predict"``).
+        inv_mass: Inverse mass MPM solves against [1/kg], [B] (``"rewind"``).
+        inv_inertia: Inverse body-frame inertia [1/(kg m^2)], [B] (``"rewind"``).
+        dt: Frame time [s].
+        body_q: Body poses, [B].
+        body_qd: Body velocities after the frame's rigid substeps, [B].
+        body_wrench: The lagged sand wrench applied during those substeps, [B] (``"rewind"``).
+        body_qd_out: Output: the velocities the MPM collider sees, [B].
+    """
+    if scheme == "predict":
+        eval_predict_body_velocity(gravity, dt, body_qd, body_qd_out)
+    elif scheme == "rewind":
+        eval_rewind_body_velocity(inv_mass, inv_inertia, dt, body_q, body_qd, body_wrench, body_qd_out)
+    elif scheme == "actual":
+        wp.copy(body_qd_out, body_qd, count=body_qd.shape[0])
+    else:
+        raise ValueError(f"unknown velocity hand-over {scheme!r}: choose 'predict', 'rewind' or 'actual'")
 
 
 @wp.kernel
