@@ -28,7 +28,7 @@ def bodies() -> dict[str, np.ndarray]:
 
 
 def _run(scheme: str, b: dict[str, np.ndarray]) -> np.ndarray:
-    out = wp.zeros(2, dtype=wp.spatial_vector, device="cpu")
+    out = wp.zeros(2, dtype=wp.spatial_vectorf, device="cpu")  # = wp.spatial_vector, typed as a class
     hand_over_velocity(
         scheme,
         G,
