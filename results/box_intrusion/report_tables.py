@@ -2,7 +2,7 @@
 """Print the README tables of a box-study directory (scores vs MPM, absolute sinkage error, MPM rebounds).
 
 Usage: ``uv run python results/box_intrusion/report_tables.py [DIR ...]`` (CPU, seconds; default
-``results/box_intrusion/box_v0.03_i1000``). Reads ``summary.json``, ``trials.csv`` and ``grf.jsonl`` as written
+``results/box_intrusion/box_v0.03_i1000``). Reads ``summary.json``, ``trials.csv`` and the series (``grf.jsonl[.gz]``) as written
 by ``workflows/box_study.py``; runs nothing.
 
 Printed per variant and model: the summary's medians (travel and sinkage relative errors, GRF profile error / mg,
@@ -19,6 +19,8 @@ import sys
 from pathlib import Path
 
 import numpy as np
+
+from gmloco.eval.study_io import StudyRecords
 
 REBOUND = 0.02
 """Backward travel from the furthest point that counts as a rebound [m]."""
@@ -37,13 +39,11 @@ def load_rows(d: Path) -> dict[tuple[str, str], dict[int, dict[str, float]]]:
 def rebounds(d: Path) -> dict[str, tuple[int, int]]:
     """Per variant: (MPM trials that rebound, MPM trials)."""
     out: dict[str, list[int]] = {}
-    with (d / "grf.jsonl").open() as f:
-        for line in f:
-            r = json.loads(line)
-            if r["model"] != "mpm":
-                continue
-            x = np.asarray(r["pos"])[:, 0]
-            out.setdefault(r["variant"], []).append(int(x.max() - x[-1] > REBOUND))
+    for r in StudyRecords(d).series():
+        if r["model"] != "mpm":
+            continue
+        x = np.asarray(r["pos"])[:, 0]
+        out.setdefault(r["variant"], []).append(int(x.max() - x[-1] > REBOUND))
     return {v: (sum(n), len(n)) for v, n in out.items()}
 
 

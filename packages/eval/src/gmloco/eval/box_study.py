@@ -36,7 +36,7 @@ class BoxStudyCfg:
     """Configuration of the box-intrusion study."""
 
     out_dir: str = "results/box_intrusion"
-    """Output directory (trials.csv, grf.jsonl, summary.json, fig_box_intrusion.png)."""
+    """Output directory (trials.csv, grf.jsonl.gz, summary.json, fig_box_intrusion.png)."""
     num_trials: int = 30
     """Number of randomized media N (N >= 30 for the paper figure)."""
     seed: int = 0

@@ -228,7 +228,7 @@ def _mpm_by_trial(out_dir: str | Path) -> tuple[float, int, dict[tuple[str, int]
     """Return (voxel size [m], rheology iterations, MPM rows keyed by (variant, trial)) of one study directory."""
     rows = [r for r in StudyRecords(out_dir).rows() if r["model"] == "mpm"]
     if not rows:
-        raise ValueError(f"{out_dir}: no MPM trials (trials.csv + grf.jsonl)")
+        raise ValueError(f"{out_dir}: no MPM trials (trials.csv + grf.jsonl[.gz])")
     voxels = {float(r["voxel_size"]) for r in rows}
     if len(voxels) != 1:
         raise ValueError(f"{out_dir}: MPM trials at several voxel sizes {sorted(voxels)}; use one dir per size")
