@@ -8,6 +8,15 @@ TCN on a grid over the held-out (rho_c, mu_int) region and on the named presets;
 success rate and tracking error per material and speed, next to the PPO-3D-RFT baseline (``--baseline``) on the
 presets; the adaptation walk basalt -> dry sand -> poppy seed. Writes ``summary.json``, ``materials.csv``,
 ``adaptation.png`` and ``adaptation_env0.json`` to ``--out``.
+
+    python scripts/gpu/eval_ts.py --actor teacher --teacher runs/s6/teacher_clr50/model_XXXX.pt --device cpu \
+        --adaptation-envs 16 --out <dir>
+
+``--actor teacher`` walks only the adaptation course, with the teacher of a ``TeacherPPO`` checkpoint acting
+(``--teacher``, default the committed ``artifacts/gm_loco_teacher/checkpoint.pt``) on ``--adaptation-envs`` envs,
+and writes ``summary.json`` (per material: left-foot swing apex mean / std / 90th percentile and count, forward
+speed, true and decoded eta), ``adaptation.png`` and ``adaptation_env0.json``. Reward weights do not enter a
+rollout, so a teacher trained with ``--reward-weight`` overrides needs none here.
 """
 
 from __future__ import annotations
@@ -26,7 +35,9 @@ def _floats(text: str) -> tuple[float, ...]:
 
 def _parse(argv: list[str] | None) -> argparse.Namespace:
     p = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    p.add_argument("--actor", choices=["student", "teacher"], default="student", help="teacher: adaptation walk only")
     p.add_argument("--student", default="artifacts/gm_loco_student/checkpoint.pt")
+    p.add_argument("--teacher", default="artifacts/gm_loco_teacher/checkpoint.pt", help="TeacherPPO checkpoint")
     p.add_argument("--baseline", default="artifacts/ppo_rft3d/policy.onnx", help="'none' to skip")
     p.add_argument("--contact-model", default="rft3d")
     p.add_argument("--latent-dim", type=int, default=16)
@@ -40,6 +51,7 @@ def _parse(argv: list[str] | None) -> argparse.Namespace:
     p.add_argument("--adaptation-duration-s", type=float, default=10.0, help="0 skips the adaptation walk")
     p.add_argument("--adaptation-edges", default="3.0,6.0")
     p.add_argument("--adaptation-speed", type=float, default=1.0)
+    p.add_argument("--adaptation-envs", type=int, default=16, help="envs of the walk with --actor teacher")
     p.add_argument("--device", default="cuda:0")
     p.add_argument("--seed", type=int, default=0)
     p.add_argument("--out", type=Path, required=True)
@@ -54,7 +66,9 @@ def main(argv: list[str] | None = None) -> dict[str, Any]:
 
     n_rho, n_mu = (int(x) for x in args.held_out_grid.split(","))
     cfg = TsEvalCfg(
+        actor=args.actor,
         student_checkpoint=args.student,
+        teacher_checkpoint=args.teacher,
         baseline_policy=None if args.baseline == "none" else args.baseline,
         contact_model=args.contact_model,
         latent_dim=args.latent_dim,
@@ -68,6 +82,7 @@ def main(argv: list[str] | None = None) -> dict[str, Any]:
         adaptation_duration_s=args.adaptation_duration_s,
         adaptation_edges=_floats(args.adaptation_edges),
         adaptation_speed=args.adaptation_speed,
+        adaptation_envs=args.adaptation_envs,
         device=args.device,
         seed=args.seed,
         out_dir=str(args.out),
@@ -77,6 +92,10 @@ def main(argv: list[str] | None = None) -> dict[str, Any]:
     from gmloco.train.evaluation_ts import finite_json
 
     (args.out / "summary.json").write_text(json.dumps(finite_json(summary), indent=1, default=str))
+    if args.actor == "teacher":
+        print(json.dumps(finite_json(summary["adaptation"]), indent=1))
+        print(f"survived {summary['adaptation_survived']}/{args.adaptation_envs}, wall {summary['wall_s']:.0f} s")
+        return summary
     keys = ("held_out", "presets", "all")
     print(json.dumps({k: v for k, v in finite_json(summary["metrics"]).items() if k.split("/")[0] in keys}, indent=1))
     return summary

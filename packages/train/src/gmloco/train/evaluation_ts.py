@@ -19,6 +19,11 @@ One :func:`evaluate_teacher_student` call rebuilds the student (with its frozen 
   an edge (the contact package's per-point material field is not wired into the training env); decoded eta and the
   left foot's swing apex (sole height above the free surface at the highest point of each swing) against distance.
 
+With ``TsEvalCfg.actor = "teacher"`` the teacher of a ``TeacherPPO`` checkpoint acts instead and only the adaptation
+walk runs (on ``adaptation_envs`` envs): its per-material swing apexes measure a teacher's clearance before a
+distillation. Reward weights do not enter a rollout (they only scale the reward terms), so a teacher trained with
+``--reward-weight`` overrides is rebuilt with the default task.
+
 Heavy imports (mjlab, the env stack, matplotlib) happen inside the functions.
 """
 
@@ -28,7 +33,7 @@ import json
 import math
 from dataclasses import asdict, dataclass, field, replace
 from pathlib import Path
-from typing import Any
+from typing import Any, Literal
 
 import numpy as np
 import torch
@@ -37,7 +42,14 @@ from gmloco.train.config import ContactModelName, TerrainName
 from gmloco.train.evaluation import RolloutCriteriaCfg, accumulate_tracking, tracking_stats
 from gmloco.train.teacher_student.heldout import DEFAULT_HELD_OUT, HeldOutRegionCfg, r2_score
 
-__all__ = ["TsEvalCfg", "adaptation_rollout", "decoded_eta_check", "evaluate_teacher_student", "swing_apexes"]
+__all__ = [
+    "TsEvalCfg",
+    "adaptation_rollout",
+    "decoded_eta_check",
+    "evaluate_teacher_adaptation",
+    "evaluate_teacher_student",
+    "swing_apexes",
+]
 
 
 @dataclass
@@ -47,8 +59,13 @@ class TsEvalCfg(RolloutCriteriaCfg):
     Commands, cells and failure rules: :class:`~gmloco.train.evaluation.RolloutCriteriaCfg` (as ``EvalCfg``).
     """
 
+    actor: Literal["student", "teacher"] = "student"
+    """Acting policy: ``"student"`` (every evaluation) or ``"teacher"`` (``teacher_checkpoint``; the adaptation walk
+    alone, as the held-out eta, action-error and baseline parts are about the student)."""
     student_checkpoint: str = "artifacts/gm_loco_student/checkpoint.pt"
     """``StudentPPO`` checkpoint (holds the frozen teacher in ``teacher_state_dict``)."""
+    teacher_checkpoint: str = "artifacts/gm_loco_teacher/checkpoint.pt"
+    """``TeacherPPO`` checkpoint, used when ``actor`` is ``"teacher"``."""
     baseline_policy: str | None = "artifacts/ppo_rft3d/policy.onnx"
     """PPO baseline (mjlab ONNX export) scored on the named presets; None: skip."""
     contact_model: ContactModelName = "rft3d"
@@ -79,6 +96,8 @@ class TsEvalCfg(RolloutCriteriaCfg):
     """Commanded forward speed on the adaptation course [m/s]."""
     adaptation_duration_s: float = 10.0
     """Duration of the adaptation walk [s]; 0 skips it."""
+    adaptation_envs: int = 16
+    """Envs of the walk when it runs alone (``actor="teacher"``); the student's walk uses the cells' envs."""
     device: str = "cpu"
     """Torch / Warp device."""
     seed: int = 0
@@ -121,8 +140,17 @@ def _student_entries(cfg: TsEvalCfg) -> dict[str, Any]:
     return student_train_entries(teacher, student, DistillCfg())
 
 
+def _actor_entries(cfg: TsEvalCfg) -> tuple[str, dict[str, Any]]:
+    """Checkpoint and rsl-rl entries of the acting policy (the teacher's as ``train_ts_chunk.py --stage teacher``)."""
+    from gmloco.train.teacher_student import ObsGroupsCfg, TeacherCfg
+
+    if cfg.actor == "teacher":
+        return cfg.teacher_checkpoint, TeacherCfg(latent_dim=cfg.latent_dim).to_rsl_rl(ObsGroupsCfg())
+    return cfg.student_checkpoint, _student_entries(cfg)
+
+
 def _build_runner(cfg: TsEvalCfg, num_envs: int, duration_s: float) -> Any:
-    """Play-mode env (eval floor, failure terminations, fixed commands) + runner with the student checkpoint."""
+    """Play-mode env (eval floor, failure terminations, fixed commands) + runner with the acting checkpoint."""
     from mjlab.envs import ManagerBasedRlEnv
     from mjlab.managers.termination_manager import TerminationTermCfg
     from mjlab.rl import RslRlVecEnvWrapper
@@ -145,11 +173,11 @@ def _build_runner(cfg: TsEvalCfg, num_envs: int, duration_s: float) -> Any:
     twist.rel_standing_envs, twist.rel_heading_envs, twist.heading_command = 0.0, 0.0, False  # type: ignore[attr-defined]
     twist.rel_world_envs, twist.rel_forward_envs, twist.ranges.heading = 0.0, 0.0, None  # type: ignore[attr-defined]
     env = RslRlVecEnvWrapper(ManagerBasedRlEnv(cfg=env_cfg, device=cfg.device))
-    train_cfg = asdict(make_g1_granular_ppo_cfg()) | _student_entries(cfg)
-    runner = GmlocoOnPolicyRunner(env, train_cfg, None, cfg.device)
-    runner.load(cfg.student_checkpoint, map_location=cfg.device)
-    if not getattr(runner.alg, "teacher_loaded", False):
-        raise ValueError(f"{cfg.student_checkpoint} holds no teacher: evaluate a distilled student checkpoint.")
+    checkpoint, entries = _actor_entries(cfg)
+    runner = GmlocoOnPolicyRunner(env, asdict(make_g1_granular_ppo_cfg()) | entries, None, cfg.device)
+    runner.load(checkpoint, map_location=cfg.device)
+    if cfg.actor == "student" and not getattr(runner.alg, "teacher_loaded", False):
+        raise ValueError(f"{checkpoint} holds no teacher: evaluate a distilled student checkpoint.")
     return runner
 
 
@@ -177,7 +205,18 @@ def _start(runner: Any, commands: torch.Tensor) -> Any:
 
 
 def _policy_step(runner: Any, obs: Any) -> dict[str, torch.Tensor]:
-    """Student action, decoded etas of student and teacher, squared action difference, on one observation."""
+    """Acting policy's action and decoded etas on one observation.
+
+    ``StudentPPO`` runner: student action, decoded etas of student and teacher, squared action difference.
+    ``TeacherPPO`` runner: teacher action and its decoded eta ``psi(mu)`` (keys ``actions``, ``eta_teacher``).
+    """
+    from gmloco.train.teacher_student import StudentPPO
+
+    is_student = isinstance(runner.alg, StudentPPO)
+    if not is_student:
+        with torch.no_grad():
+            actions = runner.alg.actor(obs)
+            return {"actions": actions, "eta_teacher": runner.alg.actor.decode(runner.alg.actor.latent_mu)[:, 0]}
     student, teacher = runner.alg.actor, runner.alg.teacher
     with torch.no_grad():
         actions = student(obs)
@@ -239,28 +278,21 @@ def decoded_eta_check(runner: Any, steps: int, warmup_steps: int) -> dict[str, f
     and both psi(z_hat) and the frozen teacher's psi(mu) on the student's states are scored, plus the student-vs-teacher
     action MSE. Steps before ``warmup_steps`` and the first ``warmup_steps`` after a reset are left out.
     """
-    from gmloco.train.teacher_student import StudentPPO
-
     env = runner.env
     runner.alg.eval_mode()
     obs = env.get_observations()
-    is_student = isinstance(runner.alg, StudentPPO)
     since_reset = torch.zeros(env.num_envs, dtype=torch.long, device=env.device)
     rows: dict[str, list[torch.Tensor]] = {"true": [], "teacher": [], "student": [], "action_sq": [], "valid": []}
     for _ in range(steps):
-        if is_student:
-            out = _policy_step(runner, obs)
-            actions = out["actions"]
-            rows["student"].append(out["eta_student"])
+        out = _policy_step(runner, obs)
+        for key in ("teacher", "student"):
+            if f"eta_{key}" in out:
+                rows[key].append(out[f"eta_{key}"])
+        if "action_sq" in out:
             rows["action_sq"].append(out["action_sq"])
-        else:
-            with torch.no_grad():
-                actions = runner.alg.actor(obs)
-                out = {"eta_teacher": runner.alg.actor.decode(runner.alg.actor.latent_mu)[:, 0]}
-        rows["teacher"].append(out["eta_teacher"])
         rows["true"].append(env.unwrapped.sand.eta.clone())
         rows["valid"].append(since_reset >= warmup_steps)
-        obs, _, dones, _ = env.step(actions)
+        obs, _, dones, _ = env.step(out["actions"])
         since_reset = torch.where(dones.bool(), 0, since_reset + 1)
     raw = {k: torch.stack(v).cpu().numpy() for k, v in rows.items() if v}
     valid = raw["valid"]
@@ -417,10 +449,16 @@ def _course_table(cfg: TsEvalCfg) -> torch.Tensor:
 
 
 def adaptation_rollout(runner: Any, cfg: TsEvalCfg) -> dict[str, Any]:
-    """Walk every env along the course; return per-step traces ``[T, W]`` and per-material swing statistics.
+    """Walk every env along the course with the runner's acting policy (student or teacher).
 
     The material of env w is the course material at its distance s_w = (p_w - p_w(0)) . h_w(0) along its initial
     heading; it is switched (in place, with its eta) when s_w crosses an edge.
+
+    Returns:
+        ``trace``: per-step ``[T, W]`` arrays ``s`` [m], ``material`` (course index), ``eta_true``, the decoded etas
+        (``eta_teacher``; ``eta_student`` when the student acts), ``v_forward`` (pelvis velocity along the initial
+        heading [m/s]), ``left_height`` [m], ``left_contact``, ``alive``; ``per_material``: rows of
+        :func:`_adaptation_stats`; ``survived``: envs alive at the end.
     """
     env = runner.env.unwrapped
     n, dev = env.num_envs, env.device
@@ -437,8 +475,7 @@ def adaptation_rollout(runner: Any, cfg: TsEvalCfg) -> dict[str, Any]:
     yaw = torch.atan2(2 * (q[:, 0] * q[:, 3] + q[:, 1] * q[:, 2]), 1 - 2 * (q[:, 2] ** 2 + q[:, 3] ** 2))
     heading = torch.stack([torch.cos(yaw), torch.sin(yaw)], dim=-1)
     alive = torch.ones(n, dtype=torch.bool, device=dev)
-    names = ("s", "material", "eta_true", "eta_student", "eta_teacher", "left_height", "left_contact", "alive")
-    trace: dict[str, list[torch.Tensor]] = {k: [] for k in names}
+    trace: dict[str, list[torch.Tensor]] = {}
     from tensordict import TensorDict
 
     for _ in range(round(cfg.adaptation_duration_s / env.step_dt)):
@@ -449,42 +486,64 @@ def adaptation_rollout(runner: Any, cfg: TsEvalCfg) -> dict[str, Any]:
             _pin_materials(env, *(table[index].T.tolist()))
         out = _policy_step(runner, obs)
         feet.update()
-        step_values = (s, index.float(), env.sand.eta, out["eta_student"], out["eta_teacher"])
-        for k, v in zip(names[:5], step_values, strict=True):
-            trace[k].append(v.clone())
-        trace["left_height"].append(feet.height[:, 0].clone())
-        trace["left_contact"].append(feet.in_contact[:, 0].float())
-        trace["alive"].append(alive.float())
+        step = {"s": s, "material": index.float(), "eta_true": env.sand.eta}
+        step |= {k: out[k] for k in ("eta_student", "eta_teacher") if k in out}
+        step["v_forward"] = (robot.data.root_link_lin_vel_w[:, :2] * heading).sum(-1)
+        step |= {
+            "left_height": feet.height[:, 0],
+            "left_contact": feet.in_contact[:, 0].float(),
+            "alive": alive.float(),
+        }
+        for k, v in step.items():
+            trace.setdefault(k, []).append(v.clone())
         obs_dict, _, terminated, _, _ = env.step(out["actions"])
         obs = TensorDict(obs_dict, batch_size=[n])
         alive &= ~terminated
     raw = {k: torch.stack(v).cpu().numpy() for k, v in trace.items()}
-    return {"trace": raw, "per_material": _adaptation_stats(cfg, raw)}
+    return {"trace": raw, "per_material": _adaptation_stats(cfg, raw), "survived": int(alive.sum())}
 
 
 def _adaptation_stats(cfg: TsEvalCfg, raw: dict[str, np.ndarray]) -> list[dict[str, Any]]:
-    """Per course material: swings, mean / std of the left-foot swing apex, mean decoded and true eta."""
-    apex_by_material: dict[int, list[float]] = {i: [] for i in range(len(cfg.adaptation_materials))}
+    """Per course material: left-foot swings, apex and lift statistics, falls, forward speed, mean etas.
+
+    An apex counts for the material under the pelvis at the apex step. ``swing_apex_*``: sole height above the free
+    surface at the apex [m]; ``swing_lift_mean_m``: apex minus the lowest sole height since the previous apex (the
+    first swing: since the start), i.e. how far the foot rises from its sunken stance [m] (contact is a 40 N force
+    threshold, so on soft ground a foot can leave "contact" while still sunk); ``falls``: envs that failed there;
+    ``eta_student`` only when it was traced (student acting).
+    """
+    materials = range(len(cfg.adaptation_materials))
+    apex_by_material: dict[int, list[float]] = {i: [] for i in materials}
+    lift_by_material: dict[int, list[float]] = {i: [] for i in materials}
+    falls = dict.fromkeys(materials, 0)
     for w in range(raw["s"].shape[1]):
+        height = raw["left_height"][:, w]
         contact, alive = raw["left_contact"][:, w] > 0.5, raw["alive"][:, w] > 0.5
-        for t in swing_apexes(raw["left_height"][:, w], contact, alive):
-            apex_by_material[int(raw["material"][t, w])].append(float(raw["left_height"][t, w]))
+        previous = 0
+        for t in swing_apexes(height, contact, alive):
+            apex_by_material[int(raw["material"][t, w])].append(float(height[t]))
+            lift_by_material[int(raw["material"][t, w])].append(float(height[t] - height[previous : t + 1].min()))
+            previous = t
+        if not alive[-1]:
+            falls[int(raw["material"][max(int(alive.sum()) - 1, 0), w])] += 1
     rows = []
     for i, name in enumerate(cfg.adaptation_materials):
         sel = (raw["material"] == i) & (raw["alive"] > 0.5)
-        apex = np.asarray(apex_by_material[i])
-        rows.append(
-            {
-                "material": name,
-                "steps": int(sel.sum()),
-                "swings": int(apex.size),
-                "swing_apex_mean_m": float(apex.mean()) if apex.size else None,
-                "swing_apex_std_m": float(apex.std()) if apex.size else None,
-                "eta_true": float(raw["eta_true"][sel].mean()) if sel.any() else None,
-                "eta_student": float(raw["eta_student"][sel].mean()) if sel.any() else None,
-                "eta_teacher": float(raw["eta_teacher"][sel].mean()) if sel.any() else None,
-            }
-        )
+        apex, lift = np.asarray(apex_by_material[i]), np.asarray(lift_by_material[i])
+        row: dict[str, Any] = {
+            "material": name,
+            "steps": int(sel.sum()),
+            "falls": falls[i],
+            "swings": int(apex.size),
+            "swing_apex_mean_m": float(apex.mean()) if apex.size else None,
+            "swing_apex_std_m": float(apex.std()) if apex.size else None,
+            "swing_apex_p90_m": float(np.percentile(apex, 90)) if apex.size else None,
+            "swing_lift_mean_m": float(lift.mean()) if lift.size else None,
+        }
+        for key in ("v_forward", "eta_true", "eta_student", "eta_teacher"):
+            if key in raw:
+                row[key] = float(raw[key][sel].mean()) if sel.any() else None
+        rows.append(row)
     return rows
 
 
@@ -500,9 +559,11 @@ def fig_adaptation(cfg: TsEvalCfg, result: dict[str, Any], path: Path, env_index
     s = raw["s"][alive, w]
     fig, ax = plt.subplots(2, 1, figsize=(8, 5), sharex=True, constrained_layout=True)
     ax[0].plot(s, raw["eta_true"][alive, w], "k-", lw=1.5, label="true eta")
-    ax[0].plot(s, raw["eta_student"][alive, w], "C0-", lw=1, label="student psi(z_hat)")
+    if "eta_student" in raw:
+        ax[0].plot(s, raw["eta_student"][alive, w], "C0-", lw=1, label="student psi(z_hat)")
     ax[0].plot(s, raw["eta_teacher"][alive, w], "C1--", lw=1, label="teacher psi(z)")
-    ax[0].set(ylabel="normalized stiffness eta [-]", title="basalt -> dry sand -> poppy seed (granular sim)")
+    course = " -> ".join(m.replace("_", " ") for m in cfg.adaptation_materials)
+    ax[0].set(ylabel="normalized stiffness eta [-]", title=f"{course}, {cfg.actor} acting (granular sim)")
     ax[0].legend(fontsize=8)
     ax[1].plot(s, raw["left_height"][alive, w], "C2-", lw=0.8, label="left sole height above sand")
     apex = swing_apexes(raw["left_height"][:, w], raw["left_contact"][:, w] > 0.5, alive)
@@ -524,7 +585,12 @@ def fig_adaptation(cfg: TsEvalCfg, result: dict[str, Any], path: Path, env_index
 
 
 def evaluate_teacher_student(cfg: TsEvalCfg) -> dict[str, Any]:
-    """Run the held-out eta, student-vs-teacher, walking and adaptation evaluations; return the summary dict."""
+    """Run the held-out eta, student-vs-teacher, walking and adaptation evaluations; return the summary dict.
+
+    With ``cfg.actor == "teacher"``: :func:`evaluate_teacher_adaptation` (the adaptation walk alone).
+    """
+    if cfg.actor == "teacher":
+        return evaluate_teacher_adaptation(cfg)
     cells = _cells(cfg)
     runner = _build_runner(cfg, len(cells), max(cfg.duration_s, cfg.adaptation_duration_s))
     env = runner.env.unwrapped
@@ -552,6 +618,7 @@ def evaluate_teacher_student(cfg: TsEvalCfg) -> dict[str, Any]:
         "materials": _material_rows(cells, raw, warmup),
         "held_out_region": asdict(cfg.held_out),
         "adaptation": None if adaptation is None else adaptation["per_material"],
+        "adaptation_survived": None if adaptation is None else adaptation["survived"],
         "cfg": json.loads(json.dumps(asdict(cfg), default=str)),
     }
     if cfg.baseline_policy is not None:
@@ -563,17 +630,45 @@ def evaluate_teacher_student(cfg: TsEvalCfg) -> dict[str, Any]:
     return summary
 
 
+def evaluate_teacher_adaptation(cfg: TsEvalCfg) -> dict[str, Any]:
+    """Walk the adaptation course with the teacher of ``cfg.teacher_checkpoint`` acting on ``cfg.adaptation_envs``.
+
+    Returns the summary dict: ``adaptation`` (per-material rows of :func:`_adaptation_stats`: ``steps``,
+    ``falls``, ``swings``, ``swing_apex_mean_m``, ``swing_apex_std_m``, ``swing_apex_p90_m``, ``swing_lift_mean_m``,
+    ``v_forward``, ``eta_true``, ``eta_teacher``), ``adaptation_survived`` and ``cfg``; written with the figure
+    and env 0's trace to ``cfg.out_dir`` if set.
+    """
+    if cfg.actor != "teacher" or cfg.adaptation_duration_s <= 0:
+        raise ValueError("evaluate_teacher_adaptation needs actor='teacher' and adaptation_duration_s > 0")
+    runner = _build_runner(cfg, cfg.adaptation_envs, cfg.adaptation_duration_s)
+    try:
+        adaptation = adaptation_rollout(runner, cfg)
+    finally:
+        runner.env.close()
+    summary = {
+        "actor": cfg.actor,
+        "checkpoint": cfg.teacher_checkpoint,
+        "adaptation": adaptation["per_material"],
+        "adaptation_survived": adaptation["survived"],
+        "cfg": json.loads(json.dumps(asdict(cfg), default=str)),
+    }
+    if cfg.out_dir is not None:
+        _write(cfg, summary, adaptation)
+    return summary
+
+
 def _write(cfg: TsEvalCfg, summary: dict[str, Any], adaptation: dict[str, Any] | None) -> None:
-    """Write ``summary.json``, ``materials.csv`` and the adaptation figure + trace of env 0."""
+    """Write ``summary.json``, ``materials.csv`` (if the summary has materials) and the adaptation figure + trace."""
     import csv
 
     out = Path(cfg.out_dir)  # type: ignore[arg-type]
     out.mkdir(parents=True, exist_ok=True)
     (out / "summary.json").write_text(json.dumps(finite_json(summary), indent=1, default=str))
-    with (out / "materials.csv").open("w", newline="") as f:
-        writer = csv.DictWriter(f, fieldnames=list(summary["materials"][0]))
-        writer.writeheader()
-        writer.writerows(summary["materials"])
+    if summary.get("materials"):
+        with (out / "materials.csv").open("w", newline="") as f:
+            writer = csv.DictWriter(f, fieldnames=list(summary["materials"][0]))
+            writer.writeheader()
+            writer.writerows(summary["materials"])
     if adaptation is not None:
         fig_adaptation(cfg, adaptation, out / "adaptation.png")
         trace = {k: v[:, 0].tolist() for k, v in adaptation["trace"].items()}
