@@ -47,6 +47,18 @@ def main() -> None:
     p.add_argument("--box-size", type=float, nargs=3, default=[0.3, 0.3, 0.2])
     p.add_argument("--max-minutes", type=float, default=60.0)
     p.add_argument("--device", default=None)
+    p.add_argument(
+        "--handover",
+        default="predict",
+        choices=["predict", "rewind", "actual"],
+        help="MPM coupling: collider velocity MPM sees (MpmSolverCfg.velocity_handover)",
+    )
+    p.add_argument(
+        "--max-leaked-fraction",
+        type=float,
+        default=1.0e-4,
+        help="stray particles below the floor a trial may leave (fraction of its particles)",
+    )
     p.add_argument("--no-figure", action="store_true")
     p.add_argument("--convergence", nargs="+", default=None, help="study dirs at different voxel sizes")
     p.add_argument("--smoke", action="store_true", help="CPU smoke: 1 trial, tiny bed, 0.2 s")
@@ -62,12 +74,13 @@ def main() -> None:
         base = BoxStudyCfg()
         box = replace(base.box, duration=a.duration, size=tuple(a.box_size))
         mpm = MpmSolverCfg(voxel_size=a.voxel_size, grid_type=a.grid_type, max_active_cell_count=a.max_active_cells,
-                           max_iterations=a.max_iterations)  # fmt: skip
+                           max_iterations=a.max_iterations, velocity_handover=a.handover)  # fmt: skip
         cfg = replace(
             base, out_dir=a.out_dir, num_trials=a.num_trials, seed=a.seed, variants=tuple(a.variants), box=box,
             rom=replace(base.rom, box=box), bed=SandBedCfg(size_x=a.bed[0], size_y=a.bed[1], depth=a.bed[2]),
             mpm=mpm, rft3d_fitted_coeffs=a.fitted_coeffs, max_minutes=a.max_minutes, device=a.device,
             rigid_solver=a.rigid_solver, make_figure=not a.no_figure, mpm_batch=a.mpm_batch,
+            mpm_max_leaked_fraction=a.max_leaked_fraction,
         )  # fmt: skip
     if a.models:
         cfg = replace(cfg, models=tuple(a.models))

@@ -26,6 +26,7 @@ from gmloco.eval.study_io import StudyRecords
 __all__ = ["MEDIA_DRAWS", "MPM_FAILURES", "BoxStudyCfg", "box_study_smoke_cfg", "run", "sample_media"]
 
 MPM_FAILURES = "mpm_failures.jsonl"
+MPM_WARNINGS = "mpm_warnings.jsonl"
 """Per failed MPM solve: variant, trials, error and ``MpmBoxScene.diagnostics()`` (one JSON line each)."""
 MEDIA_DRAWS = 1024
 """Draws per medium parameter from the study seed; trial t uses draw t whatever the number of trials."""
@@ -78,6 +79,9 @@ class BoxStudyCfg:
     (checked in the tests); ``semi_implicit`` avoids building mujoco_warp for every trial on a GPU."""
     make_figure: bool = True
     """Write ``fig_box_intrusion.png`` at the end."""
+    mpm_max_leaked_fraction: float = 1.0e-4
+    """Stray particles below the floor a trial may leave, per region, as a fraction of its particles (``test_final``);
+    tolerated ones are logged to ``mpm_warnings.jsonl``. 2 cm voxels lost 1-5 of 288k in 3 of 30 trials."""
 
 
 def box_study_smoke_cfg(out_dir: str, **overrides: Any) -> BoxStudyCfg:
@@ -192,7 +196,7 @@ def _run_mpm_batch(
     scene = MpmBoxScene(scene_cfg, mats)
     scene.run()
     try:
-        scene.test_final()
+        scene.test_final(cfg.mpm_max_leaked_fraction)
     except AssertionError as e:
         # keep what a failed solve tells (which region, how far, how many particles) for the report
         diag = {"variant": variant, "trials": trials, "error": str(e), "media": [asdict(m) for m in mats],
@@ -200,6 +204,10 @@ def _run_mpm_batch(
         with (Path(cfg.out_dir) / MPM_FAILURES).open("a") as f:
             f.write(json.dumps(diag, default=float) + "\n")
         raise
+    diag = scene.diagnostics()
+    if diag["leaked_particles"]:  # within the tolerance: kept, and said
+        with (Path(cfg.out_dir) / MPM_WARNINGS).open("a") as f:
+            f.write(json.dumps({"variant": variant, "trials": trials, **diag}, default=float) + "\n")
     q_all, f_all = np.array(scene.body_q_all), np.array(scene.sand_force_all)  # [T, R, 7] (p, q_xyzw), [T, R, 3]
     timing = {"wall_s": (time.perf_counter() - t0) / len(trials), "frames_per_s": scene.frames_per_second,
               "particle_count": scene.particle_count // len(trials), "voxel_size": cfg.mpm.voxel_size}  # fmt: skip

@@ -302,19 +302,26 @@ class MpmBoxScene:
         """Simulated frames per wall-clock second [1/s] (graph capture and construction excluded)."""
         return self.frame / max(self.wall_time, 1e-9)
 
-    def test_final(self) -> None:
+    def test_final(self, max_leaked_fraction: float = 0.0) -> None:
         """Assert physical sanity: finite state, boxes above the floor, sand inside the containers.
 
         Also ask Newton whether the sparse grid ever ran out of capacity (it reports that only when asked).
+
+        Args:
+            max_leaked_fraction: Particles of one region allowed below the floor, as a fraction of the region's
+                particles (0: none). A handful of strays (e.g. 4 of 288k at 2 cm voxels) leave the box's motion
+                unchanged; a failing floor loses many more.
         """
         self.mpm.check_sparse_grid_rebuild_status()
         q = np.asarray(self.body_q_all[-1])
         assert np.all(np.isfinite(q)), "box state is not finite"
         assert np.all(q[:, 2] > -self.cfg.bed.depth), f"a box fell through the bed (z = {q[:, 2].min():.3f} m)"
         d = self.diagnostics()
-        assert d["leaked_particles"] == 0, (
+        allowed = int(max_leaked_fraction * self.particle_count / len(self.mats))
+        assert max(d["leaked_per_region"]) <= allowed and d["nonfinite_particles"] == 0, (
             f"sand leaked through the floor: {d['leaked_particles']} of {self.particle_count} particles more than "
-            f"2 voxels below it (min z = {d['particle_z_min']:.3f} m, per region {d['leaked_per_region']})"
+            f"2 voxels below it (min z = {d['particle_z_min']:.3f} m, per region {d['leaked_per_region']}, "
+            f"allowed {allowed} per region)"
         )
 
     def diagnostics(self) -> dict[str, Any]:
