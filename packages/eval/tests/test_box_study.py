@@ -202,7 +202,7 @@ def test_failed_mpm_solve_is_logged_and_skipped(tmp_path: Path, monkeypatch: pyt
     real = MpmBoxScene.test_final
     calls = []
 
-    def fail_first(self: MpmBoxScene) -> None:
+    def fail_first(self: MpmBoxScene, max_leaked_fraction: float = 0.0) -> None:
         calls.append(1)
         if len(calls) == 1:
             raise AssertionError("sand leaked through the floor: test")
