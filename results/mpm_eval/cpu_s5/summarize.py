@@ -7,6 +7,7 @@ the largest toe-down sole pitch up to 1 s, the share of logged frames (t <= 1 s)
 and the first fall (the evaluation's rule). Prints Markdown.
 
     uv run python results/mpm_eval/cpu_s5/summarize.py
+    uv run python results/mpm_eval/cpu_s5/summarize.py --log results/mpm_eval/cpu_s6/runs.jsonl <more logs ...>
 """
 
 from __future__ import annotations
@@ -28,7 +29,10 @@ def walk_row(rec: dict[str, Any]) -> str:
     """One Markdown row of a walking run."""
     rows = rec["rows"]
     if "t" not in rows[0]:
-        return ""
+        if "f" not in rows[0]:
+            return ""
+        # older records (``../gpu_s5/``) log the frame index only
+        rows = [{**r, "t": r["f"] * rec.get("frame_dt", 0.01)} for r in rows]
     cells = []
     for t in (0.25, 0.5, 0.75, 1.0):
         r = at(rows, t)
@@ -41,6 +45,7 @@ def walk_row(rec: dict[str, Any]) -> str:
     cfg = "3D-RFT (training sim)" if rec.get("sim", "").startswith("mujoco") else (
         f"MPM {100 * rec['voxel']:.0f} cm / {rec['iterations']} its, frame {1000 * rec.get('frame_dt', 0.01):g} ms "
         f"x {rec.get('substeps', 2)}, m_eff {rec.get('effective_mass') or 'm/2'}"
+        + (f", {rec['handover']}" if "handover" in rec else "")
     )  # fmt: skip
     fall = rec.get("first_fall_s")
     last = rows[-1]
@@ -52,9 +57,9 @@ def walk_row(rec: dict[str, Any]) -> str:
 def main() -> None:
     """Print the tables."""
     p = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    p.add_argument("--log", type=Path, default=Path("results/mpm_eval/cpu_s5/runs.jsonl"))
+    p.add_argument("--log", type=Path, nargs="+", default=[Path("results/mpm_eval/cpu_s5/runs.jsonl")])
     args = p.parse_args()
-    recs = [json.loads(line) for line in args.log.read_text().splitlines() if line.strip()]
+    recs = [json.loads(line) for log in args.log for line in log.read_text().splitlines() if line.strip()]
     print(
         "| run | simulator | 0.25 s | 0.5 s | 0.75 s | 1.0 s | toe-down pitch min [deg] | fz < -5 N: frames (mid [cm]) | run end: pelvis, body pitch | fall [s] (50 Hz log) |"
     )
