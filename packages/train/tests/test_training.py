@@ -63,6 +63,21 @@ def test_checkpoint_carries_the_curriculum_step_counter(run_dir: Path) -> None:
     assert ckpt["infos"]["env_state"]["common_step_counter"] == 3 * 4
 
 
+def test_resume_from_a_slim_checkpoint(run_dir: Path, tmp_path: Path) -> None:
+    """A checkpoint without optimizer state (the committed artifacts) resumes with its weights and iteration."""
+    import shutil
+
+    import torch
+
+    slim_dir = tmp_path / "slim"
+    shutil.copytree(run_dir, slim_dir)
+    ckpt = torch.load(slim_dir / "model_3.pt", map_location="cpu", weights_only=False)
+    ckpt.pop("optimizer_state_dict")
+    torch.save(ckpt, slim_dir / "model_3.pt")
+    metrics = train(_cfg(slim_dir, max_iterations=4))
+    assert metrics["resumed_from_iteration"] == 3 and metrics["iteration"] == 4
+
+
 def test_resume_refuses_a_changed_task(run_dir: Path) -> None:
     """Resuming a run directory with another contact model is an error, not a silent mix."""
     with pytest.raises(ValueError, match="task"):

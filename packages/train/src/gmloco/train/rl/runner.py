@@ -124,7 +124,13 @@ class GmlocoOnPolicyRunner(MjlabOnPolicyRunner):
     def load(
         self, path: str, load_cfg: dict | None = None, strict: bool = True, map_location: str | None = None
     ) -> dict:
-        """Load a checkpoint, restoring the floor levels (mjlab's runner restores the env step counter)."""
+        """Load a checkpoint, restoring the floor levels (mjlab's runner restores the env step counter).
+
+        A slim checkpoint (saved without ``optimizer_state_dict``, as the committed artifacts are) restores the
+        weights and the iteration and starts a fresh optimizer.
+        """
+        if load_cfg is None and "optimizer_state_dict" not in torch.load(path, map_location="cpu", weights_only=False):
+            load_cfg = {"actor": True, "critic": True, "iteration": True, "optimizer": False, "rnd": False}
         infos = super().load(path, load_cfg, strict, map_location or self.device)
         levels = (infos or {}).get("sand_floor_level")
         env = self.env.unwrapped
