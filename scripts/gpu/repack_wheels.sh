@@ -1,0 +1,36 @@
+#!/usr/bin/env bash
+# Regroups the wheel parts made by pack_wheels.sh into smaller parts, offline (no download):
+#
+#   PART_MB=7 scripts/gpu/repack_wheels.sh [OUTDIR]     (default .devwheels)
+#
+# The working tree travels with every device call and the call's total is capped at 64 MiB, so when the tree grows
+# the parts must shrink: PART_MB + tree size (tracked and untracked-not-ignored files) must stay under 64 MiB.
+# Split wheels (WHEEL.piece.NN) are joined back first, then split and grouped as pack_wheels.sh does.
+set -euo pipefail
+here=$(cd "$(dirname "$0")" && pwd)
+out=${1:-.devwheels}
+limit=$(( ${PART_MB:-7} * 1024 * 1024 ))
+[ -d "$out/part1" ] || { echo "no parts in $out: run scripts/gpu/pack_wheels.sh first" >&2; exit 1; }
+tmp=$(mktemp -d "${out%/}.repack.XXXX")
+find "$out"/part* -maxdepth 1 -type f ! -name install_part.sh -exec mv {} "$tmp"/ \;
+for first in "$tmp"/*.piece.00; do  # join split wheels
+  [ -e "$first" ] || continue
+  cat "${first%.piece.00}".piece.* > "${first%.piece.00}" && rm "${first%.piece.00}".piece.*
+done
+rm -rf "$out" && mkdir -p "$out/dl" && mv "$tmp"/*.whl "$out/dl/" && rmdir "$tmp"
+for w in "$out"/dl/*.whl; do
+  if [ "$(stat -c %s "$w")" -gt "$limit" ]; then split -b "$limit" -d -a 2 "$w" "$w.piece." && rm "$w"; fi
+done
+n=0
+for f in $(ls -S "$out/dl"); do  # first fit, largest first
+  size=$(stat -c %s "$out/dl/$f"); placed=
+  for ((i = 1; i <= n; i++)); do
+    if [ $(( $(du -sb "$out/part$i" | cut -f1) + size )) -le "$limit" ]; then
+      mv "$out/dl/$f" "$out/part$i/"; placed=1; break
+    fi
+  done
+  if [ -z "$placed" ]; then n=$((n + 1)); mkdir -p "$out/part$n"; mv "$out/dl/$f" "$out/part$n/"; fi
+done
+rmdir "$out/dl"
+for ((i = 1; i <= n; i++)); do cp "$here/install_part.sh" "$out/part$i/"; done
+echo "$n parts in $out"
