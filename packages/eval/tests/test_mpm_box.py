@@ -114,8 +114,10 @@ def test_batched_regions_match_single_scenes() -> None:
 
 
 def test_final_diagnostics_count_leaked_particles(resting_box: MpmBoxScene) -> None:
-    """No particle below the floor after the run; one moved 1 m down is counted, per region, and fails test_final
-    unless tolerated (``max_leaked_fraction``), a second one then fails again."""
+    """No particle below the floor after the run; one moved 1 m down is counted, per region, and fails test_final.
+
+    Unless tolerated (``max_leaked_fraction``): then a second one fails again.
+    """
     d = resting_box.diagnostics()
     assert d["leaked_particles"] == 0 and d["leaked_per_region"] == [0] and d["nonfinite_particles"] == 0
     q = resting_box.sand_state.particle_q
