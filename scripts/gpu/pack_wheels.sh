@@ -28,19 +28,4 @@ grep -vE '^\s*(#|$)' "$req" | sed 's/\s*#.*//' | while read -r pin; do
   fi
 done
 rmdir "$out/sdist"
-for w in "$out"/dl/*.whl; do   # split large wheels into WHEEL.piece.NN
-  if [ "$(stat -c %s "$w")" -gt "$limit" ]; then split -b "$limit" -d -a 2 "$w" "$w.piece." && rm "$w"; fi
-done
-n=0
-for f in $(ls -S "$out/dl"); do  # first fit, largest first
-  size=$(stat -c %s "$out/dl/$f"); placed=
-  for ((i = 1; i <= n; i++)); do
-    if [ $(( $(du -sb "$out/part$i" | cut -f1) + size )) -le "$limit" ]; then
-      mv "$out/dl/$f" "$out/part$i/"; placed=1; break
-    fi
-  done
-  if [ -z "$placed" ]; then n=$((n + 1)); mkdir -p "$out/part$n"; mv "$out/dl/$f" "$out/part$n/"; fi
-done
-rmdir "$out/dl"
-for ((i = 1; i <= n; i++)); do cp "$here/install_part.sh" "$out/part$i/"; done
-echo "$n parts in $out:"; du -sh "$out"/part*
+bash "$here/group_parts.sh" "$out" "$limit"
