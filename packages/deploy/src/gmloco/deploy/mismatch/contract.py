@@ -10,6 +10,7 @@ from typing import Literal
 
 import numpy as np
 
+from gmloco.deploy.mismatch.frames import quat_conj, quat_mul, quat_to_mat
 from gmloco.deploy.mismatch.recording import Recording
 
 __all__ = ["ContractCfg", "ContractError", "ContractIssue", "JointMapError", "check_recording", "joint_ranges"]
@@ -60,6 +61,21 @@ class ContractCfg:
     """Largest tolerated std(dt) / median(dt) [-]."""
     min_duration: float = 2.0
     """Shorter recordings cannot be analysed [s]."""
+    quat_gravity_bad: float = 0.5
+    """Median angle between the accelerometer and the quaternion's up direction above which a reading of the IMU
+    quaternion is inconsistent with gravity [rad] (about 29 deg)."""
+    quat_gravity_good: float = 0.2
+    """Median angle below which a reading of the IMU quaternion is consistent with gravity [rad] (about 11 deg)."""
+    quat_gravity_window: float = 0.25
+    """Moving-average window of the accelerometer and the up direction before they are compared: averages out the
+    body's own accelerations over a step, which leave gravity [s]."""
+    quat_rate_window: float = 0.04
+    """Window over which the quaternion's rotation rate is compared with the gyro [s]."""
+    quat_rate_min: float = 0.1
+    """Gyro activity (RMS about its median) below which the rate comparison is not used [rad/s]."""
+    quat_rate_ratio: float = 3.0
+    """One reading decides on the rate test when its gyro misfit is this many times smaller than the other's and
+    below half the gyro activity [-]."""
 
 
 @lru_cache(maxsize=1)
@@ -169,8 +185,8 @@ def _xcorr(a: np.ndarray, b: np.ndarray) -> np.ndarray:
     return c
 
 
-def _units(rec: Recording) -> list[ContractIssue]:
-    """Degrees for radians, g for m/s^2, quaternion order and norm."""
+def _units(rec: Recording, cfg: ContractCfg) -> list[ContractIssue]:
+    """Degrees for radians, g for m/s^2, quaternion order (:func:`_quat_order`) and norm."""
     issues = []
     if np.nanmax(np.abs(rec.q)) > 2 * np.pi:
         issues.append(ContractIssue("units", "error", "joint positions exceed 2*pi: degrees logged as radians?"))
@@ -187,11 +203,85 @@ def _units(rec: Recording) -> list[ContractIssue]:
     qn = np.linalg.norm(rec.imu_quat, axis=1)
     if np.nanmax(np.abs(qn - 1.0)) > 0.05:
         issues.append(ContractIssue("units", "error", "IMU quaternion is not unit norm"))
-    elif np.nanmedian(np.abs(rec.imu_quat[:, 0])) < 0.5 < np.nanmedian(np.abs(rec.imu_quat[:, 3])):
-        issues.append(ContractIssue("units", "error", "IMU quaternion looks (x, y, z, w); the schema is (w, x, y, z)"))
+    else:
+        swapped, evidence = _quat_order(rec.imu_quat, rec.imu_gyro, rec.imu_acc, rec.dt, cfg)
+        if swapped:
+            issues.append(
+                ContractIssue(
+                    "units", "error", "IMU quaternion looks (x, y, z, w); the schema is (w, x, y, z)", evidence
+                )
+            )
     if np.nanmedian(np.abs(rec.imu_gyro)) > 5.0:
         issues.append(ContractIssue("units", "error", "gyro magnitudes look like deg/s; the schema is rad/s"))
     return issues
+
+
+def _quat_order(quat: np.ndarray, gyro: np.ndarray, acc: np.ndarray, dt: float, cfg: ContractCfg) -> tuple[bool, dict]:
+    """Whether the IMU quaternion columns are (x, y, z, w) rather than the schema's (w, x, y, z).
+
+    Both readings of the columns (as given, and re-read as x, y, z, w) are tested against the other IMU channels
+    with quantities that do not depend on the heading (a turning robot must pass whatever its yaw):
+
+    * gravity: the median angle between the accelerometer (specific force, up at rest) and the up direction in
+      the IMU frame implied by the reading, ``R(q)^T e_z``, both averaged over ``quat_gravity_window``;
+    * rate: the RMS misfit between the gyro and the body rotation rate of the reading, from
+      ``q(k)^-1 q(k + m)`` over ``quat_rate_window`` (a constant gyro bias removed by the median), used only when
+      the gyro moves (RMS above ``quat_rate_min``).
+
+    A test favours a reading when that reading fits and the other does not. The order is reported wrong only when
+    a test favours (x, y, z, w) and none favours (w, x, y, z); a recording that is uninformative (standing still
+    at a heading where both readings look upright) passes.
+
+    Returns:
+        ``(swapped, evidence)`` with the per-reading misfits in ``evidence``.
+    """
+    readings = {"wxyz": np.asarray(quat, float), "xyzw": np.asarray(quat, float)[:, [3, 0, 1, 2]]}
+    n = len(quat)
+    if n < 3 or dt <= 0.0:
+        return False, {}
+    m = max(1, round(cfg.quat_rate_window / dt))
+    w = min(n, max(1, round(cfg.quat_gravity_window / dt)))
+
+    def _avg(x: np.ndarray) -> np.ndarray:
+        """Moving average over ``w`` samples ('valid' part)."""
+        c = np.concatenate([np.zeros((1, x.shape[1])), np.cumsum(x, axis=0)])
+        return (c[w:] - c[:-w]) / w
+
+    a_avg = _avg(np.asarray(acc, float))
+    activity = float(np.sqrt(np.mean((gyro - np.median(gyro, axis=0)) ** 2))) if n > m else 0.0
+    grav, rate = {}, {}
+    for name, q in readings.items():
+        q = q / np.linalg.norm(q, axis=1, keepdims=True)
+        up = _avg(quat_to_mat(q)[:, 2, :])  # world z in the IMU frame
+        cos = np.sum(up * a_avg, axis=1) / np.maximum(np.linalg.norm(up, axis=1) * np.linalg.norm(a_avg, axis=1), 1e-9)
+        grav[name] = float(np.median(np.arccos(np.clip(cos, -1.0, 1.0))))
+        if n > m:
+            rel = quat_mul(quat_conj(q[:-m]), q[m:])
+            rel = rel * np.where(rel[:, :1] < 0.0, -1.0, 1.0)
+            sn = np.linalg.norm(rel[:, 1:], axis=1, keepdims=True)
+            ang = 2.0 * np.arctan2(sn, rel[:, :1])
+            w_q = np.where(sn > 1e-12, rel[:, 1:] / np.maximum(sn, 1e-300) * ang, 2.0 * rel[:, 1:]) / (m * dt)
+            csum = np.concatenate([np.zeros((1, 3)), np.cumsum(gyro, axis=0)])
+            mean_gyro = (csum[m:n] - csum[: n - m] + csum[m + 1 :] - csum[1 : n - m + 1]) / (2 * m)  # trapezoid
+            res = mean_gyro - w_q
+            rate[name] = float(np.sqrt(np.mean((res - np.median(res, axis=0)) ** 2)))
+    votes = set()
+    for good, bad in (("wxyz", "xyzw"), ("xyzw", "wxyz")):
+        if grav[good] < cfg.quat_gravity_good and grav[bad] > cfg.quat_gravity_bad:
+            votes.add(good)
+        if (
+            rate
+            and activity > cfg.quat_rate_min
+            and rate[good] < 0.5 * activity
+            and rate[bad] > cfg.quat_rate_ratio * rate[good]
+        ):
+            votes.add(good)
+    evidence = {
+        "gravity_angle_rad": {k: round(v, 3) for k, v in grav.items()},
+        "gyro_misfit_rad_s": {k: round(v, 3) for k, v in rate.items()},
+        "gyro_activity_rad_s": round(activity, 3),
+    }
+    return votes == {"xyzw"}, evidence
 
 
 def _time_base(rec: Recording, cfg: ContractCfg) -> list[ContractIssue]:
@@ -258,7 +348,7 @@ def check_recording(rec: Recording, cfg: ContractCfg | None = None, raise_on_err
     cfg = cfg or ContractCfg()
     issues = _channels(rec)
     if not any(i.severity == "error" for i in issues):
-        issues += _time_base(rec, cfg) + _units(rec) + _joint_map(rec, cfg)
+        issues += _time_base(rec, cfg) + _units(rec, cfg) + _joint_map(rec, cfg)
     errors = [i for i in issues if i.severity == "error"]
     if raise_on_error and errors:
         cls = JointMapError if any(i.check == "joint_map" for i in errors) else ContractError
