@@ -202,11 +202,11 @@ def test_failed_mpm_solve_is_logged_and_skipped(tmp_path: Path, monkeypatch: pyt
     real = MpmBoxScene.test_final
     calls = []
 
-    def fail_first(self: MpmBoxScene, max_leaked_fraction: float = 0.0) -> None:
+    def fail_first(self: MpmBoxScene, max_leaked_fraction: float = 0.0) -> dict:
         calls.append(1)
         if len(calls) == 1:
             raise AssertionError("sand leaked through the floor: test")
-        real(self)
+        return real(self, max_leaked_fraction)
 
     monkeypatch.setattr(MpmBoxScene, "test_final", fail_first)
     cfg = replace(box_study_smoke_cfg(str(tmp_path)), num_trials=2, mpm_batch=1, models=("mpm",),

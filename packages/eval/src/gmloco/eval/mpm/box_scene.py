@@ -302,10 +302,11 @@ class MpmBoxScene:
         """Simulated frames per wall-clock second [1/s] (graph capture and construction excluded)."""
         return self.frame / max(self.wall_time, 1e-9)
 
-    def test_final(self, max_leaked_fraction: float = 0.0) -> None:
+    def test_final(self, max_leaked_fraction: float = 0.0) -> dict[str, Any]:
         """Assert physical sanity: finite state, boxes above the floor, sand inside the containers.
 
         Also ask Newton whether the sparse grid ever ran out of capacity (it reports that only when asked).
+        Returns the :meth:`diagnostics` it checked.
 
         Args:
             max_leaked_fraction: Particles of one region allowed below the floor, as a fraction of the region's
@@ -323,6 +324,7 @@ class MpmBoxScene:
             f"2 voxels below it (min z = {d['particle_z_min']:.3f} m, per region {d['leaked_per_region']}, "
             f"allowed {allowed} per region)"
         )
+        return d
 
     def diagnostics(self) -> dict[str, Any]:
         """Return the checks of :meth:`test_final` as numbers, without asserting.
