@@ -129,7 +129,9 @@ class GmlocoOnPolicyRunner(MjlabOnPolicyRunner):
         A slim checkpoint (saved without ``optimizer_state_dict``, as the committed artifacts are) restores the
         weights and the iteration and starts a fresh optimizer.
         """
-        if load_cfg is None and "optimizer_state_dict" not in torch.load(path, map_location="cpu", weights_only=False):
+        # peek at the keys through a memory map: the tensors are read once, by the load below
+        peek = torch.load(path, map_location="cpu", weights_only=False, mmap=True)
+        if load_cfg is None and "optimizer_state_dict" not in peek:
             load_cfg = {"actor": True, "critic": True, "iteration": True, "optimizer": False, "rnd": False}
         infos = super().load(path, load_cfg, strict, map_location or self.device)
         levels = (infos or {}).get("sand_floor_level")
