@@ -88,6 +88,13 @@ def _parse(argv: list[str] | None) -> argparse.Namespace:
         help="teacher: start a fresh run from this PPO checkpoint's actor and critic (e.g. artifacts/ppo_rft3d/checkpoint.pt)",
     )
     p.add_argument(
+        "--warm-start-encoder",
+        type=Path,
+        default=None,
+        help="student, first chunk of a new run: start the history encoder from this earlier student checkpoint "
+        "(e.g. artifacts/gm_loco_student/checkpoint.pt) instead of from scratch",
+    )
+    p.add_argument(
         "--curriculum-scale",
         type=float,
         default=None,
@@ -370,6 +377,9 @@ def main(argv: list[str] | None = None) -> dict[str, Any]:
         history_length=args.history_length,
         init_checkpoint=None if init is None else str(init),
         warm_start_ppo=None if args.stage != "teacher" or args.warm_start_ppo is None else str(args.warm_start_ppo),
+        warm_start_student_encoder=None
+        if init is None or args.warm_start_encoder is None
+        else str(args.warm_start_encoder),
     )
     metrics = train(cfg)
     ckpt = _newest(run_dir)

@@ -1,18 +1,31 @@
 # SPDX-License-Identifier: Apache-2.0
-"""Warm start of the VAE teacher from a stacked-frame PPO actor: exact on a stationary history."""
+"""Warm starts: the VAE teacher from a PPO actor (exact on a stationary history), a student's encoder from a student."""
 
 from __future__ import annotations
 
 import copy
 from collections.abc import Callable
+from pathlib import Path
 
 import pytest
 import torch
 from rsl_rl.env import VecEnv
 from torch import nn
 
-from gmloco.train.teacher_student import ObsGroupsCfg, TeacherCfg, TeacherPPO
-from gmloco.train.teacher_student.warm_start import stacked_columns, teacher_actor_from_ppo
+from gmloco.train.teacher_student import (
+    DistillCfg,
+    ObsGroupsCfg,
+    StudentCfg,
+    StudentPPO,
+    TeacherCfg,
+    TeacherPPO,
+)
+from gmloco.train.teacher_student.warm_start import (
+    STUDENT_ENCODER_PREFIXES,
+    stacked_columns,
+    student_encoder_from,
+    teacher_actor_from_ppo,
+)
 
 FRAMES = 3
 TERM_DIMS = (2, 3)  # the toy env's actor frame: command (2) + noise (3)
@@ -76,3 +89,61 @@ def test_warm_start_refuses_a_ppo_input_that_is_not_whole_frames(
     state = alg.actor.state_dict()
     with pytest.raises(ValueError, match="not a stack"):
         teacher_actor_from_ppo(_ppo_state(state, 14, torch.Generator().manual_seed(1)), state, TERM_DIMS)
+
+
+def _fresh_student(env: VecEnv, cfg: dict, teacher: dict, seed: int) -> StudentPPO:
+    torch.manual_seed(seed)
+    alg = StudentPPO.construct_algorithm(env.get_observations(), env, cfg, "cpu")
+    alg.load(teacher, None, strict=True)
+    return alg
+
+
+def test_student_encoder_warm_start_copies_only_the_history_encoder(
+    student_alg: StudentPPO,
+    toy_env: VecEnv,
+    teacher_cfg: TeacherCfg,
+    student_cfg: StudentCfg,
+    distill_cfg: DistillCfg,
+    groups: ObsGroupsCfg,
+    runner_cfg: Callable[[dict], dict],
+    teacher_ckpt: dict,
+    tmp_path: Path,
+) -> None:
+    """A new student from a (new) teacher takes the earlier student's TCN and history normalizer, nothing else."""
+    earlier = student_alg.save()
+    with torch.no_grad():
+        for key, value in earlier["actor_state_dict"].items():
+            if torch.is_floating_point(value):
+                earlier["actor_state_dict"][key] = value + 0.5  # distinct from any fresh initialisation
+    path = tmp_path / "student.pt"
+    torch.save(earlier, path)
+    cfg = runner_cfg(distill_cfg.to_rsl_rl(teacher_cfg, student_cfg, groups))
+    new = _fresh_student(toy_env, cfg, teacher_ckpt, seed=7)
+    before = {k: v.clone() for k, v in new.actor.state_dict().items()}
+    record = student_encoder_from(new, path)
+    after = new.actor.state_dict()
+    copied = {k for k in after if k.startswith(STUDENT_ENCODER_PREFIXES)}
+    assert copied and record["entries"] == len(copied)
+    for key, value in after.items():
+        expected = earlier["actor_state_dict"][key] if key in copied else before[key]
+        assert torch.equal(value, expected), key
+
+
+def test_student_encoder_warm_start_refuses_a_teacher_checkpoint(
+    student_alg: StudentPPO, teacher_ckpt: dict, tmp_path: Path
+) -> None:
+    """A teacher checkpoint has no student encoder: refused with the reason."""
+    path = tmp_path / "teacher.pt"
+    torch.save(teacher_ckpt, path)
+    with pytest.raises(ValueError, match="not a student checkpoint"):
+        student_encoder_from(student_alg, path)
+
+
+def test_student_encoder_warm_start_refuses_another_latent_size(student_alg: StudentPPO, tmp_path: Path) -> None:
+    """An encoder of another latent size cannot be copied: refused, naming the entries."""
+    saved = student_alg.save()
+    saved["actor_state_dict"]["encoder.mlp.2.weight"] = torch.zeros(3, 1)
+    path = tmp_path / "student.pt"
+    torch.save(saved, path)
+    with pytest.raises(ValueError, match="does not fit"):
+        student_encoder_from(student_alg, path)

@@ -71,6 +71,10 @@ class TrainRunCfg:
     """VAE teacher only: a vanilla-PPO checkpoint of the same task whose actor (stacked frames mapped onto one
     frame, latent inputs zero) and critic start the teacher when ``run_dir`` has no checkpoint
     (``gmloco.train.teacher_student.warm_start``); None: start from scratch."""
+    warm_start_student_encoder: str | None = None
+    """Student only, with ``init_checkpoint`` a teacher: an earlier student checkpoint whose history encoder (TCN +
+    normalizer) replaces the fresh one when ``run_dir`` has no checkpoint (distilling from a new teacher); None: a
+    fresh encoder."""
 
 
 def _check_resume_cfg(run_dir: Path, cfg: TrainRunCfg) -> None:
@@ -121,6 +125,14 @@ def _warm_start(runner: Any, env: Any, path: str, run_dir: Path) -> None:
     (run_dir / "warm_start.json").write_text(json.dumps(record, indent=1))
 
 
+def _warm_start_encoder(runner: Any, path: str, run_dir: Path) -> None:
+    """Start a student's history encoder from an earlier student; the record goes to ``run_dir/warm_start.json``."""
+    from gmloco.train.teacher_student.warm_start import student_encoder_from
+
+    record = student_encoder_from(runner.alg, Path(path).resolve())
+    (run_dir / "warm_start.json").write_text(json.dumps(record, indent=1))
+
+
 def train(cfg: TrainRunCfg) -> dict[str, float]:
     """Train (or resume) PPO on the granular G1 task and return summary metrics.
 
@@ -150,6 +162,8 @@ def train(cfg: TrainRunCfg) -> dict[str, float]:
         runner.load(str(checkpoint))
     elif cfg.init_checkpoint is not None:
         runner.load(str(Path(cfg.init_checkpoint).resolve()))
+        if cfg.warm_start_student_encoder is not None:
+            _warm_start_encoder(runner, cfg.warm_start_student_encoder, run_dir)
     elif cfg.warm_start_ppo is not None:
         _warm_start(runner, env, cfg.warm_start_ppo, run_dir)
     resumed_from = runner.current_learning_iteration

@@ -20,7 +20,13 @@ from typing import Any
 
 import torch
 
-__all__ = ["stacked_columns", "teacher_actor_from_ppo", "warm_start_from_ppo"]
+__all__ = [
+    "STUDENT_ENCODER_PREFIXES",
+    "stacked_columns",
+    "student_encoder_from",
+    "teacher_actor_from_ppo",
+    "warm_start_from_ppo",
+]
 
 _NORM = "obs_normalizer."
 _FIRST = "mlp.0."
@@ -110,3 +116,45 @@ def warm_start_from_ppo(alg: Any, path: str | Path, term_dims: Sequence[int]) ->
     if critic_copied:
         critic.load_state_dict({k: v.to(device) for k, v in theirs.items()}, strict=True)
     return {"warm_start_ppo": str(path), "ppo_iteration": int(ckpt.get("iter", -1)), "critic_copied": critic_copied}
+
+
+STUDENT_ENCODER_PREFIXES = ("encoder.", "history_normalizer.")
+"""Student actor entries that map the proprioceptive history to z_hat (TCN and its input normalizer)."""
+
+
+def student_encoder_from(alg: Any, path: str | Path) -> dict[str, Any]:
+    """Copy an earlier student's history encoder (TCN + history normalizer) into a ``StudentPPO``; return a record.
+
+    Used when a student is distilled from a new teacher: the actor MLP, action distribution and critic come from the
+    new teacher (``init_from_teacher``), the encoder that infers the terrain latent from proprioception starts from
+    the earlier student instead of from scratch. The new teacher's latent space may differ from the old one's; the
+    latent loss ``||z - z_hat||^2`` then moves the encoder, which only needs to adapt, not learn from nothing.
+
+    Args:
+        alg: The runner's ``StudentPPO`` (its ``_raw_actor`` or ``actor``).
+        path: A student checkpoint (``actor_state_dict`` with ``encoder.*`` and ``history_normalizer.*``).
+
+    Raises:
+        ValueError: If ``path`` holds no student encoder, or its shapes differ (another history length or latent
+            size).
+    """
+    ckpt = torch.load(path, map_location="cpu", weights_only=False)
+    theirs = {k: v for k, v in ckpt.get("actor_state_dict", {}).items() if k.startswith(STUDENT_ENCODER_PREFIXES)}
+    if not theirs or "teacher_state_dict" not in ckpt:
+        raise ValueError(f"{path} is not a student checkpoint (no encoder.* entries / no teacher): pass a student's")
+    actor = getattr(alg, "_raw_actor", None) or alg.actor
+    own = actor.state_dict()
+    mine = {k for k in own if k.startswith(STUDENT_ENCODER_PREFIXES)}
+    if mine != theirs.keys() or any(own[k].shape != theirs[k].shape for k in mine):
+        diff = sorted(
+            k for k in mine | theirs.keys() if k not in own or k not in theirs or own[k].shape != theirs[k].shape
+        )
+        raise ValueError(f"student encoder of {path} does not fit this student (history length / latent size?): {diff}")
+    device = next(actor.parameters()).device
+    own.update({k: v.to(device) for k, v in theirs.items()})
+    actor.load_state_dict(own, strict=True)
+    return {
+        "warm_start_student_encoder": str(path),
+        "student_iteration": int(ckpt.get("iter", -1)),
+        "entries": len(theirs),
+    }
