@@ -30,6 +30,13 @@ def _parse(argv: list[str] | None) -> argparse.Namespace:
     p.add_argument("--episode-s", type=float, default=10.0)
     p.add_argument("--voxel", type=float, default=0.05)
     p.add_argument("--iters", type=int, default=G1EvalCfg().solver.max_iterations, help="rheology iterations")
+    p.add_argument(
+        "--frame-dt",
+        type=float,
+        default=G1EvalCfg().solver.frame_dt,
+        help="MPM frame = coupling period [s]; must divide the 0.02 s policy step (0.01, 0.005, 0.0025)",
+    )
+    p.add_argument("--substeps", type=int, default=G1EvalCfg().solver.rigid_substeps, help="rigid steps per frame")
     p.add_argument("--bed-depth", type=float, default=G1EvalCfg.bed_depth, help="sand depth of flat / rough beds [m]")
     p.add_argument("--robots-per-batch", type=int, default=25)
     p.add_argument("--static-bed", action="store_true", help="naive baseline: a bed covering the course")
@@ -40,7 +47,13 @@ def _parse(argv: list[str] | None) -> argparse.Namespace:
     p.add_argument("--fresh", action="store_true", help="discard episodes.jsonl instead of resuming")
     p.add_argument("--device", default=None)
     p.add_argument("--seed", type=int, default=0)
-    return p.parse_args(argv)
+    a = p.parse_args(argv)
+    per_policy = 0.02 / a.frame_dt if a.frame_dt > 0.0 else 0.0
+    if per_policy < 1.0 or abs(per_policy - round(per_policy)) > 1e-6:
+        p.error(f"--frame-dt {a.frame_dt} s must divide the 0.02 s policy step (e.g. 0.01, 0.005, 0.0025)")
+    if a.substeps < 1:
+        p.error(f"--substeps {a.substeps} must be >= 1 (rigid steps per MPM frame)")
+    return a
 
 
 def main(argv: list[str] | None = None) -> None:
@@ -58,7 +71,9 @@ def main(argv: list[str] | None = None) -> None:
         episode_s=a.episode_s,
         window=SandWindowCfg(moving=not a.static_bed, length=a.window_length, width=a.window_width),
         robots_per_batch=a.robots_per_batch,
-        solver=replace(base.solver, voxel_size=a.voxel, max_iterations=a.iters),
+        solver=replace(
+            base.solver, voxel_size=a.voxel, max_iterations=a.iters, frame_dt=a.frame_dt, rigid_substeps=a.substeps
+        ),
         bed_depth=a.bed_depth,
         record_mcap=not a.no_mcap,
         max_minutes=a.max_minutes,
