@@ -23,6 +23,7 @@ from rsl_rl.utils import resolve_callable, resolve_obs_groups
 from tensordict import TensorDict
 
 from gmloco.train.teacher_student.aux_ppo import AuxLossPPO
+from gmloco.train.teacher_student.checkpoint_teacher import attach_teacher
 from gmloco.train.teacher_student.curriculum import LinearRamp
 from gmloco.train.teacher_student.losses import distill_terms, squared_error
 from gmloco.train.teacher_student.student import StudentActor
@@ -164,7 +165,12 @@ class StudentPPO(AuxLossPPO):
         return saved
 
     def load(self, loaded_dict: dict, load_cfg: dict | None, strict: bool) -> bool:
-        """Load a student checkpoint, or a teacher checkpoint (no ``teacher_state_dict``) via :meth:`load_teacher`."""
+        """Load a student checkpoint, or a teacher checkpoint (no ``teacher_state_dict``) via :meth:`load_teacher`.
+
+        A student checkpoint whose teacher was detached (``checkpoint_teacher.detach_teacher``) gets it back from the
+        teacher file it names first.
+        """
+        loaded_dict = dict(attach_teacher(loaded_dict))
         if "teacher_state_dict" not in loaded_dict:
             self.load_teacher(loaded_dict, strict)
             return False
