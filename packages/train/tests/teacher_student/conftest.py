@@ -161,18 +161,27 @@ def teacher_ckpt(
 
 
 @pytest.fixture
-def student_alg(
+def new_student(
     toy_env: VecEnv,
     teacher_cfg: TeacherCfg,
     student_cfg: StudentCfg,
     distill_cfg: DistillCfg,
     groups: ObsGroupsCfg,
     runner_cfg: Callable[[dict], dict],
-    teacher_ckpt: dict,
-) -> StudentPPO:
+) -> Callable[[int], StudentPPO]:
+    """Return a function that builds a fresh StudentPPO (no teacher loaded) from the typed cfgs with a given seed."""
+
+    def build(seed: int) -> StudentPPO:
+        torch.manual_seed(seed)
+        cfg = runner_cfg(distill_cfg.to_rsl_rl(teacher_cfg, student_cfg, groups))
+        return StudentPPO.construct_algorithm(toy_env.get_observations(), toy_env, cfg, "cpu")  # type: ignore[return-value]
+
+    return build
+
+
+@pytest.fixture
+def student_alg(new_student: Callable[[int], StudentPPO], teacher_ckpt: dict) -> StudentPPO:
     """StudentPPO built by its construct_algorithm from the typed cfgs, with the teacher loaded."""
-    torch.manual_seed(0)
-    cfg = runner_cfg(distill_cfg.to_rsl_rl(teacher_cfg, student_cfg, groups))
-    alg = StudentPPO.construct_algorithm(toy_env.get_observations(), toy_env, cfg, "cpu")
+    alg = new_student(0)
     alg.load(teacher_ckpt, None, strict=True)
     return alg

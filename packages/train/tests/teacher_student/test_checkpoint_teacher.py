@@ -8,9 +8,8 @@ from pathlib import Path
 
 import pytest
 import torch
-from rsl_rl.env import VecEnv
 
-from gmloco.train.teacher_student import DistillCfg, ObsGroupsCfg, StudentCfg, StudentPPO, TeacherCfg
+from gmloco.train.teacher_student import StudentPPO
 from gmloco.train.teacher_student.checkpoint_teacher import (
     TEACHER_SOURCE_KEY,
     attach_teacher,
@@ -28,20 +27,13 @@ def saved(student_alg: StudentPPO, teacher_ckpt: dict, tmp_path: Path) -> tuple[
 
 
 def test_detached_student_loads_back_exactly(
-    saved: tuple[dict, Path],
-    toy_env: VecEnv,
-    teacher_cfg: TeacherCfg,
-    student_cfg: StudentCfg,
-    distill_cfg: DistillCfg,
-    groups: ObsGroupsCfg,
-    runner_cfg: Callable[[dict], dict],
+    saved: tuple[dict, Path], new_student: Callable[[int], StudentPPO]
 ) -> None:
     """Detach, load into a fresh StudentPPO: student and teacher tensors equal the full checkpoint's."""
     full, teacher_path = saved
     slim = detach_teacher(full, teacher_path)
     assert "teacher_state_dict" not in slim and slim[TEACHER_SOURCE_KEY] == str(teacher_path)
-    cfg = runner_cfg(distill_cfg.to_rsl_rl(teacher_cfg, student_cfg, groups))
-    fresh = StudentPPO.construct_algorithm(toy_env.get_observations(), toy_env, cfg, "cpu")
+    fresh = new_student(3)
     assert fresh.load(slim, None, strict=True) is True
     assert fresh.teacher_loaded
     assert state_digest(fresh.teacher.state_dict()) == state_digest(full["teacher_state_dict"])

@@ -11,13 +11,9 @@ import torch
 from rsl_rl.env import VecEnv
 
 from gmloco.train.teacher_student import (
-    DistillCfg,
     LinearRamp,
-    ObsGroupsCfg,
     StudentActor,
-    StudentCfg,
     StudentPPO,
-    TeacherCfg,
 )
 
 
@@ -109,13 +105,7 @@ def _snapshot_copy(batch: dict) -> dict:
 
 
 def test_student_checkpoint_round_trip_keeps_curriculum_and_teacher(
-    student_alg: StudentPPO,
-    toy_env: VecEnv,
-    teacher_cfg: TeacherCfg,
-    student_cfg: StudentCfg,
-    distill_cfg: DistillCfg,
-    groups: ObsGroupsCfg,
-    runner_cfg: Callable[[dict], dict],
+    student_alg: StudentPPO, toy_env: VecEnv, new_student: Callable[[int], StudentPPO]
 ) -> None:
     """save() then load() into a fresh StudentPPO restores student, teacher and the curriculum position."""
     student_alg.train_mode()
@@ -123,8 +113,7 @@ def test_student_checkpoint_round_trip_keeps_curriculum_and_teacher(
     student_alg.update()
     saved = student_alg.save()
     assert saved["distill_updates"] == 1 and "teacher_state_dict" in saved
-    cfg = runner_cfg(distill_cfg.to_rsl_rl(teacher_cfg, student_cfg, groups))
-    fresh = StudentPPO.construct_algorithm(toy_env.get_observations(), toy_env, cfg, "cpu")
+    fresh = new_student(1)
     assert fresh.load(saved, None, strict=True) is True
     assert fresh.teacher_loaded and fresh.num_updates == 1
     for key, value in saved["actor_state_dict"].items():

@@ -13,9 +13,7 @@ from rsl_rl.env import VecEnv
 from torch import nn
 
 from gmloco.train.teacher_student import (
-    DistillCfg,
     ObsGroupsCfg,
-    StudentCfg,
     StudentPPO,
     TeacherCfg,
     TeacherPPO,
@@ -91,23 +89,8 @@ def test_warm_start_refuses_a_ppo_input_that_is_not_whole_frames(
         teacher_actor_from_ppo(_ppo_state(state, 14, torch.Generator().manual_seed(1)), state, TERM_DIMS)
 
 
-def _fresh_student(env: VecEnv, cfg: dict, teacher: dict, seed: int) -> StudentPPO:
-    torch.manual_seed(seed)
-    alg = StudentPPO.construct_algorithm(env.get_observations(), env, cfg, "cpu")
-    alg.load(teacher, None, strict=True)
-    return alg
-
-
 def test_student_encoder_warm_start_copies_only_the_history_encoder(
-    student_alg: StudentPPO,
-    toy_env: VecEnv,
-    teacher_cfg: TeacherCfg,
-    student_cfg: StudentCfg,
-    distill_cfg: DistillCfg,
-    groups: ObsGroupsCfg,
-    runner_cfg: Callable[[dict], dict],
-    teacher_ckpt: dict,
-    tmp_path: Path,
+    student_alg: StudentPPO, new_student: Callable[[int], StudentPPO], teacher_ckpt: dict, tmp_path: Path
 ) -> None:
     """A new student from a (new) teacher takes the earlier student's TCN and history normalizer, nothing else."""
     earlier = student_alg.save()
@@ -117,8 +100,8 @@ def test_student_encoder_warm_start_copies_only_the_history_encoder(
                 earlier["actor_state_dict"][key] = value + 0.5  # distinct from any fresh initialisation
     path = tmp_path / "student.pt"
     torch.save(earlier, path)
-    cfg = runner_cfg(distill_cfg.to_rsl_rl(teacher_cfg, student_cfg, groups))
-    new = _fresh_student(toy_env, cfg, teacher_ckpt, seed=7)
+    new = new_student(7)
+    new.load(teacher_ckpt, None, strict=True)
     before = {k: v.clone() for k, v in new.actor.state_dict().items()}
     record = student_encoder_from(new, path)
     after = new.actor.state_dict()
