@@ -1,13 +1,16 @@
 # SPDX-License-Identifier: Apache-2.0
-"""Coupling launchers: the collider velocity each hand-over scheme gives MPM, against numpy."""
+"""Coupling launchers: the collider velocity each hand-over scheme gives MPM (against numpy), the sand wrench on a body."""
 
 from __future__ import annotations
 
+from typing import Any
+
+import newton
 import numpy as np
 import pytest
 import warp as wp
 
-from gmloco.eval.mpm.kernels_coupling import hand_over_velocity
+from gmloco.eval.mpm.kernels_coupling import eval_body_sand_wrench, hand_over_velocity
 
 G = (0.0, 0.0, -9.81)
 DT = 0.01
@@ -65,3 +68,46 @@ def test_actual_copies_and_unknown_scheme_is_refused(bodies: dict[str, np.ndarra
     np.testing.assert_array_equal(_run("actual", bodies), bodies["qd"])
     with pytest.raises(ValueError, match="predict"):
         _run("backward", bodies)
+
+
+def _free_body_model(com: tuple[float, float, float], q: np.ndarray) -> Any:
+    """One free 2 kg body, isotropic inertia 0.02 kg m^2, CoM off its origin, no gravity, no contacts."""
+    b = newton.ModelBuilder(gravity=(0.0, 0.0, 0.0))
+    body = b.add_body(
+        xform=wp.transform(wp.vec3(*q[:3]), wp.quat(*q[3:])),
+        mass=2.0,
+        com=wp.vec3(*com),
+        inertia=wp.mat33(np.eye(3) * 0.02),
+    )
+    b.add_shape_box(body, hx=0.05, hy=0.05, hz=0.05, cfg=newton.ModelBuilder.ShapeConfig(density=0.0))
+    return b.finalize(device="cpu")
+
+
+def test_sand_wrench_moves_a_body_as_the_node_force_would() -> None:
+    """Node force F at p -> wrench (F, (p - c) x F) -> SolverMuJoCo: dv = F dt / m and dw = I^-1 ((p - c) x F) dt.
+
+    Guards the convention the G1 and box scenes rely on: Newton's ``body_f`` is a force at the CoM plus a torque, in
+    world frame; a wrench about the body origin, or in body frame, would turn the body differently.
+    """
+    s = np.sqrt(0.5)
+    q = np.array([0.3, -0.2, 1.0, 0.0, 0.0, s, s])  # rotated 90 deg about z: the body-frame CoM offset turns
+    com_body = (0.1, 0.02, -0.03)
+    model = _free_body_model(com_body, q)
+    s0, s1 = model.state(), model.state()
+    newton.eval_fk(model, model.joint_q, model.joint_qd, s0)
+    f = np.array([3.0, -1.0, 40.0])
+    p = np.array([0.45, -0.1, 0.95])
+    dt, mpm_dt = 1e-3, 0.01
+    wrench = wp.zeros(1, dtype=wp.spatial_vectorf, device="cpu")
+    impulses = (
+        wp.array([f * mpm_dt], dtype=wp.vec3, device="cpu"),
+        wp.array([p], dtype=wp.vec3, device="cpu"),
+        wp.array([0], dtype=int, device="cpu"),
+    )
+    eval_body_sand_wrench(wp.array([0], dtype=int, device="cpu"), model.body_com, mpm_dt, impulses, s0.body_q, wrench)
+    wp.copy(s0.body_f, wrench)
+    newton.solvers.SolverMuJoCo(model).step(s0, s1, model.control(), None, dt)
+    com_world = q[:3] + np.array([-com_body[1], com_body[0], com_body[2]])  # R_z(90) applied to the offset
+    qd = s1.body_qd.numpy()[0]
+    np.testing.assert_allclose(qd[:3], f * dt / 2.0, rtol=1e-3, atol=1e-6)
+    np.testing.assert_allclose(qd[3:], np.cross(p - com_world, f) * dt / 0.02, rtol=1e-3, atol=1e-5)
