@@ -175,3 +175,30 @@ def test_soles_stand_on_the_floor_under_a_shallow_bed() -> None:
     assert np.asarray(scene.base_q)[-1, 0, 2] > 0.65
     without = np.asarray(_stiff_standing(depth=depth, frames=40, drop_height=0.3, floor_contact=False).sinkage)[:, 0]
     assert without.max() > depth + 0.05, "without the floor contact the soles should pass the floor (control)"
+
+
+def test_odd_substeps_keep_the_frame_buffers_and_the_physics(monkeypatch: pytest.MonkeyPatch) -> None:
+    """5 ms frames x 1 rigid step: frames end on the State objects they start with, the pelvis path unchanged.
+
+    A captured CUDA graph replays fixed buffers; without the parity copy an odd substep count swaps them every frame.
+    The copy moves values and changes none: the walk is identical with and without it.
+    """
+    if not POLICY.exists():
+        pytest.skip(f"no exported policy at {POLICY}")
+
+    def walk(parity: bool) -> tuple[np.ndarray, np.ndarray, bool]:
+        if not parity:
+            monkeypatch.setattr(G1MpmScene, "_restore_state_parity", lambda self: None)
+        cfg = G1MpmSceneCfg(commands=((1.0, 0.0, 0.0),), window=SandWindowCfg(moving=True, length=0.6, width=0.5),
+                            solver=MpmSolverCfg(voxel_size=0.05, frame_dt=0.005, rigid_substeps=1))  # fmt: skip
+        scene = G1MpmScene(cfg, MjlabOnnxPolicy(POLICY))
+        first = scene.state_0
+        scene.run(7)  # an odd frame count: without the copy the buffers end swapped
+        return np.asarray(scene.base_q), scene.state_0.joint_q.numpy(), scene.state_0 is first
+
+    base_parity, joints_parity, same_buffers = walk(parity=True)
+    base_plain, joints_plain, swapped_back = walk(parity=False)
+    assert same_buffers and not swapped_back
+    np.testing.assert_array_equal(base_parity, base_plain)
+    np.testing.assert_array_equal(joints_parity, joints_plain)
+    assert np.ptp(base_parity[:, 0, 2]) > 0.0  # the pelvis moved: the comparison is not between two resting robots

@@ -403,6 +403,8 @@ class G1MpmScene:
             wp.copy(self.state_0.body_f, self.sand_wrench)
             self.rigid.step(self.state_0, self.state_1, self.control, self.contacts, self.sim_dt)
             self.state_0, self.state_1 = self.state_1, self.state_0
+        if self.cfg.solver.rigid_substeps % 2:
+            self._restore_state_parity()
         self.window.advance(self.state_0.body_q)
         wp.copy(self.sand_state.body_q, self.state_0.body_q, count=self.wall_body_offset)
         if self.cfg.wall_colliders:
@@ -418,13 +420,28 @@ class G1MpmScene:
             self.mpm.collect_collider_impulses(self.sand_state), self.sand_state.body_q, self.sand_wrench,
         )  # fmt: skip
 
+    def _restore_state_parity(self) -> None:
+        """After an odd number of substeps, move the newest rigid state back into the frame's first State object.
+
+        The substeps ping-pong between two States; an odd count would leave the newest one in the other object, so
+        consecutive frames would swap buffers, which a captured CUDA graph (fixed buffers) cannot follow. Copying the
+        integrated fields back makes every frame start and end on the same objects; the values are unchanged.
+        """
+        import warp as wp
+
+        for name in ("joint_q", "joint_qd", "body_q", "body_qd"):
+            src, dst = getattr(self.state_0, name), getattr(self.state_1, name)
+            if src is not None and dst is not None:
+                wp.copy(dst, src)
+        self.state_0, self.state_1 = self.state_1, self.state_0
+
     def capture(self) -> None:
-        """Capture one frame as a CUDA graph (fixed-capacity grid, even substeps, CUDA only; else eager)."""
+        """Capture one frame as a CUDA graph (fixed-capacity grid, CUDA only; else eager)."""
         import warp as wp
 
         s = self.cfg.solver
         fixed = s.grid_type == "fixed" or (s.grid_type == "sparse" and s.max_active_cell_count > 0)
-        if not (self.cfg.use_cuda_graph and self.device.is_cuda and fixed and s.rigid_substeps % 2 == 0):
+        if not (self.cfg.use_cuda_graph and self.device.is_cuda and fixed):
             return
         self.simulate()  # warm-up: lazily built inner graphs and kernels
         try:
