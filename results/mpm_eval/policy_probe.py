@@ -24,7 +24,7 @@ from typing import Any
 import numpy as np
 
 from gmloco.eval.g1_eval_policy import StudentOnnxPolicy, load_policy
-from gmloco.eval.mpm.box_scene import MpmSolverCfg
+from gmloco.eval.mpm.box_scene import MpmSolverCfg, frame_dt_problem
 from gmloco.eval.mpm.g1_scene import G1MpmScene, G1MpmSceneCfg, SoleCfg
 from gmloco.eval.mpm.window import SandWindowCfg
 from gmloco.eval.mpm.window_terrain import terrain_cfg
@@ -137,9 +137,8 @@ def main() -> None:
     p.add_argument("--duration", type=float, default=None, help="simulated time [s]; overrides --frames")
     p.add_argument("--log", type=Path, default=Path("results/mpm_eval/policies_cpu.jsonl"))
     args = p.parse_args()
-    per_policy = 0.02 / args.frame_dt if args.frame_dt > 0.0 else 0.0  # the policy runs at 50 Hz on whole frames
-    if per_policy < 1.0 or abs(per_policy - round(per_policy)) > 1e-6:
-        p.error(f"--frame-dt {args.frame_dt} s must divide the 0.02 s policy step (e.g. 0.01, 0.005, 0.0025)")
+    if (problem := frame_dt_problem(args.frame_dt)) is not None:  # the policy runs at 50 Hz on whole frames
+        p.error(f"--frame-dt: {problem}")
     if args.substeps < 1:
         p.error(f"--substeps {args.substeps} must be >= 1 (rigid steps per MPM frame)")
     if args.duration is not None:

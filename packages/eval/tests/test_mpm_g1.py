@@ -8,7 +8,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from gmloco.eval.mpm.box_scene import MpmSolverCfg
+from gmloco.eval.mpm.box_scene import MpmSolverCfg, frame_dt_problem
 from gmloco.eval.mpm.g1_scene import G1MpmScene, G1MpmSceneCfg, MjlabOnnxPolicy
 from gmloco.eval.mpm.window import SandWindowCfg
 
@@ -202,3 +202,17 @@ def test_odd_substeps_keep_the_frame_buffers_and_the_physics(monkeypatch: pytest
     np.testing.assert_array_equal(base_parity, base_plain)
     np.testing.assert_array_equal(joints_parity, joints_plain)
     assert np.ptp(base_parity[:, 0, 2]) > 0.0  # the pelvis moved: the comparison is not between two resting robots
+
+
+@pytest.mark.parametrize(
+    ("frame_dt", "ok"), [(0.01, True), (0.005, True), (0.0025, True), (0.003, False), (0.04, False)]
+)
+def test_frame_dt_must_divide_the_policy_step(frame_dt: float, ok: bool) -> None:
+    """Whole frames per 50 Hz policy step, else a reason naming the value; the scene refuses such a frame."""
+    problem = frame_dt_problem(frame_dt)
+    assert (problem is None) == ok
+    if not ok:
+        assert str(frame_dt) in str(problem)
+        if POLICY.exists():
+            with pytest.raises(ValueError, match="must divide"):
+                G1MpmScene(G1MpmSceneCfg(solver=MpmSolverCfg(frame_dt=frame_dt)), MjlabOnnxPolicy(POLICY))

@@ -14,6 +14,7 @@ import json
 from dataclasses import replace
 
 from gmloco.eval.g1_eval import G1EvalCfg, run
+from gmloco.eval.mpm.box_scene import frame_dt_problem
 from gmloco.eval.mpm.window import SandWindowCfg
 
 __all__ = ["main"]
@@ -48,9 +49,8 @@ def _parse(argv: list[str] | None) -> argparse.Namespace:
     p.add_argument("--device", default=None)
     p.add_argument("--seed", type=int, default=0)
     a = p.parse_args(argv)
-    per_policy = 0.02 / a.frame_dt if a.frame_dt > 0.0 else 0.0
-    if per_policy < 1.0 or abs(per_policy - round(per_policy)) > 1e-6:
-        p.error(f"--frame-dt {a.frame_dt} s must divide the 0.02 s policy step (e.g. 0.01, 0.005, 0.0025)")
+    if (problem := frame_dt_problem(a.frame_dt)) is not None:
+        p.error(f"--frame-dt: {problem}")
     if a.substeps < 1:
         p.error(f"--substeps {a.substeps} must be >= 1 (rigid steps per MPM frame)")
     return a

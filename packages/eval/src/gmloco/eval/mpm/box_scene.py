@@ -38,6 +38,7 @@ __all__ = [
     "MpmSolverCfg",
     "VelocityHandover",
     "emit_bed_particles",
+    "frame_dt_problem",
     "model_gravity",
     "region_offsets",
 ]
@@ -351,6 +352,18 @@ class MpmBoxScene:
             "floor_tolerance_z": floor,
             "box_z": np.asarray(q)[:, 2].tolist(),
         }
+
+
+def frame_dt_problem(frame_dt: float, policy_dt: float = 0.02) -> str | None:
+    """Why an MPM frame of ``frame_dt`` [s] cannot drive a policy of period ``policy_dt`` [s]; None when it can.
+
+    The policy acts on whole frames, so a period must hold a whole number (>= 1) of frames: 0.01, 0.005, 0.0025 s
+    for the 50 Hz policy.
+    """
+    per_policy = policy_dt / frame_dt if frame_dt > 0.0 else 0.0
+    if per_policy < 1.0 or abs(per_policy - round(per_policy)) > 1e-6:
+        return f"frame_dt {frame_dt} s must divide the {policy_dt} s policy step (e.g. 0.01, 0.005, 0.0025 s)"
+    return None
 
 
 def model_gravity(model: Any) -> tuple[float, float, float]:

@@ -39,7 +39,7 @@ from typing import Any
 import numpy as np
 
 from gmloco.eval.g1_eval_policy import MjlabOnnxPolicy, PolicySpec, StudentOnnxPolicy
-from gmloco.eval.mpm.box_scene import MpmSolverCfg, model_gravity
+from gmloco.eval.mpm.box_scene import MpmSolverCfg, frame_dt_problem, model_gravity
 from gmloco.eval.mpm.coupled_setup import make_coupled_states, make_mpm_solver
 from gmloco.eval.mpm.window import SandWindow, SandWindowCfg
 from gmloco.eval.mpm.window_terrain import TerrainCfg, terrain_materials, terrain_surface_height
@@ -146,8 +146,10 @@ class G1MpmScene:
         self.spec = policy if isinstance(policy, PolicySpec) else policy.spec
         self.device = wp.get_device(cfg.device)
         s = cfg.solver
+        if (problem := frame_dt_problem(s.frame_dt, self.spec.policy_dt)) is not None:
+            raise ValueError(f"MpmSolverCfg.{problem}")
         self.frame_dt, self.sim_dt = s.frame_dt, s.frame_dt / s.rigid_substeps
-        self.frames_per_policy = max(1, round(self.spec.policy_dt / self.frame_dt))
+        self.frames_per_policy = round(self.spec.policy_dt / self.frame_dt)
         n = cfg.num_robots
         self.commands = np.array([cfg.commands[r % len(cfg.commands)] for r in range(n)], dtype=np.float64)
         self.lane_y = np.arange(n) * cfg.lane_spacing
