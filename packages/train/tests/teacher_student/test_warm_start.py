@@ -18,6 +18,7 @@ from gmloco.train.teacher_student import (
     TeacherCfg,
     TeacherPPO,
 )
+from gmloco.train.teacher_student.checkpoint_teacher import detach_teacher
 from gmloco.train.teacher_student.warm_start import (
     STUDENT_ENCODER_PREFIXES,
     stacked_columns,
@@ -130,3 +131,16 @@ def test_student_encoder_warm_start_refuses_another_latent_size(student_alg: Stu
     torch.save(saved, path)
     with pytest.raises(ValueError, match="does not fit"):
         student_encoder_from(student_alg, path)
+
+
+def test_student_encoder_warm_start_takes_a_student_whose_teacher_is_detached(
+    student_alg: StudentPPO, new_student: Callable[[int], StudentPPO], teacher_ckpt: dict, tmp_path: Path
+) -> None:
+    """Committed students carry no teacher (they name its file): their encoder is still a valid warm start."""
+    teacher_path = tmp_path / "teacher.pt"
+    torch.save(teacher_ckpt, teacher_path)
+    path = tmp_path / "student.pt"
+    torch.save(detach_teacher(student_alg.save(), teacher_path), path)
+    new = new_student(7)
+    new.load(teacher_ckpt, None, strict=True)
+    assert student_encoder_from(new, path)["entries"] > 0

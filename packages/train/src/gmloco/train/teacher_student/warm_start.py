@@ -20,6 +20,8 @@ from typing import Any
 
 import torch
 
+from gmloco.train.teacher_student.checkpoint_teacher import TEACHER_SOURCE_KEY
+
 __all__ = [
     "STUDENT_ENCODER_PREFIXES",
     "stacked_columns",
@@ -132,7 +134,8 @@ def student_encoder_from(alg: Any, path: str | Path) -> dict[str, Any]:
 
     Args:
         alg: The runner's ``StudentPPO`` (its ``_raw_actor`` or ``actor``).
-        path: A student checkpoint (``actor_state_dict`` with ``encoder.*`` and ``history_normalizer.*``).
+        path: A student checkpoint (``actor_state_dict`` with ``encoder.*`` and ``history_normalizer.*``), with its
+            teacher embedded or detached (``checkpoint_teacher``); the teacher itself is not read.
 
     Raises:
         ValueError: If ``path`` holds no student encoder, or its shapes differ (another history length or latent
@@ -140,7 +143,7 @@ def student_encoder_from(alg: Any, path: str | Path) -> dict[str, Any]:
     """
     ckpt = torch.load(path, map_location="cpu", weights_only=False)
     theirs = {k: v for k, v in ckpt.get("actor_state_dict", {}).items() if k.startswith(STUDENT_ENCODER_PREFIXES)}
-    if not theirs or "teacher_state_dict" not in ckpt:
+    if not theirs or ("teacher_state_dict" not in ckpt and TEACHER_SOURCE_KEY not in ckpt):
         raise ValueError(f"{path} is not a student checkpoint (no encoder.* entries / no teacher): pass a student's")
     actor = getattr(alg, "_raw_actor", None) or alg.actor
     own = actor.state_dict()
