@@ -19,6 +19,9 @@ from gmloco.eval.mpm.window import SandWindowCfg
 
 __all__ = ["main"]
 
+_SOLVER = G1EvalCfg().solver
+"""The evaluation's default MPM numerics (the command line's defaults)."""
+
 
 def _parse(argv: list[str] | None) -> argparse.Namespace:
     p = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
@@ -30,14 +33,14 @@ def _parse(argv: list[str] | None) -> argparse.Namespace:
     p.add_argument("--num-episodes", type=int, default=100)
     p.add_argument("--episode-s", type=float, default=10.0)
     p.add_argument("--voxel", type=float, default=0.05)
-    p.add_argument("--iters", type=int, default=G1EvalCfg().solver.max_iterations, help="rheology iterations")
+    p.add_argument("--iters", type=int, default=_SOLVER.max_iterations, help="rheology iterations")
     p.add_argument(
         "--frame-dt",
         type=float,
-        default=G1EvalCfg().solver.frame_dt,
+        default=_SOLVER.frame_dt,
         help="MPM frame = coupling period [s]; must divide the 0.02 s policy step (0.01, 0.005, 0.0025)",
     )
-    p.add_argument("--substeps", type=int, default=G1EvalCfg().solver.rigid_substeps, help="rigid steps per frame")
+    p.add_argument("--substeps", type=int, default=_SOLVER.rigid_substeps, help="rigid steps per frame")
     p.add_argument("--bed-depth", type=float, default=G1EvalCfg.bed_depth, help="sand depth of flat / rough beds [m]")
     p.add_argument("--robots-per-batch", type=int, default=25)
     p.add_argument("--static-bed", action="store_true", help="naive baseline: a bed covering the course")
