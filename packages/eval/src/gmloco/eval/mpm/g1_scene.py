@@ -56,6 +56,9 @@ __all__ = [
 ]
 
 FOOT_BODIES = ("left_ankle_roll_link", "right_ankle_roll_link")
+# MuJoCo Warp constraint rows per robot: both soles on the rigid floor (8 corners x 2 soles x 4 pyramidal rows) plus
+# joint limits of a fallen robot reached 93 on the H100 (session 8: "nefc overflow" at 64, rows dropped).
+NJMAX_PER_ROBOT = 160
 
 
 def g1_mjcf_path() -> Path:
@@ -315,7 +318,7 @@ class G1MpmScene:
         per_world = 1 if self.as_worlds else self.cfg.num_robots
         self.rigid = newton.solvers.SolverMuJoCo(
             self.model, use_mujoco_cpu=not self.as_worlds, use_mujoco_contacts=self.cfg.floor_contact,
-            njmax=64 * per_world, nconmax=64 * per_world,
+            njmax=NJMAX_PER_ROBOT * per_world, nconmax=64 * per_world,
         )  # fmt: skip
         # mujoco_warp without MuJoCo contacts still reads Newton contacts: an empty set (the robots touch only sand)
         no_contacts = self.cfg.floor_contact or not self.as_worlds
