@@ -44,6 +44,20 @@ def test_rom_study_records_and_resume(tmp_path: Path) -> None:
     assert all(r["sinkage"] < 0.01 for r in rows if r["model"] == "rigid")
 
 
+def test_resume_under_other_settings_is_refused(tmp_path: Path) -> None:
+    """A second call with another box duration would mix two studies: refused, naming the field; the same is fine."""
+    cfg = replace(box_study_smoke_cfg(str(tmp_path)), num_trials=1, models=("rigid",))
+    run(cfg)
+    longer = replace(cfg, box=replace(cfg.box, duration=cfg.box.duration + 0.1))
+    with pytest.raises(ValueError, match=r"box\.duration"):
+        run(longer)
+    with pytest.raises(ValueError, match=r"mpm\.max_iterations"):
+        run(replace(cfg, mpm=replace(cfg.mpm, max_iterations=cfg.mpm.max_iterations + 1)))
+    assert len(StudyRecords(tmp_path).rows()) == 1
+    run(replace(cfg, models=("rigid", "rft3d"), max_minutes=1.0))  # other models / time box: allowed
+    assert len(StudyRecords(tmp_path).rows()) == 2
+
+
 def test_mpm_smoke_trials_batched_and_scored(tmp_path: Path) -> None:
     """Run two MPM trials in one solve (tiny beds, 0.2 s) plus Rigid and 3D-RFT: matched, scored and timed.
 

@@ -241,12 +241,60 @@ def _run_mpm(cfg: BoxStudyCfg, records: StudyRecords, media: dict[str, np.ndarra
     return True
 
 
+# Settings that change a record's numbers: a directory's records must all share them (``check_resume``).
+RESULT_FIELDS = ("seed", "bulk_density", "packing", "mu_int", "mu_surf", "box", "rom", "bed", "mpm", "rigid_solver")
+
+
+def _flatten(value: Any, prefix: str) -> dict[str, Any]:
+    """Return ``{dotted.path: leaf}`` of a JSON-like value."""
+    if isinstance(value, dict):
+        out: dict[str, Any] = {}
+        for k, v in value.items():
+            out.update(_flatten(v, f"{prefix}.{k}"))
+        return out
+    return {prefix: value}
+
+
+def check_resume(cfg: BoxStudyCfg, records: StudyRecords) -> None:
+    """Refuse to add records to a directory whose records were made under other settings.
+
+    A resumed study skips the records it finds, so a call with, e.g., another box duration would silently mix two
+    studies in one table. Compares the fields of ``RESULT_FIELDS`` (device excepted) with the directory's
+    ``config.json``; the fitted 3D-RFT set may be added to a directory without one, never swapped.
+    """
+    saved_path = Path(cfg.out_dir) / "config.json"
+    if not saved_path.exists() or not records.rows():
+        return
+    saved = json.loads(saved_path.read_text())
+    new = json.loads(json.dumps(asdict(cfg), default=str))
+    old_flat: dict[str, Any] = {}
+    new_flat: dict[str, Any] = {}
+    for key in RESULT_FIELDS:
+        old_flat.update(_flatten(saved.get(key), key))
+        new_flat.update(_flatten(new.get(key), key))
+    diffs = [
+        f"{k}: directory {old_flat.get(k)!r}, this call {new_flat.get(k)!r}"
+        for k in sorted(set(old_flat) | set(new_flat))
+        if not k.endswith(".device") and old_flat.get(k) != new_flat.get(k)
+    ]
+    old_fit, new_fit = saved.get("rft3d_fitted_coeffs"), new.get("rft3d_fitted_coeffs")
+    if old_fit and new_fit and old_fit != new_fit:
+        diffs.append(f"rft3d_fitted_coeffs: directory {old_fit!r}, this call {new_fit!r}")
+    if diffs:
+        raise ValueError(
+            f"{cfg.out_dir} holds records made under other settings, and a resumed study would mix them:\n  "
+            + "\n  ".join(diffs)
+            + f"\nPass the directory's settings ({saved_path}) or choose a new out_dir."
+        )
+
+
 def run(cfg: BoxStudyCfg) -> dict[str, Any]:
     """Run (or resume) the study and write its outputs; return the summary with a ``complete`` flag."""
     from gmloco.eval.box_summary import summarize_study
 
     t_start = time.perf_counter()
     records = StudyRecords(cfg.out_dir)
+    check_resume(cfg, records)
     media = sample_media(cfg)
     models = list(cfg.models) + (["rft3d_fitted"] if cfg.rft3d_fitted_coeffs else [])
     (Path(cfg.out_dir) / "config.json").write_text(json.dumps(asdict(cfg), indent=1, default=str))
