@@ -4,12 +4,21 @@
 from __future__ import annotations
 
 import math
+import time
 from dataclasses import replace
 from pathlib import Path
 
 import numpy as np
 
-from gmloco.eval.g1_eval import EpisodeSpec, G1EvalCfg, episode_batches, episode_specs, score_episode, summarize
+from gmloco.eval.g1_eval import (
+    EpisodeSpec,
+    G1EvalCfg,
+    episode_batches,
+    episode_specs,
+    score_episode,
+    step_frames,
+    summarize,
+)
 from gmloco.eval.tables_mpm import table_speeds, table_terrains
 
 
@@ -104,3 +113,35 @@ def test_episode_mcap_round_trip(tmp_path: Path) -> None:
     _, acc = lg.signal("imu.accelerometer")
     np.testing.assert_allclose(acc[:, 2], 9.81, atol=1e-6)
     assert lg.metadata.contact_model == "mpm" and lg.metadata.material == "dry_sand"
+
+
+class _FakeScene:
+    """Counts frames; robot 0 falls (pelvis 0.1 m) at ``fall_frame``, robot 1 stays up unless ``both_fall``."""
+
+    frames_per_policy = 2
+
+    def __init__(self, fall_frame: int, both_fall: bool = False) -> None:
+        self.frame, self.fall_frame, self.both_fall = 0, fall_frame, both_fall
+        self.z: list[list[float]] = []
+
+    def step(self) -> None:
+        self.frame += 1
+        down = self.frame >= self.fall_frame
+        self.z.append([0.1 if down else 0.7, 0.1 if down and self.both_fall else 0.7])
+
+    @property
+    def base_q(self) -> np.ndarray:
+        q = np.zeros((len(self.z), 2, 7))
+        q[:, :, 2] = self.z
+        return q
+
+
+def test_step_frames_stops_when_all_fell_and_at_the_time_box() -> None:
+    """All robots down: the batch ends early (True); a passed deadline: abandoned (False) at the next policy step."""
+    cfg = G1EvalCfg()
+    scene = _FakeScene(fall_frame=5, both_fall=True)
+    assert step_frames(scene, 100, cfg) and scene.frame == 5  # the fall lands on a policy step (frame index 4)
+    scene = _FakeScene(fall_frame=5)
+    assert step_frames(scene, 100, cfg) and scene.frame == 100  # one robot still up: runs to the end
+    scene = _FakeScene(fall_frame=1000)
+    assert not step_frames(scene, 100, cfg, deadline=time.perf_counter() - 1.0) and scene.frame == 1

@@ -162,8 +162,42 @@ def _window_and_lanes(batch: list[EpisodeSpec], cfg: G1EvalCfg) -> tuple[SandWin
     return win, float(size[1]) + cfg.lane_gap
 
 
-def run_batch(batch: list[EpisodeSpec], cfg: G1EvalCfg, policy: Any) -> list[dict[str, Any]]:
-    """Simulate a batch of episodes together; return one log per episode (policy rate) with the batch's timings."""
+def step_frames(scene: Any, frames: int, cfg: G1EvalCfg, deadline: float | None = None, label: str = "") -> bool:
+    """Step ``frames`` frames (or until every robot has fallen); False if ``deadline`` (perf_counter s) passed first.
+
+    Prints a progress line to stderr about every 30 s: frames done, frames/s, robots still up.
+    """
+    import sys
+
+    k = scene.frames_per_policy
+    t_start = last = time.perf_counter()
+    for f in range(frames):
+        scene.step()
+        if f % k:
+            continue
+        now = time.perf_counter()
+        if deadline is not None and now > deadline:
+            print(f"{label}: time box reached at frame {f + 1}/{frames}; batch abandoned", file=sys.stderr, flush=True)
+            return False
+        if _all_failed(scene, cfg):
+            break  # every robot has fallen: the rest cannot change any outcome
+        if now - last > 30.0:
+            z = np.asarray(scene.base_q)[:, :, 2]
+            up = int((~(z < cfg.failure.min_base_height).any(axis=0)).sum())
+            rate = (f + 1) / (now - t_start)
+            print(f"{label}: frame {f + 1}/{frames}, {rate:.1f} frames/s, {up}/{z.shape[1]} robots up",
+                  file=sys.stderr, flush=True)  # fmt: skip
+            last = now
+    return True
+
+
+def run_batch(
+    batch: list[EpisodeSpec], cfg: G1EvalCfg, policy: Any, deadline: float | None = None, label: str = ""
+) -> list[dict[str, Any]] | None:
+    """Simulate a batch of episodes together; return one log per episode (policy rate) with the batch's timings.
+
+    None when ``deadline`` (``time.perf_counter`` s) passes before the batch ends: its episodes are not kept.
+    """
     from gmloco.eval.mpm.g1_scene import G1MpmScene, G1MpmSceneCfg
     from gmloco.eval.mpm.window_terrain import terrain_cfg, terrain_surface_height
 
@@ -187,10 +221,8 @@ def run_batch(batch: list[EpisodeSpec], cfg: G1EvalCfg, policy: Any) -> list[dic
     build_s = time.perf_counter() - t0
     frames = round(cfg.episode_s / scene.frame_dt)
     k = scene.frames_per_policy
-    for f in range(frames):
-        scene.step()
-        if f % k == 0 and _all_failed(scene, cfg):
-            break  # every robot has fallen: the rest cannot change any outcome
+    if not step_frames(scene, frames, cfg, deadline, label):
+        return None
     if solver.max_active_cell_count > 0 and solver.grid_type == "sparse":
         scene.mpm.check_sparse_grid_rebuild_status()
     names = ("base_q", "base_qd", "foot_force", "sinkage", "foot_sinkage", "joint_q", "joint_qd", "target", "action")
@@ -301,7 +333,8 @@ def run(cfg: G1EvalCfg) -> tuple[dict[str, float], bool]:
     """Run (or resume) the evaluation; return (summary metrics, complete).
 
     Writes ``episodes.jsonl`` after every batch, and ``summary.json``, tables and figures at the end of the call.
-    Stops early when ``max_minutes`` is reached (complete = False) with every finished episode kept.
+    Stops early when ``max_minutes`` is reached (complete = False) with every finished episode kept; a batch still
+    running then is abandoned, since its episodes are unfinished.
     """
     out = Path(cfg.out_dir)
     out.mkdir(parents=True, exist_ok=True)
@@ -314,11 +347,16 @@ def run(cfg: G1EvalCfg) -> tuple[dict[str, float], bool]:
     todo = [s for s in episode_specs(cfg) if s.key not in done]
     policy = load_policy(cfg.policy_path, min(cfg.robots_per_batch, max(len(todo), 1)))
     t0, sim_s, complete = time.perf_counter(), 0.0, True
-    for batch in episode_batches(todo, cfg.robots_per_batch):
-        if cfg.max_minutes is not None and time.perf_counter() - t0 > 60.0 * cfg.max_minutes:
+    deadline = None if cfg.max_minutes is None else t0 + 60.0 * cfg.max_minutes
+    batches = episode_batches(todo, cfg.robots_per_batch)
+    for i, batch in enumerate(batches):
+        if deadline is not None and time.perf_counter() > deadline:
             complete = False
             break
-        logs = run_batch(batch, cfg, policy)
+        logs = run_batch(batch, cfg, policy, deadline, label=f"batch {i + 1}/{len(batches)} ({len(batch)} robots)")
+        if logs is None:  # the time box ended inside the batch: its episodes are unfinished, none is kept
+            complete = False
+            break
         sim_s += logs[0]["build_s"] + logs[0]["sim_s"]
         new = [score_episode(lg["spec"], cfg, lg) for lg in logs]
         for lg, row in zip(logs, new, strict=True):
