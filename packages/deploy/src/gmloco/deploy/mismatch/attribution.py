@@ -45,9 +45,9 @@ class AttributionCfg:
     """Effects fitted in a second round when the first leaves the mismatch unexplained (:func:`second_round`)."""
     max_iter: int = 4
     """Levenberg-Marquardt iterations per fit."""
-    pattern_sweeps: int = 1
+    pattern_sweeps: int = 3
     """Sweeps of the coordinate pattern search that follows Levenberg-Marquardt in fits of effects with more than
-    one parameter (:func:`_pattern_search`); 0 turns it off."""
+    one parameter (:func:`_pattern_search`; sweep k steps by ``2 tolerance / 2^k``); 0 turns it off."""
     bic_min: float = 10.0
     """Delta-BIC (with n_eff) an effect needs (Kass-Raftery 'very strong')."""
     heldout_min: float = 0.03
@@ -238,18 +238,20 @@ def _pattern_search(
     PD acts on the offset reading, and the sand force of a foot depends on both legs' postures), so the
     Gauss-Newton steps stay short and the fit stalls in a valley far from a much better point that a plain
     coordinate step reaches (``shared/reference/mismatch-discovery.md`` 3.2 step 7: a derivative-free fallback
-    for non-smooth cases). Each sweep visits every component once: a step of twice the component's tolerance
-    (the smallest change that counts as a mismatch) up, else down, repeated while the training energy falls;
-    every point stays within the bounds.
+    for non-smooth cases). Each sweep visits every component once: a step up, else down, repeated while the
+    training energy falls. The first sweep steps by twice the component's tolerance (the smallest change that
+    counts as a mismatch), each further sweep by half the previous step (compass search). Every point stays
+    within the bounds.
     """
     m = pb.train
     lo, hi = spec.bounds()
     tol = spec.flat("tolerance")
     e = float(r @ r)
     theta = theta.copy()
-    for _ in range(sweeps):
+    for k in range(sweeps):
         for i in range(spec.size):
-            for step in (2.0 * tol[i], -2.0 * tol[i]):
+            size = 2.0 * tol[i] / 2.0**k
+            for step in (size, -size):
                 moved = False
                 while True:
                     cand = theta.copy()
