@@ -43,7 +43,7 @@ def walk_row(rec: dict[str, Any]) -> str:
     share = len(neg) / (2 * len(early))
     neg_mid = f"{100 * sum(m for _, m in neg) / len(neg):.1f}" if neg else "-"
     cfg = "3D-RFT (training sim)" if rec.get("sim", "").startswith("mujoco") else (
-        f"MPM {100 * rec['voxel']:.0f} cm / {rec['iterations']} its, frame {1000 * rec.get('frame_dt', 0.01):g} ms "
+        f"MPM {100 * rec['voxel']:g} cm / {rec['iterations']} its, frame {1000 * rec.get('frame_dt', 0.01):g} ms "
         f"x {rec.get('substeps', 2)}, m_eff {rec.get('effective_mass') or 'm/2'}"
         + (f", {rec['handover']}" if "handover" in rec else "")
     )  # fmt: skip
@@ -76,7 +76,7 @@ def main() -> None:
                 f"{r['fz_mpm']:.0f} / {r['fz_rft']:.0f} ({r['ratio']:.2f}; min {r['fz_min']:.0f})" for r in rec["rows"]
             ]
             print(
-                f"| {rec['label']} | {100 * rec['voxel']:.0f} cm / {rec['iterations']} {rec['grid']} | "
+                f"| {rec['label']} | {100 * rec['voxel']:g} cm / {rec['iterations']} {rec['grid']} | "
                 + " | ".join(cells)
                 + " |"
             )
