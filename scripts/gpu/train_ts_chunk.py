@@ -276,6 +276,11 @@ def _post_checks(args: argparse.Namespace, task: Any, checkpoint: Path, run_dir:
         student_policy_metadata,
     )
 
+    import torch
+
+    # Parity against onnxruntime needs full-precision convolutions: cuDNN's default TF32 puts the TCN 5e-4 off.
+    torch.backends.cudnn.allow_tf32 = False
+    torch.backends.cuda.matmul.allow_tf32 = False
     # Deep sand as in the evaluations: in play mode there is no floor curriculum, so the training floor would stay
     # at level 0 (at the surface) and the feet would never sink (nothing for the student to sense eta from).
     play = replace(task, play=True, terrain=replace(task.terrain, floor=RolloutCriteriaCfg().floor))
