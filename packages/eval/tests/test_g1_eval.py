@@ -32,7 +32,7 @@ def _log(xy: np.ndarray, vxy: np.ndarray, z: np.ndarray, dt: float, wz: float = 
     force = np.zeros((n, 2, 3))
     force[:, :, 2] = 0.5 * 30.0 * 9.81
     return {"dt": dt, "base_q": q, "base_qd": qd, "foot_force": force, "sinkage": np.full(n, 0.02),
-            "start_xy": np.zeros(2), "robot_mass": 30.0, "particles": 1, "build_s": 0.0, "sim_s": 1.0,
+            "foot_sinkage": np.full((n, 2), 0.02), "start_xy": np.zeros(2), "robot_mass": 30.0, "particles": 1, "build_s": 0.0, "sim_s": 1.0,
             "frames": n}  # fmt: skip
 
 
@@ -49,6 +49,21 @@ def test_perfect_straight_walk_succeeds() -> None:
     assert row["path_error"] < 0.011  # half a sample spacing at most
     assert math.isclose(row["support_ratio"], 1.0) and math.isclose(row["max_sinkage"], 0.02)
     assert math.isclose(row["mean_sinkage"], 0.02)
+    assert row["swings"] == 0 and math.isnan(row["swing_apex"])  # both feet loaded throughout: no swing
+
+
+def test_swing_clearance_of_a_stepping_foot() -> None:
+    """One foot lifts 6 cm out of a 2 cm footprint every 20 steps: apex 4 cm above the surface, lift 6 cm."""
+    cfg = replace(G1EvalCfg(), episode_s=2.0)
+    dt, n = 0.02, 100
+    t = (np.arange(n) + 1) * dt
+    log = _log(np.stack([t, 0 * t], 1), np.tile([1.0, 0.0], (n, 1)), np.full(n, 0.7), dt)
+    swing = (np.arange(n) % 20) >= 10
+    log["foot_force"][swing, 0, 2] = 0.0
+    log["foot_sinkage"][swing, 0] = -0.04
+    row = score_episode(EpisodeSpec("dry_sand", "straight", 1.0, 0), cfg, log)
+    assert row["swings"] == 4  # the fifth swing is still open when the log ends
+    assert math.isclose(row["swing_apex"], 0.04) and math.isclose(row["swing_lift"], 0.06)
 
 
 def test_standing_still_times_out_and_fall_fails() -> None:

@@ -18,6 +18,7 @@ from gmloco.eval.metrics.locomotion import (
     metric_velocity_tracking_error,
     metric_yaw_tracking_error,
     quat_wxyz_to_roll_pitch_yaw,
+    swing_clearance,
 )
 
 
@@ -113,3 +114,37 @@ def test_roll_pitch_yaw() -> None:
         q[0], q[1 + axis] = math.cos(0.15), math.sin(0.15)
         rpy = quat_wxyz_to_roll_pitch_yaw(q)
         assert np.allclose(rpy, np.eye(3)[axis] * 0.3)
+
+
+def _gait(cycles: int, stance_low: float, apex: float) -> tuple[np.ndarray, np.ndarray]:
+    """One foot alternating 10 loaded steps at ``stance_low`` [m] and 10 unloaded steps with a peak at ``apex`` [m]."""
+    swing_h = stance_low + (apex - stance_low) * np.sin(np.linspace(0.0, math.pi, 10))
+    h = np.concatenate([np.r_[np.full(10, stance_low), swing_h] for _ in range(cycles)])
+    load = np.concatenate([np.r_[np.full(10, 300.0), np.zeros(10)] for _ in range(cycles)])
+    return h, load
+
+
+def test_swing_clearance_known_gait() -> None:
+    """Two feet with known apex / stance depth; the last, open swing and flicker are not counted."""
+    h0, l0 = _gait(3, -0.05, 0.08)  # apex 8 cm, lift 13 cm
+    h1, l1 = _gait(3, -0.01, 0.02)  # apex 2 cm, lift 3 cm
+    l1[12] = 0.0  # one-step flicker inside a stance... (inside a swing it changes nothing)
+    l1[5] = 0.0  # ... and inside a stance: too short to count as a swing
+    height, load = np.stack([h0, h1], axis=1), np.stack([l0, l1], axis=1)
+    # each foot: swings at 10-19 and 30-39 end in a touchdown; the one at 50-59 is still open at the end
+    out = swing_clearance(height, load)
+    peak = float(np.sin(np.linspace(0.0, math.pi, 10)).max())  # the sampled swing peaks just below its apex
+    assert out.swings == 4
+    assert out.apex == pytest.approx(((-0.05 + 0.13 * peak) + (-0.01 + 0.03 * peak)) / 2)
+    assert out.lift == pytest.approx((0.13 + 0.03) * peak / 2)
+
+
+def test_swing_clearance_alive_cut_and_no_swing() -> None:
+    """Steps after the fall do not count; a foot that never lifts gives NaN means and zero swings."""
+    h, load = _gait(3, -0.02, 0.05)
+    cut = swing_clearance(h[:, None], load[:, None], alive_steps=35)
+    assert cut.swings == 1  # the swing at 30-39 has no touchdown before step 35
+    still = swing_clearance(np.full((50, 2), -0.03), np.full((50, 2), 200.0))
+    assert still.swings == 0 and math.isnan(still.apex) and math.isnan(still.lift)
+    with pytest.raises(ValueError, match=r"\[T, F\]"):
+        swing_clearance(h, load)

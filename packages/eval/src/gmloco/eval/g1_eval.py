@@ -13,6 +13,8 @@ with :mod:`gmloco.eval.metrics.locomotion`:
   choice: the paper gives no tolerance, and an exact v T lets no lag through).
 * velocity tracking error: mean |v_xy - v_cmd| in the yaw frame over alive steps; yaw tracking error: mean
   |w_z - w_cmd| over alive steps; path error: DTW between executed and commanded xy paths (alive part).
+* swing clearance: mean apex of the completed swings above the local surface and their lift above the stance
+  before (``swing_clearance``: a foot is in swing while its sand force is below 40 N).
 
 Outputs under ``out_dir``: ``episodes.jsonl`` (one line per finished episode; the resume state),
 ``summary.json`` (metrics per group, throughput, config), the paper-shaped tables (``tables_mpm``), figures
@@ -38,6 +40,7 @@ from gmloco.eval.metrics.locomotion import (
     metric_path_error,
     metric_velocity_tracking_error,
     metric_yaw_tracking_error,
+    swing_clearance,
     quat_wxyz_to_roll_pitch_yaw,
 )
 from gmloco.eval.mpm.box_scene import MpmSolverCfg
@@ -277,6 +280,7 @@ def score_episode(spec: EpisodeSpec, cfg: G1EvalCfg, log: dict[str, Any]) -> dic
     v_yaw = np.stack([c * qd[:, 0] + s * qd[:, 1], -s * qd[:, 0] + c * qd[:, 1]], axis=1)
     fz = log["foot_force"][:, :, 2].sum(axis=1) if len(log["foot_force"]) else np.zeros(1)
     sink = np.asarray(log["sinkage"])[:alive]
+    swing = swing_clearance(-np.asarray(log["foot_sinkage"]), np.asarray(log["foot_force"])[..., 2], alive)
     return {
         "key": spec.key, "terrain": spec.terrain, "scenario": spec.scenario, "speed": spec.speed,
         "success": out.success, "reason": out.reason, "alive_s": out.alive_steps * dt,
@@ -287,6 +291,7 @@ def score_episode(spec: EpisodeSpec, cfg: G1EvalCfg, log: dict[str, Any]) -> dic
         "support_ratio": float(fz[len(fz) // 2 :].mean() / (log["robot_mass"] * 9.81)),
         "max_sinkage": float(np.max(sink)) if len(sink) else float("nan"),
         "mean_sinkage": float(np.mean(sink)) if len(sink) else float("nan"),
+        "swing_apex": swing.apex, "swing_lift": swing.lift, "swings": swing.swings,
         # a sole reached the rigid floor under the sand (the soles stand on it): the bed was too shallow there
         "floor_reached": bool(len(sink) and np.max(sink) >= log.get("depth", math.inf) - 0.005),
         "particles": log["particles"], "batch_size": log.get("batch_size", 1), "build_s": log["build_s"],
@@ -296,6 +301,7 @@ def score_episode(spec: EpisodeSpec, cfg: G1EvalCfg, log: dict[str, Any]) -> dic
 
 METRIC_KEYS = (
     "success", "vel_error", "yaw_error", "path_error", "support_ratio", "max_sinkage", "mean_sinkage", "floor_reached",
+    "swing_apex", "swing_lift",
 )  # fmt: skip
 
 

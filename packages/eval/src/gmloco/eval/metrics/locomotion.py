@@ -7,6 +7,9 @@
 * Yaw tracking error: mean |w_z - w_z_cmd| [rad/s] over alive steps.
 * Path error: dynamic-time-warping distance between executed and commanded xy paths, normalised by the
   warping-path length (mean matched point distance [m]).
+* Swing clearance: the highest point of each completed swing of a sole above the local surface [m], and its lift
+  above the lowest point of the stance before it [m] (the paper's swing-clearance figure; on sand a foot must
+  lift out of its own footprint before it can swing forward).
 """
 
 from __future__ import annotations
@@ -18,6 +21,7 @@ import numpy as np
 
 __all__ = [
     "EpisodeOutcome",
+    "SwingClearance",
     "FailureCfg",
     "circular_path",
     "dtw_distance",
@@ -27,6 +31,7 @@ __all__ = [
     "metric_velocity_tracking_error",
     "metric_yaw_tracking_error",
     "quat_wxyz_to_roll_pitch_yaw",
+    "swing_clearance",
 ]
 
 
@@ -210,3 +215,60 @@ def circular_path(
         dy = -r * (np.cos(yaw) - math.cos(start_yaw))
     xy = np.stack([start_xy[0] + dx, start_xy[1] + dy], axis=-1)
     return xy, yaw
+
+
+@dataclass(frozen=True)
+class SwingClearance:
+    """Swing statistics of one episode (NaN means where no swing completed)."""
+
+    apex: float
+    """Mean over completed swings of the sole's highest point above the local surface [m]."""
+    lift: float
+    """Mean over completed swings of the apex minus the lowest sole point of the stance before it [m]."""
+    swings: int
+    """Number of completed swings, all feet."""
+
+
+def swing_clearance(
+    height: np.ndarray, load: np.ndarray, alive_steps: int | None = None, threshold: float = 40.0, min_steps: int = 3
+) -> SwingClearance:
+    """Swing apex and lift of every completed swing of every foot.
+
+    A swing is a run of at least ``min_steps`` steps with the foot's vertical load below ``threshold`` that ends
+    in a touchdown within the alive steps (the last, open swing does not count). Its stance is the run of loaded
+    steps before it; the first swing of a foot, which has no stance on record before it, counts for the apex only.
+
+    Args:
+        height: Lowest sole point above the local surface per step and foot [m], ``[T, F]`` (negative: sunk).
+        load: Vertical ground force on each foot [N], ``[T, F]``.
+        alive_steps: Steps that count (the episode's alive part); None: all.
+        threshold: Load below which a foot is in swing [N].
+        min_steps: Shortest swing counted [steps] (shorter runs are contact flicker).
+    """
+    height, load = np.asarray(height, dtype=float), np.asarray(load, dtype=float)
+    if height.shape != load.shape or height.ndim != 2:
+        raise ValueError(f"height and load must both be [T, F]; got {height.shape} and {load.shape}")
+    n = height.shape[0] if alive_steps is None else min(alive_steps, height.shape[0])
+    apexes: list[float] = []
+    lifts: list[float] = []
+    for f in range(height.shape[1]):
+        h, swing = height[:n, f], load[:n, f] < threshold
+        t, stance_low = 0, math.nan
+        while t < n:
+            end = t
+            while end < n and swing[end] == swing[t]:
+                end += 1
+            if not swing[t]:
+                stance_low = float(h[t:end].min())
+            elif end < n and end - t >= min_steps:
+                apex = float(h[t:end].max())
+                apexes.append(apex)
+                if math.isfinite(stance_low):
+                    lifts.append(apex - stance_low)
+            t = end
+    return SwingClearance(apex=_mean_or_nan(apexes), lift=_mean_or_nan(lifts), swings=len(apexes))
+
+
+def _mean_or_nan(values: list[float]) -> float:
+    """Mean of ``values``; NaN for none."""
+    return float(np.mean(values)) if values else math.nan
