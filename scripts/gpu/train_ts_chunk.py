@@ -80,6 +80,13 @@ def _parse(argv: list[str] | None) -> argparse.Namespace:
         help="override one reward term's weight (repeatable; 0 drops the term), e.g. foot_clearance_l2=-50; "
         "pass the same overrides to every chunk of a run (the task is rebuilt from the arguments each chunk)",
     )
+    p.add_argument(
+        "--foot-clearance",
+        choices=["penalty", "reward", "touchdown"],
+        default=None,
+        help="GranularTaskCfg.foot_clearance (default: the task's, the L2 penalty); 'touchdown' pays each swing's "
+        "lift out of the footprint at touchdown; pass the same value to every chunk of a run",
+    )
     p.add_argument("--teacher-checkpoint", type=Path, default=None)
     p.add_argument(
         "--warm-start-ppo",
@@ -206,6 +213,8 @@ def _task(args: argparse.Namespace) -> Any:
     from gmloco.train.teacher_student.heldout import with_held_out
 
     task = replace(g1_granular_task(args.contact_model, args.terrain), policy_history_length=1)
+    if args.foot_clearance is not None:
+        task = replace(task, foot_clearance=args.foot_clearance)
     weights = reward_weights(args.reward_weight)
     if weights:
         task = replace(task, reward_weights=weights)
@@ -267,6 +276,8 @@ def _last_values(curve: dict[str, list[float]], window: int = 10) -> dict[str, f
 
 def _post_checks(args: argparse.Namespace, task: Any, checkpoint: Path, run_dir: Path) -> dict[str, Any]:
     """Decoded-eta rollout on the DR (deep sand, no floor); for the student also the ONNX export and parity checks."""
+    import torch
+
     from gmloco.train.evaluation import RolloutCriteriaCfg
     from gmloco.train.evaluation_ts import decoded_eta_check
     from gmloco.train.teacher_student.export_student import (
@@ -275,8 +286,6 @@ def _post_checks(args: argparse.Namespace, task: Any, checkpoint: Path, run_dir:
         rollout_parity_check,
         student_policy_metadata,
     )
-
-    import torch
 
     # Parity against onnxruntime needs full-precision convolutions: cuDNN's default TF32 puts the TCN 5e-4 off.
     torch.backends.cudnn.allow_tf32 = False

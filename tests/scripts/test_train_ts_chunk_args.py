@@ -36,3 +36,17 @@ def test_malformed_reward_weight_exits_with_the_expected_form(item: str) -> None
     """A malformed item stops the script and says which form is expected."""
     with pytest.raises(SystemExit, match="NAME=WEIGHT"):
         _load().reward_weights([item])
+
+
+def test_foot_clearance_touchdown_swaps_the_swing_term() -> None:
+    """--foot-clearance touchdown replaces the L2 penalty by the lift paid at touchdown; its weight can be overridden."""
+    chunk = _load()
+    base = ["--stage", "teacher", "--out", "unused", "--no-held-out", "--foot-clearance", "touchdown"]
+    task = chunk._task(chunk._parse([*base, "--reward-weight", "swing_height_at_touchdown=40"]))
+    assert task.foot_clearance == "touchdown"
+
+    from gmloco.train.tasks.g1_granular.rewards_cfg import make_rewards_cfg
+
+    rewards = make_rewards_cfg(task)
+    assert "foot_clearance_l2" not in rewards and rewards["swing_height_at_touchdown"].weight == 40.0
+    assert rewards["swing_height_at_touchdown"].params["relative"] is True

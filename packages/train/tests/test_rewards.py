@@ -121,3 +121,27 @@ def test_foot_clearance_form_selects_the_term() -> None:
     assert rewards["foot_clearance_l2"].weight == -2.0 and "foot_clearance" not in rewards
     rewards = make_rewards_cfg(replace(task, foot_clearance="reward"))
     assert rewards["foot_clearance"].weight == 5.0 and "foot_clearance_l2" not in rewards
+
+
+def test_swing_height_is_paid_once_per_touchdown_clipped_and_only_when_moving() -> None:
+    """Foot 0 lands after a 20 cm lift (paid the 12 cm cap), foot 1 is in the air; a still command pays nothing."""
+    from types import SimpleNamespace
+
+    from gmloco.train.mdp.rewards import swing_height_at_touchdown
+
+    feet = SimpleNamespace(
+        first_contact=torch.tensor([[True, False], [True, True]]),
+        last_swing_lift=torch.tensor([[0.20, 0.05], [0.05, 0.07]]),
+        last_swing_apex=torch.tensor([[0.04, 0.01], [-0.02, 0.03]]),
+    )
+    feet.update = lambda: feet
+    commands = torch.tensor([[1.0, 0.0, 0.0], [1.0, 0.0, 0.0]])
+    env = SimpleNamespace(
+        sand=SimpleNamespace(feet=feet), command_manager=SimpleNamespace(get_command=lambda name: commands)
+    )
+    lift = swing_height_at_touchdown(env, 0.12, "twist")  # type: ignore[arg-type]
+    np.testing.assert_allclose(lift.numpy(), [0.12, 0.12], atol=1e-7)
+    apex = swing_height_at_touchdown(env, 0.12, "twist", relative=False)  # type: ignore[arg-type]
+    np.testing.assert_allclose(apex.numpy(), [0.04, 0.03], atol=1e-7)  # a sunk apex pays 0, not a penalty
+    commands.zero_()
+    assert swing_height_at_touchdown(env, 0.12, "twist").abs().sum().item() == 0.0

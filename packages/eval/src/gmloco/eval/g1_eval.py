@@ -40,8 +40,8 @@ from gmloco.eval.metrics.locomotion import (
     metric_path_error,
     metric_velocity_tracking_error,
     metric_yaw_tracking_error,
-    swing_clearance,
     quat_wxyz_to_roll_pitch_yaw,
+    swing_clearance,
 )
 from gmloco.eval.mpm.box_scene import MpmSolverCfg
 from gmloco.eval.mpm.window import SandWindowCfg

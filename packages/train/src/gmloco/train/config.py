@@ -152,11 +152,14 @@ class GranularTaskCfg:
     tens of thousands of iterations; 0.1 fits it into a ~2k-iteration budget (ramp over 1.5k iterations, stages
     at 1k and 1.5k). Below 1, the wide initial tracking kernel (std 1 m/s, where standing still already earns
     ~70 % of the tracking reward) is left before the policy settles on standing."""
-    foot_clearance: Literal["penalty", "reward"] = "penalty"
+    foot_clearance: Literal["penalty", "reward", "touchdown"] = "penalty"
     """Swing-height term. ``"penalty"``: the GM-Loco project page's ``foot_clearance_l2`` (weight -2, zero for
     still feet); ``"reward"``: the public code's exp form (weight +5), which pays its maximum to feet that do not
     move, so a policy that stands still earns it in full (measured: 62 % of the term's maximum at iteration 1,400
-    while tracking earned 17 %, no walking; see artifacts/ppo_rft3d/manifest.json)."""
+    while tracking earned 17 %, no walking; see artifacts/ppo_rft3d/manifest.json); ``"touchdown"``:
+    ``swing_height_at_touchdown`` (weight +100, lift out of the footprint up to 0.12 m, paid per completed swing),
+    which pays neither standing nor an early fall (the penalty at weight -300 taught a teacher to fall early,
+    results/mpm_eval/gpu_s9/README.md). Its weight is a starting value, not yet tuned by a training run."""
     reward_weights: dict[str, float] = field(default_factory=dict)
     """Overrides of reward term weights by name (see ``mdp.rewards``)."""
     play: bool = False

@@ -87,6 +87,15 @@ class FootContactTracker:
         """Foot roll [rad] (ZYX Euler of the foot body), [W, 2]."""
         self.pitch = zeros()
         """Foot pitch [rad] (ZYX Euler of the foot body), [W, 2]."""
+        self.swing_peak = zeros()
+        """Highest sole height of the current swing [m] (the current height while in contact), [W, 2]."""
+        self.stance_low = zeros()
+        """Lowest sole height of the current or, in the air, the last stance [m] (0 after a reset), [W, 2]."""
+        self.last_swing_apex = zeros()
+        """Highest sole height of the swing that ended at the last touchdown [m], [W, 2]."""
+        self.last_swing_lift = zeros()
+        """That swing's apex minus the lowest sole height of the stance before it [m]: how far the foot came out
+        of its own footprint, [W, 2]."""
         self._updated_at = -1
 
     def update(self) -> FootContactTracker:
@@ -99,11 +108,13 @@ class FootContactTracker:
         self._update_forces()
         self._update_timers(dt)
         self._update_kinematics()
+        self._update_swing()
         return self
 
     def reset(self, env_ids: torch.Tensor) -> None:
         """Clear the timers of ``env_ids`` (episode start)."""
-        for buf in (self.air_time, self.contact_time, self.last_air_time, self.landing_force):
+        for buf in (self.air_time, self.contact_time, self.last_air_time, self.landing_force, self.swing_peak,
+                    self.stance_low, self.last_swing_apex, self.last_swing_lift):  # fmt: skip
             buf[env_ids] = 0.0
         self.in_contact[env_ids] = False
         self.first_contact[env_ids] = False
@@ -143,3 +154,12 @@ class FootContactTracker:
         r22 = 1.0 - 2.0 * (x * x + y * y)
         self.roll.copy_(torch.atan2(r21, r22))
         self.pitch.copy_(torch.asin(torch.clamp(-r20, -1.0, 1.0)))
+
+    def _update_swing(self) -> None:
+        """Swing apex and lift: at a touchdown, close the swing; in contact, track the stance's lowest point."""
+        touchdown, contact, h = self.first_contact, self.in_contact, self.height
+        self.last_swing_apex.copy_(torch.where(touchdown, self.swing_peak, self.last_swing_apex))
+        self.last_swing_lift.copy_(torch.where(touchdown, self.swing_peak - self.stance_low, self.last_swing_lift))
+        stance_low = torch.where(contact, torch.minimum(self.stance_low, h), self.stance_low)
+        self.stance_low.copy_(torch.where(touchdown, h, stance_low))
+        self.swing_peak.copy_(torch.where(contact, h, torch.maximum(self.swing_peak, h)))

@@ -21,8 +21,8 @@ import numpy as np
 
 __all__ = [
     "EpisodeOutcome",
-    "SwingClearance",
     "FailureCfg",
+    "SwingClearance",
     "circular_path",
     "dtw_distance",
     "episode_outcome",

@@ -42,6 +42,7 @@ __all__ = [
     "joint_vel_l2",
     "lin_vel_z_l2",
     "no_fly",
+    "swing_height_at_touchdown",
     "track_ang_vel_z_exp",
     "track_heading_exp",
     "track_lin_vel_xy_exp",
@@ -286,6 +287,22 @@ def foot_clearance(env: ManagerBasedRlEnv, target_height: float, std: float, tan
     feet = get_sand(env).feet.update()
     speed = torch.linalg.vector_norm(feet.vel_w[..., :2], dim=-1)
     return _clearance(feet.height, speed, target_height, std, tanh_mult)
+
+
+def swing_height_at_touchdown(
+    env: ManagerBasedRlEnv, target_height: float, command_name: str, relative: bool = True
+) -> torch.Tensor:
+    """Sum over feet touching down this step of the finished swing's height, clipped to [0, ``target_height``] [m].
+
+    ``relative``: the swing's lift above the lowest point of the stance before it (how far the foot came out of
+    its own footprint, what a foot on soft sand needs); otherwise its apex above the free surface. Paid only for
+    completed swings while a motion is commanded, so neither standing still nor ending the episode earns it (the
+    L2 penalty ``foot_clearance_l2`` at weight -300 taught a teacher to fall early; the exp form pays still feet).
+    """
+    feet = get_sand(env).feet.update()
+    height = feet.last_swing_lift if relative else feet.last_swing_apex
+    paid = torch.clamp(height, min=0.0, max=target_height) * feet.first_contact
+    return paid.sum(dim=1) * _moving(_command(env, command_name), 0.05)
 
 
 def foot_clearance_l2(env: ManagerBasedRlEnv, target_height: float, tanh_mult: float) -> torch.Tensor:

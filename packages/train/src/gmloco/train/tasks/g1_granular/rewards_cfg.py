@@ -88,7 +88,15 @@ def _joint_terms() -> dict[str, RewardTermCfg]:
 
 
 def _clearance_term(task: GranularTaskCfg) -> dict[str, RewardTermCfg]:
-    """Swing-height term: the project page's L2 penalty (default) or the code snapshot's exp reward."""
+    """Swing-height term: the project page's L2 penalty (default), the code's exp reward or the touchdown lift."""
+    if task.foot_clearance == "touchdown":
+        return {
+            "swing_height_at_touchdown": RewardTermCfg(
+                func=mdp.swing_height_at_touchdown,
+                weight=100.0,
+                params={"target_height": 0.12, "command_name": CMD, "relative": True},
+            )
+        }
     if task.foot_clearance == "reward":
         return {
             "foot_clearance": RewardTermCfg(
