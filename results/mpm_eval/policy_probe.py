@@ -163,6 +163,7 @@ def main() -> None:
     fell = (bq[:, 2] < 0.2) | (tilt > np.pi / 4)
     first_fall = float(np.argmax(fell) * scene.spec.policy_dt) if fell.any() else None
     eta = [r["eta"] for r in rows if "eta" in r]
+    swing = swing_summary(rows, first_fall)
     rec = dict(
         label=args.label, policy=str(args.policy), vx_cmd=args.vx, window=args.window, rigid=args.rigid,
         depth=0.1 if args.rigid else args.depth, voxel=args.voxel, iterations=args.iterations, frames=args.frames,
@@ -173,14 +174,34 @@ def main() -> None:
         pelvis_min=round(min(float(bq[:, 2].min()), min(r["pz"] for r in rows)), 4), max_abs_sole_pitch=max(abs(v) for r in rows for v in r["pitch"]),
         max_tilt_deg=round(float(np.degrees(tilt.max())), 1), first_fall_s=first_fall,
         mean_vx=round(float((bq[-1, 0] - bq[0, 0]) / ((len(bq) - 1) * scene.spec.policy_dt)), 3),
-        eta_mean_2nd_half=round(float(np.mean(eta[len(eta) // 2 :])), 4) if eta else None,
+        eta_mean_2nd_half=round(float(np.mean(eta[len(eta) // 2 :])), 4) if eta else None, **swing,
         s=round(time.time() - t, 1),
     )  # fmt: skip
     args.log.parent.mkdir(parents=True, exist_ok=True)
     with args.log.open("a") as f:
         f.write(json.dumps(rec) + "\n")
-    keys = ("support2", "support_50hz", "pelvis_min", "max_abs_sole_pitch", "max_tilt_deg", "first_fall_s", "mean_vx")
+    keys = ("support2", "support_50hz", "pelvis_min", "max_abs_sole_pitch", "max_tilt_deg", "first_fall_s", "mean_vx",
+            *swing)  # fmt: skip
     print(args.label, {k: rec[k] for k in (*keys, "eta_mean_2nd_half", "s")}, flush=True)
+
+
+def swing_summary(rows: list[dict[str, Any]], fall_s: float | None, threshold: float = 40.0) -> dict[str, Any]:
+    """Swings of the logged rows before the fall: apex and lift of the lowest sole corner and of the sole's mid-plane
+    above the initial surface [m] (``swing_clearance``, a foot in swing below ``threshold`` N of sand force), and the
+    mean x sand force on swinging feet [N] (negative: the sand drags the swinging foot back)."""
+    from gmloco.eval.metrics.locomotion import swing_clearance
+
+    alive = [r for r in rows if fall_s is None or r["t"] < fall_s]
+    if len(alive) < 3:
+        return {}
+    fz = np.array([r["fz"] for r in alive])
+    low = swing_clearance(-np.array([r["low"] for r in alive]), fz, threshold=threshold, min_steps=2)
+    mid = swing_clearance(-np.array([r["mid"] for r in alive]), fz, threshold=threshold, min_steps=2)
+    fx = np.array([r["fx"] for r in alive])
+    rnd = lambda x: None if not np.isfinite(x) else round(float(x), 4)  # noqa: E731
+    return {"swings": low.swings, "swing_apex_low": rnd(low.apex), "swing_lift_low": rnd(low.lift),
+            "swing_apex_mid": rnd(mid.apex), "swing_lift_mid": rnd(mid.lift),
+            "swing_drag_x": rnd(fx[fz < threshold].mean()) if (fz < threshold).any() else None}  # fmt: skip
 
 
 if __name__ == "__main__":
