@@ -88,14 +88,16 @@ def test_episode_specs_batches_summary_and_tables() -> None:
     assert [[s.index for s in b] for b in episode_batches(specs, 2)] == [[0, 1], [2], [0, 1], [2]]
     rows = [{"terrain": s.terrain, "scenario": s.scenario, "speed": s.speed, "success": s.index == 0,
              "vel_error": 0.1 * s.index, "yaw_error": 0.0, "path_error": 0.0, "support_ratio": 1.0,
-             "max_sinkage": 0.01, "mean_sinkage": 0.005} for s in specs]  # fmt: skip
+             "max_sinkage": 0.01, "mean_sinkage": 0.005, "swing_apex": 0.02 * s.index,
+             "swing_lift": float("nan") if s.index else 0.06} for s in specs]  # fmt: skip
     m = summarize(rows)
     assert math.isclose(m["all/success_rate"], 1 / 3) and m["all/num_episodes"] == 6
     assert math.isclose(m["dry_sand/straight/v1/vel_error"], 0.1) and m["poppy_seed/straight/v2/num_episodes"] == 1
-    # table: dry sand success 1/3 = 33.3 %, velocity error mean(0, 0.1, 0.2) = 0.1 m/s, sinkage 0.5 cm
+    # table: dry sand success 1/3 = 33.3 %, velocity error mean(0, 0.1, 0.2) = 0.1 m/s, sinkage 0.5 cm, swing apex
+    # mean(0, 2, 4) = 2 cm, lift 6 cm (episodes without a finished swing, NaN, are left out of the mean)
     t = table_terrains(rows, "p")
     assert t[0][:4] == ["p", "dry_sand", "straight", 3]
-    np.testing.assert_allclose(t[0][4:], [100 / 3, 0.1, 0.0, 0.0, 0.5])
+    np.testing.assert_allclose(t[0][4:], [100 / 3, 0.1, 0.0, 0.0, 0.5, 2.0, 6.0])
     header, body = table_speeds(rows)
     # v = 1: episodes 0 (success) and 2 (fail) -> 50 %; v = 2: episode 1 (fail) -> 0 %
     assert header[2:] == ["v=1 m/s", "v=2 m/s"] and body[0][2:] == [50.0, 0.0]

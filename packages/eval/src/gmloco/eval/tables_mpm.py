@@ -19,7 +19,7 @@ import numpy as np
 __all__ = ["table_speeds", "table_terrains", "write_tables"]
 
 TERRAIN_COLUMNS = ("policy", "terrain", "scenario", "episodes", "success_rate_pct", "vel_error_mps",
-                   "yaw_error_radps", "path_error_m", "mean_sinkage_cm")  # fmt: skip
+                   "yaw_error_radps", "path_error_m", "mean_sinkage_cm", "swing_apex_cm", "swing_lift_cm")  # fmt: skip
 """Columns of ``table_terrains``."""
 
 
@@ -42,7 +42,8 @@ def table_terrains(rows: list[dict[str, Any]], policy: str) -> list[list[Any]]:
     out = []
     for (terrain, scenario), rs in _cells(rows).items():
         out.append([policy, terrain, scenario, len(rs), 100.0 * _mean(rs, "success"), _mean(rs, "vel_error"),
-                    _mean(rs, "yaw_error"), _mean(rs, "path_error"), 100.0 * _mean(rs, "mean_sinkage")])  # fmt: skip
+                    _mean(rs, "yaw_error"), _mean(rs, "path_error"), 100.0 * _mean(rs, "mean_sinkage"),
+                    100.0 * _mean(rs, "swing_apex"), 100.0 * _mean(rs, "swing_lift")])  # fmt: skip
     return out
 
 
