@@ -39,14 +39,15 @@ def test_malformed_reward_weight_exits_with_the_expected_form(item: str) -> None
 
 
 def test_foot_clearance_touchdown_swaps_the_swing_term() -> None:
-    """--foot-clearance touchdown replaces the L2 penalty by the lift paid at touchdown; its weight can be overridden."""
+    """--foot-clearance touchdown adds the lift paid at touchdown to the L2 penalty; both weights can be overridden."""
     chunk = _load()
     base = ["--stage", "teacher", "--out", "unused", "--no-held-out", "--foot-clearance", "touchdown"]
-    task = chunk._task(chunk._parse([*base, "--reward-weight", "swing_height_at_touchdown=40"]))
+    weights = ["--reward-weight", "swing_height_at_touchdown=40", "--reward-weight", "foot_clearance_l2=-50"]
+    task = chunk._task(chunk._parse([*base, *weights]))
     assert task.foot_clearance == "touchdown"
 
     from gmloco.train.tasks.g1_granular.rewards_cfg import make_rewards_cfg
 
     rewards = make_rewards_cfg(task)
-    assert "foot_clearance_l2" not in rewards and rewards["swing_height_at_touchdown"].weight == 40.0
+    assert rewards["foot_clearance_l2"].weight == -50.0 and rewards["swing_height_at_touchdown"].weight == 40.0
     assert rewards["swing_height_at_touchdown"].params["relative"] is True

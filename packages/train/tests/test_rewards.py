@@ -121,6 +121,9 @@ def test_foot_clearance_form_selects_the_term() -> None:
     assert rewards["foot_clearance_l2"].weight == -2.0 and "foot_clearance" not in rewards
     rewards = make_rewards_cfg(replace(task, foot_clearance="reward"))
     assert rewards["foot_clearance"].weight == 5.0 and "foot_clearance_l2" not in rewards
+    rewards = make_rewards_cfg(replace(task, foot_clearance="touchdown"))
+    assert rewards["foot_clearance_l2"].weight == -2.0 and rewards["swing_height_at_touchdown"].weight == 200.0
+    assert "swing_height_at_touchdown" not in make_rewards_cfg(task)
 
 
 def test_swing_height_is_paid_once_per_touchdown_clipped_and_only_when_moving() -> None:
