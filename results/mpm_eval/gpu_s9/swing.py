@@ -30,7 +30,10 @@ RUNS = {  # label -> (record file, simulator)
     "student_it2418_v3_i250_dt0.005_sub1": (MPM_EVAL / "gpu_s7/g1_students_v3cm_dt005.jsonl", "MPM 3 cm / 5 ms"),
     "student_clr50_it419_v3_i250_dt0.005_sub1": (MPM_EVAL / "gpu_s7/g1_students_v3cm_dt005.jsonl", "MPM 3 cm / 5 ms"),
     "student_clr50_it1081_v3_i250_dt0.005_sub1": (MPM_EVAL / "gpu_s8/g1_student1081_dt005.jsonl", "MPM 3 cm / 5 ms"),
-    "student_clr50_it1081_v1.5_i250_dt0.005_sub1": (MPM_EVAL / "gpu_s8/g1_student1081_dt005.jsonl", "MPM 1.5 cm / 5 ms"),
+    "student_clr50_it1081_v1.5_i250_dt0.005_sub1": (
+        MPM_EVAL / "gpu_s8/g1_student1081_dt005.jsonl",
+        "MPM 1.5 cm / 5 ms",
+    ),
     "student_hs_A_v3_i250_dt0.005_sub1": (HERE / "probe_hs.jsonl", "MPM 3 cm / 5 ms"),
 }
 FIGURE_PAIR = ("rft3d_train_v1_fx", "ppo_rft3d_v3_i250_dt0.005_sub1_3s")
