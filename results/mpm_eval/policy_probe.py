@@ -186,9 +186,12 @@ def main() -> None:
 
 
 def swing_summary(rows: list[dict[str, Any]], fall_s: float | None, threshold: float = 40.0) -> dict[str, Any]:
-    """Swings of the logged rows before the fall: apex and lift of the lowest sole corner and of the sole's mid-plane
-    above the initial surface [m] (``swing_clearance``, a foot in swing below ``threshold`` N of sand force), and the
-    mean x sand force on swinging feet [N] (negative: the sand drags the swinging foot back)."""
+    """Swing summary of the logged rows before the fall.
+
+    Apex and lift of the lowest sole corner and of the sole's mid-plane above the initial surface [m]
+    (``swing_clearance``, a foot in swing below ``threshold`` N of sand force), and the mean x sand force on
+    swinging feet [N] (negative: the sand drags the swinging foot back).
+    """
     from gmloco.eval.metrics.locomotion import swing_clearance
 
     alive = [r for r in rows if fall_s is None or r["t"] < fall_s]

@@ -16,11 +16,7 @@ import json
 from pathlib import Path
 from typing import Any
 
-import matplotlib
-
-matplotlib.use("Agg")
-import matplotlib.pyplot as plt  # noqa: E402
-import numpy as np  # noqa: E402
+import numpy as np
 
 HERE = Path(__file__).resolve().parent
 MPM_EVAL = HERE.parent
@@ -65,7 +61,7 @@ def table() -> None:
         rec = load(label)
         fall = rec.get("first_fall_s")
         s = swing_summary(rec["rows"], fall)
-        cm = lambda k: "-" if s.get(k) is None else f"{100 * s[k]:.1f}"  # noqa: E731
+        cm = lambda k, s=s: "-" if s.get(k) is None else f"{100 * s[k]:.1f}"  # noqa: E731
         drag = "-" if s.get("swing_drag_x") is None else f"{s['swing_drag_x']:.0f}"
         fall_s = "no" if fall is None else f"{fall:.2f}"
         print(f"| {label} | {sim} | {fall_s} | {s.get('swings', 0)} | {cm('swing_apex_low')} / {cm('swing_apex_mid')} "
@@ -74,6 +70,11 @@ def table() -> None:
 
 def figure(path: Path) -> None:
     """Lowest sole corner height and x sand force per foot up to 1.4 s (before either run falls), swings shaded."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
     fig, axes = plt.subplots(2, 2, figsize=(11, 5.5), sharex=True, sharey="row")
     for col, label in enumerate(FIGURE_PAIR):
         rec, sim = load(label), RUNS[label][1]
