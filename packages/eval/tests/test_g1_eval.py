@@ -162,3 +162,44 @@ def test_step_frames_stops_when_all_fell_and_at_the_time_box() -> None:
     assert step_frames(scene, 100, cfg) and scene.frame == 100  # one robot still up: runs to the end
     scene = _FakeScene(fall_frame=1000)
     assert not step_frames(scene, 100, cfg, deadline=time.perf_counter() - 1.0) and scene.frame == 1
+
+
+def test_transition_course_per_medium(tmp_path: Path) -> None:
+    """A walk over basalt -> dry sand -> poppy seed: decoded eta and swing apex / lift per medium, table and figure.
+
+    x = 1.2 t over 10 s; media change at x = 4 and 7 m (``terrain_cfg("transition")``). Foot 0 stands 10 steps at
+    0 / -2 / -6 cm and swings 10 steps at +4 / +3 / +1 cm on each medium; eta reads 0.5 / 0.09 / 0.02.
+    """
+    from gmloco.eval.figures_mpm import write_figures
+    from gmloco.eval.mpm.window_terrain import terrain_cfg, terrain_layer
+    from gmloco.eval.tables_mpm import table_transition, write_tables
+
+    cfg = replace(G1EvalCfg(), episode_s=10.0)
+    dt, n = 0.02, 500
+    t = (np.arange(n) + 1) * dt
+    log = _log(np.stack([1.2 * t, 0 * t], 1), np.tile([1.2, 0.0], (n, 1)), np.full(n, 0.7), dt)
+    terrain = terrain_cfg("transition")
+    layer = terrain_layer(terrain, 1.2 * t)
+    stance, apex, eta = np.array([0.0, -0.02, -0.06]), np.array([0.04, 0.03, 0.01]), np.array([0.5, 0.09, 0.02])
+    swing = (np.arange(n) % 20) >= 10
+    log["foot_force"][swing, 0, 2] = 0.0
+    log["foot_sinkage"][:, 0] = -np.where(swing, apex[layer], stance[layer])
+    log |= {"terrain_cfg": terrain, "eta": eta[layer]}
+    row = score_episode(EpisodeSpec("transition", "straight", 1.2, 0), cfg, log)
+    layers = {entry["medium"]: entry for entry in row["layers"]}
+    assert list(layers) == list(terrain.materials) and sum(e["steps"] for e in layers.values()) == n
+    for k, medium in enumerate(terrain.materials):
+        entry = layers[medium]
+        assert entry["swings"] >= 3 and np.isclose(entry["eta_mean"], eta[k])
+        assert np.isclose(entry["swing_apex"], apex[k]) and np.isclose(entry["swing_lift"], apex[k] - stance[k])
+    table = table_transition([row])
+    assert [r[1] for r in table] == list(terrain.materials)
+    np.testing.assert_allclose([r[4] for r in table], 100 * apex)
+    paths = write_tables([row], tmp_path, "p") + write_figures([row], tmp_path, "p")
+    assert {p.name for p in paths} >= {"table_transition.md", "table_transition.csv", "fig_mpm_transition.png"}
+    # a single-medium terrain has no per-medium stats and writes no transition outputs
+    flat_log = _log(np.stack([1.2 * t, 0 * t], 1), np.tile([1.2, 0.0], (n, 1)), np.full(n, 0.7), dt)
+    flat = score_episode(
+        EpisodeSpec("dry_sand", "straight", 1.2, 0), cfg, flat_log | {"terrain_cfg": terrain_cfg("dry_sand")}
+    )
+    assert flat["layers"] is None and table_transition([flat]) == []

@@ -1,5 +1,5 @@
 # SPDX-License-Identifier: Apache-2.0
-"""Figures of the MPM evaluation: success rate and velocity tracking error vs commanded speed, per terrain."""
+"""Figures of the MPM evaluation: success and velocity error vs commanded speed; the transition course per medium."""
 
 from __future__ import annotations
 
@@ -9,7 +9,7 @@ from typing import Any
 
 import numpy as np
 
-__all__ = ["fig_mpm_speed_sweep", "write_figures"]
+__all__ = ["fig_mpm_speed_sweep", "fig_mpm_transition", "write_figures"]
 
 
 def _by_speed(rs: list[dict[str, Any]], key: str) -> tuple[np.ndarray, np.ndarray]:
@@ -47,6 +47,36 @@ def fig_mpm_speed_sweep(rows: list[dict[str, Any]], path: str | Path, policy: st
     return Path(path)
 
 
+def fig_mpm_transition(rows: list[dict[str, Any]], path: str | Path, policy: str) -> Path:
+    """Decoded eta and swing apex / lift per medium of the transition course (``tables_mpm.table_transition``)."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    from gmloco.eval.tables_mpm import table_transition
+
+    table = table_transition(rows)
+    fig, (ax0, ax1) = plt.subplots(1, 2, figsize=(9, 3.4), constrained_layout=True)
+    for scenario in dict.fromkeys(r[0] for r in table):
+        cells = [r for r in table if r[0] == scenario]
+        media = [r[1] for r in cells]
+        ax0.plot(media, [r[3] for r in cells], "o-", label=scenario)
+        ax1.plot(media, [r[4] for r in cells], "o-", label=f"{scenario}: apex")
+        ax1.plot(media, [r[5] for r in cells], "s--", label=f"{scenario}: lift")
+    ax0.set(ylabel="decoded stiffness eta [-]")
+    ax1.set(ylabel="swing height [cm]")
+    ax0.legend(fontsize=7)
+    ax1.legend(fontsize=7)
+    fig.suptitle(f"{policy} on the MPM transition course (media in walking order)", fontsize=9)
+    fig.savefig(path, dpi=120)
+    plt.close(fig)
+    return Path(path)
+
+
 def write_figures(rows: list[dict[str, Any]], out_dir: str | Path, policy: str) -> list[Path]:
     """Write the evaluation figures under ``out_dir``; return their paths."""
-    return [fig_mpm_speed_sweep(rows, Path(out_dir) / "fig_mpm_speed_sweep.png", policy)]
+    paths = [fig_mpm_speed_sweep(rows, Path(out_dir) / "fig_mpm_speed_sweep.png", policy)]
+    if any(r.get("layers") for r in rows):
+        paths.append(fig_mpm_transition(rows, Path(out_dir) / "fig_mpm_transition.png", policy))
+    return paths

@@ -15,6 +15,8 @@ with :mod:`gmloco.eval.metrics.locomotion`:
   |w_z - w_cmd| over alive steps; path error: DTW between executed and commanded xy paths (alive part).
 * swing clearance: mean apex of the completed swings above the local surface and their lift above the stance
   before (``swing_clearance``: a foot is in swing while its sand force is below 40 N).
+* decoded stiffness: the student's mean decoded eta over the alive steps; on the layered ``transition`` course
+  also per medium, with the swings there (``layer_stats``; ``table_transition``, ``fig_mpm_transition.png``).
 
 Outputs under ``out_dir``: ``episodes.jsonl`` (one line per finished episode; the resume state),
 ``summary.json`` (metrics per group, throughput, config), the paper-shaped tables (``tables_mpm``), figures
@@ -232,7 +234,8 @@ def run_batch(
         return None
     if solver.max_active_cell_count > 0 and solver.grid_type == "sparse":
         scene.mpm.check_sparse_grid_rebuild_status()
-    names = ("base_q", "base_qd", "foot_force", "sinkage", "foot_sinkage", "joint_q", "joint_qd", "target", "action")
+    names = ("base_q", "base_qd", "foot_force", "sinkage", "foot_sinkage", "joint_q", "joint_qd", "target", "action",
+             "eta")  # fmt: skip
     arr = {name: np.asarray(getattr(scene, name)) for name in names}
     logs = []
     for r, spec in enumerate(batch):
@@ -243,6 +246,7 @@ def run_batch(
             "base_height": q[:, 2] - surf, "foot_force": arr["foot_force"][:, r], "sinkage": arr["sinkage"][:, r],
             "foot_sinkage": arr["foot_sinkage"][:, r], "joint_q": arr["joint_q"][:, r],
             "joint_qd": arr["joint_qd"][:, r], "target": arr["target"][:, r], "action": arr["action"][:, r],
+            "eta": arr["eta"][:, r], "terrain_cfg": terrain,
             "command": scene.commands[r], "joint_names": scene.spec.joint_names, "kp": scene.spec.kp,
             "kd": scene.spec.kd, "start_xy": q[0, :2].copy(), "robot_mass": scene.robot_mass,
             "particles": scene.particle_count, "batch_size": n, "build_s": build_s, "sim_s": scene.wall_time,
@@ -281,6 +285,7 @@ def score_episode(spec: EpisodeSpec, cfg: G1EvalCfg, log: dict[str, Any]) -> dic
     fz = log["foot_force"][:, :, 2].sum(axis=1) if len(log["foot_force"]) else np.zeros(1)
     sink = np.asarray(log["sinkage"])[:alive]
     swing = swing_clearance(-np.asarray(log["foot_sinkage"]), np.asarray(log["foot_force"])[..., 2], alive)
+    eta = np.asarray(log.get("eta", np.full(len(q), np.nan)), dtype=float)[:alive]
     return {
         "key": spec.key, "terrain": spec.terrain, "scenario": spec.scenario, "speed": spec.speed,
         "success": out.success, "reason": out.reason, "alive_s": out.alive_steps * dt,
@@ -292,6 +297,8 @@ def score_episode(spec: EpisodeSpec, cfg: G1EvalCfg, log: dict[str, Any]) -> dic
         "max_sinkage": float(np.max(sink)) if len(sink) else float("nan"),
         "mean_sinkage": float(np.mean(sink)) if len(sink) else float("nan"),
         "swing_apex": swing.apex, "swing_lift": swing.lift, "swings": swing.swings,
+        "eta_mean": float(np.mean(eta)) if np.isfinite(eta).any() else float("nan"),
+        "layers": layer_stats(log, alive),
         # a sole reached the rigid floor under the sand (the soles stand on it): the bed was too shallow there
         "floor_reached": bool(len(sink) and np.max(sink) >= log.get("depth", math.inf) - 0.005),
         "particles": log["particles"], "batch_size": log.get("batch_size", 1), "build_s": log["build_s"],
@@ -299,9 +306,51 @@ def score_episode(spec: EpisodeSpec, cfg: G1EvalCfg, log: dict[str, Any]) -> dic
     }  # fmt: skip
 
 
+def layer_stats(log: dict[str, Any], alive: int) -> list[dict[str, Any]] | None:
+    """Per medium of a layered course (``transition``): decoded eta and swings while the pelvis was over it.
+
+    None for single-medium terrains. Each entry: ``medium``, ``steps`` (alive policy steps over it), ``eta_mean``,
+    ``swing_apex`` / ``swing_lift`` [m] and ``swings`` (swings completed within one stretch over it; a swing that
+    crosses a boundary counts for neither side), NaN where there are none.
+    """
+    from gmloco.eval.mpm.window_terrain import terrain_layer
+
+    terrain = log.get("terrain_cfg")
+    if terrain is None or len(terrain.materials) < 2:
+        return None
+    x = np.asarray(log["base_q"])[:alive, 0]
+    layer = terrain_layer(terrain, x)
+    height = -np.asarray(log["foot_sinkage"])[:alive]
+    load = np.asarray(log["foot_force"])[:alive, :, 2]
+    eta = np.asarray(log.get("eta", np.full(alive, np.nan)), dtype=float)[:alive]
+    out = []
+    for k, medium in enumerate(terrain.materials):
+        on = layer == k
+        runs = _runs(on)
+        swings = [swing_clearance(height[a:b], load[a:b]) for a, b in runs]
+        finite = eta[on][np.isfinite(eta[on])]
+        out.append({"medium": medium, "steps": int(on.sum()), "swings": sum(sw.swings for sw in swings),
+                    "eta_mean": float(finite.mean()) if len(finite) else float("nan"),
+                    "swing_apex": _pooled(swings, "apex"), "swing_lift": _pooled(swings, "lift")})  # fmt: skip
+    return out
+
+
+def _pooled(parts: list[Any], key: str) -> float:
+    """Swing-weighted mean of ``key`` over ``SwingClearance`` parts with a finite value (NaN if none)."""
+    pairs = [(getattr(p, key), p.swings) for p in parts if p.swings and math.isfinite(getattr(p, key))]
+    total = sum(w for _, w in pairs)
+    return sum(v * w for v, w in pairs) / total if total else float("nan")
+
+
+def _runs(mask: np.ndarray) -> list[tuple[int, int]]:
+    """[start, end) of every run of True in ``mask``."""
+    edges = np.diff(np.concatenate([[0], mask.astype(np.int8), [0]]))
+    return list(zip(np.flatnonzero(edges == 1).tolist(), np.flatnonzero(edges == -1).tolist(), strict=True))
+
+
 METRIC_KEYS = (
     "success", "vel_error", "yaw_error", "path_error", "support_ratio", "max_sinkage", "mean_sinkage", "floor_reached",
-    "swing_apex", "swing_lift",
+    "swing_apex", "swing_lift", "eta_mean",
 )  # fmt: skip
 
 

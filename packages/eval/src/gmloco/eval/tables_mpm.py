@@ -5,6 +5,9 @@
   error, DTW path error, mean sinkage (GM-Loco's per-terrain and contact-model tables; several policies'
   ``episodes.jsonl`` concatenated give the ablation rows).
 * ``table_speeds``: success rate per commanded forward speed (rows terrain x scenario).
+* ``table_transition``: on the layered ``transition`` course, per (scenario, medium): episodes that reached the
+  medium, the student's mean decoded stiffness eta and the swing apex / lift there (GM-Loco's terrain-transition
+  analysis); written only when the rows hold transition episodes.
 """
 
 from __future__ import annotations
@@ -16,7 +19,7 @@ from typing import Any
 
 import numpy as np
 
-__all__ = ["table_speeds", "table_terrains", "write_tables"]
+__all__ = ["TRANSITION_COLUMNS", "table_speeds", "table_terrains", "table_transition", "write_tables"]
 
 TERRAIN_COLUMNS = ("policy", "terrain", "scenario", "episodes", "success_rate_pct", "vel_error_mps",
                    "yaw_error_radps", "path_error_m", "mean_sinkage_cm", "swing_apex_cm", "swing_lift_cm")  # fmt: skip
@@ -59,6 +62,21 @@ def table_speeds(rows: list[dict[str, Any]]) -> tuple[list[str], list[list[Any]]
     return header, body
 
 
+TRANSITION_COLUMNS = ("scenario", "medium", "episodes_reached", "eta_decoded", "swing_apex_cm", "swing_lift_cm")
+"""Columns of ``table_transition``."""
+
+
+def table_transition(rows: list[dict[str, Any]]) -> list[list[Any]]:
+    """Rows of ``table_transition`` (``TRANSITION_COLUMNS``), one per (scenario, medium) of the layered episodes."""
+    cells: dict[tuple[str, str], list[dict[str, Any]]] = {}
+    for r in rows:
+        for layer in r.get("layers") or []:
+            if layer["steps"] > 0:
+                cells.setdefault((r["scenario"], layer["medium"]), []).append(layer)
+    return [[scenario, medium, len(ls), _mean(ls, "eta_mean"), 100.0 * _mean(ls, "swing_apex"),
+             100.0 * _mean(ls, "swing_lift")] for (scenario, medium), ls in cells.items()]  # fmt: skip
+
+
 def _fmt(x: Any) -> str:
     """Markdown cell: 3 significant decimals for floats, ``-`` for NaN."""
     if isinstance(x, float):
@@ -83,4 +101,7 @@ def write_tables(rows: list[dict[str, Any]], out_dir: str | Path, policy: str) -
     out = Path(out_dir)
     paths = _write(out / "table_terrains", TERRAIN_COLUMNS, table_terrains(rows, policy))
     header, body = table_speeds(rows)
-    return paths + _write(out / "table_speeds", header, body)
+    paths += _write(out / "table_speeds", header, body)
+    if transition := table_transition(rows):
+        paths += _write(out / "table_transition", TRANSITION_COLUMNS, transition)
+    return paths

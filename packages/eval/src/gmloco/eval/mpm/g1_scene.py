@@ -136,6 +136,7 @@ class G1MpmScene:
         foot_sinkage: The same per foot [m], list of [R, 2].
         joint_q, joint_qd, target: Actuated joints [rad], [rad/s] and PD targets [rad], lists of [R, A].
         action: Raw policy actions, list of [R, A].
+        eta: The student's decoded normalized terrain stiffness, list of [R] (NaN for other policies).
     """
 
     def __init__(self, cfg: G1MpmSceneCfg, policy: MjlabOnnxPolicy | StudentOnnxPolicy | PolicySpec) -> None:
@@ -175,6 +176,7 @@ class G1MpmScene:
         self.joint_qd: list[np.ndarray] = []
         self.target: list[np.ndarray] = []
         self.action: list[np.ndarray] = []
+        self.eta: list[np.ndarray] = []
 
     @property
     def particle_count(self) -> int:
@@ -387,6 +389,14 @@ class G1MpmScene:
         self.joint_qd.append(st["jqd"])
         self.target.append(target)
         self.action.append(self.last_action.copy())
+        self.eta.append(self._decoded_eta())
+
+    def _decoded_eta(self) -> np.ndarray:
+        """The student's decoded terrain stiffness after its last step, [R] (NaN for policies without one)."""
+        eta = getattr(getattr(self.policy, "runner", None), "eta", None)
+        if eta is None:
+            return np.full(len(self.lane_y), np.nan)
+        return np.asarray(eta, dtype=np.float64).reshape(len(self.lane_y), -1)[:, 0]
 
     # -- stepping -------------------------------------------------------------------------------------------
 
