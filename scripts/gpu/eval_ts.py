@@ -40,6 +40,7 @@ def _parse(argv: list[str] | None) -> argparse.Namespace:
     p.add_argument("--teacher", default="artifacts/gm_loco_teacher/checkpoint.pt", help="TeacherPPO checkpoint")
     p.add_argument("--baseline", default="artifacts/ppo_rft3d/policy.onnx", help="'none' to skip")
     p.add_argument("--contact-model", default="rft3d")
+    p.add_argument("--foot-faces", choices=["sole", "box"], default="sole", help="foot-box faces the RFT models sample")
     p.add_argument("--latent-dim", type=int, default=16)
     p.add_argument("--history-length", type=int, default=50)
     p.add_argument("--held-out-grid", default="3,3", help="grid points along rho_c, mu_int")
@@ -71,6 +72,7 @@ def main(argv: list[str] | None = None) -> dict[str, Any]:
         teacher_checkpoint=args.teacher,
         baseline_policy=None if args.baseline == "none" else args.baseline,
         contact_model=args.contact_model,
+        foot_faces=args.foot_faces,
         latent_dim=args.latent_dim,
         history_length=args.history_length,
         held_out_grid=(n_rho, n_mu),

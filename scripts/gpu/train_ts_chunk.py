@@ -87,6 +87,13 @@ def _parse(argv: list[str] | None) -> argparse.Namespace:
         help="GranularTaskCfg.foot_clearance (default: the task's, the L2 penalty); 'touchdown' pays each swing's "
         "lift out of the footprint at touchdown; pass the same value to every chunk of a run",
     )
+    p.add_argument(
+        "--foot-faces",
+        choices=["sole", "box"],
+        default=None,
+        help="GranularTaskCfg.foot_faces (default: the task's, the sole only); 'box' samples all six faces of the "
+        "foot box, so a buried swinging foot meets sand; pass the same value to every chunk of a run",
+    )
     p.add_argument("--teacher-checkpoint", type=Path, default=None)
     p.add_argument(
         "--warm-start-ppo",
@@ -215,6 +222,8 @@ def _task(args: argparse.Namespace) -> Any:
     task = replace(g1_granular_task(args.contact_model, args.terrain), policy_history_length=1)
     if args.foot_clearance is not None:
         task = replace(task, foot_clearance=args.foot_clearance)
+    if args.foot_faces is not None:
+        task = replace(task, foot_faces=args.foot_faces)
     weights = reward_weights(args.reward_weight)
     if weights:
         task = replace(task, reward_weights=weights)

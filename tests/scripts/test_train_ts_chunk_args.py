@@ -51,3 +51,18 @@ def test_foot_clearance_touchdown_swaps_the_swing_term() -> None:
     rewards = make_rewards_cfg(task)
     assert rewards["foot_clearance_l2"].weight == -50.0 and rewards["swing_height_at_touchdown"].weight == 40.0
     assert rewards["swing_height_at_touchdown"].params["relative"] is True
+
+
+def test_foot_faces_box_reaches_the_contact_model_cfg() -> None:
+    """--foot-faces box makes the RFT models sample all six faces of the foot box (6 x 25 points, not 25)."""
+    chunk = _load()
+    task = chunk._task(chunk._parse(["--stage", "teacher", "--out", "unused", "--no-held-out", "--foot-faces", "box"]))
+    assert task.foot_faces == "box"
+
+    from gmloco.contact.colliders import box_collider
+    from gmloco.train.contact_models import contact_model_cfg
+
+    for name in ("rft3d", "heuristic_rft"):
+        assert len(box_collider(contact_model_cfg(name, task.foot_faces).collider).areas) == 150
+        assert len(box_collider(contact_model_cfg(name).collider).areas) == 25
+    assert chunk._task(chunk._parse(["--stage", "teacher", "--out", "unused", "--no-held-out"])).foot_faces == "sole"

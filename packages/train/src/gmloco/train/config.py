@@ -125,6 +125,11 @@ class GranularTaskCfg:
 
     contact_model: ContactModelName = "rft3d"
     """Foot-ground contact model."""
+    foot_faces: Literal["sole", "box"] = "sole"
+    """Faces of the foot box the RFT models sample: ``"sole"`` (GM-Loco's collider, the -z face) or ``"box"`` (all
+    six). With the sole alone a swinging foot that rises or points its toe down meets no sand at any depth; the
+    whole box gives 30-80 N of drag at 4-8 cm, as MPM sand does (results/mpm_eval/gpu_s9/face_drag.md). Cone and
+    rigid models ignore it."""
     terrain: SandTerrainCfg = field(default_factory=flat_sand_terrain)
     """Sand free surface and floor."""
     material: MaterialRangeCfg = field(default_factory=MaterialRangeCfg)

@@ -8,7 +8,8 @@ the contact package's own ``xi_n`` / ``xi_max`` (plain arithmetic, so it runs on
 
 from __future__ import annotations
 
-from typing import Any
+from dataclasses import replace
+from typing import Any, Literal
 
 import numpy as np
 import torch
@@ -24,8 +25,8 @@ NUM_FEET = 2
 """Feet per robot that carry a granular wrench."""
 
 
-def contact_model_cfg(name: ContactModelName) -> Any:
-    """Return the default ``gmloco.contact`` config of a named contact model."""
+def contact_model_cfg(name: ContactModelName, foot_faces: Literal["sole", "box"] = "sole") -> Any:
+    """Return the ``gmloco.contact`` config of a named contact model; the RFT models sample ``foot_faces``."""
     table = {
         "rft3d": gc.ContactRFT3DCfg,
         "heuristic_rft": gc.ContactHeuristicRFTCfg,
@@ -33,7 +34,10 @@ def contact_model_cfg(name: ContactModelName) -> Any:
         "cone_single": gc.ContactConeSingleCfg,
         "rigid": gc.ContactRigidCfg,
     }
-    return table[name]()
+    cfg = table[name]()
+    if name in ("rft3d", "heuristic_rft") and foot_faces != cfg.collider.faces:
+        cfg = replace(cfg, collider=replace(cfg.collider, faces=foot_faces))
+    return cfg
 
 
 def contact_terrain_cfg(terrain: SandTerrainCfg) -> Any:
@@ -49,7 +53,7 @@ def build_contact_model(task: GranularTaskCfg, num_envs: int, device: wp.context
 
     The model skips its per-point outputs (``point_outputs`` False): the environment reads only the foot wrenches.
     """
-    cfg = contact_model_cfg(task.contact_model)
+    cfg = contact_model_cfg(task.contact_model, task.foot_faces)
     terrain = contact_terrain_cfg(task.terrain)
     model = gc.make_contact_model(cfg, num_envs, NUM_FEET, str(device), terrain=terrain)
     model.point_outputs = False  # training reads only the wrenches (set True before install() to inspect points)

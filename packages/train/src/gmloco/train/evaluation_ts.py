@@ -70,6 +70,9 @@ class TsEvalCfg(RolloutCriteriaCfg):
     """PPO baseline (mjlab ONNX export) scored on the named presets; None: skip."""
     contact_model: ContactModelName = "rft3d"
     """Contact model of the simulator."""
+    foot_faces: Literal["sole", "box"] = "sole"
+    """Foot-box faces the RFT models sample (``GranularTaskCfg.foot_faces``); the PPO baseline always runs on the
+    sole."""
     terrain: TerrainName = "flat"
     """Sand terrain."""
     latent_dim: int = 16
@@ -160,7 +163,9 @@ def _build_runner(cfg: TsEvalCfg, num_envs: int, duration_s: float) -> Any:
     from gmloco.train.tasks.g1_granular import g1_granular_task, make_g1_granular_env_cfg, make_g1_granular_ppo_cfg
 
     task = g1_granular_task(cfg.contact_model, cfg.terrain, play=True)
-    task = replace(task, terrain=replace(task.terrain, floor=cfg.floor), command_curriculum=False)
+    task = replace(
+        task, terrain=replace(task.terrain, floor=cfg.floor), command_curriculum=False, foot_faces=cfg.foot_faces
+    )
     task.policy_history_length, task.episode_length_s = 1, duration_s + 1.0
     env_cfg = make_g1_granular_env_cfg(task, num_envs, cfg.history_length)
     env_cfg.seed = cfg.seed
