@@ -122,7 +122,7 @@ def test_foot_clearance_form_selects_the_term() -> None:
     rewards = make_rewards_cfg(replace(task, foot_clearance="reward"))
     assert rewards["foot_clearance"].weight == 5.0 and "foot_clearance_l2" not in rewards
     rewards = make_rewards_cfg(replace(task, foot_clearance="touchdown"))
-    assert rewards["foot_clearance_l2"].weight == -2.0 and rewards["swing_height_at_touchdown"].weight == 200.0
+    assert rewards["foot_clearance_l2"].weight == -2.0 and rewards["swing_height_at_touchdown"].weight == 100.0
     assert "swing_height_at_touchdown" not in make_rewards_cfg(task)
 
 

@@ -162,7 +162,7 @@ class GranularTaskCfg:
     still feet); ``"reward"``: the public code's exp form (weight +5), which pays its maximum to feet that do not
     move, so a policy that stands still earns it in full (measured: 62 % of the term's maximum at iteration 1,400
     while tracking earned 17 %, no walking; see artifacts/ppo_rft3d/manifest.json); ``"touchdown"``: the penalty
-    plus ``swing_height_at_touchdown`` (weight +200, lift out of the footprint up to 0.12 m, paid per completed
+    plus ``swing_height_at_touchdown`` (weight +100, lift out of the footprint up to 0.12 m, paid per completed
     swing), which pays neither standing nor an early fall (the penalty alone at weight -300 taught a teacher to fall
     early, results/mpm_eval/gpu_s9/README.md). Its weight is a starting value, not yet tuned by a training run."""
     reward_weights: dict[str, float] = field(default_factory=dict)
