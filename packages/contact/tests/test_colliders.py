@@ -35,8 +35,10 @@ def test_box_faces_are_exact(resolution: int | tuple[int, int, int]) -> None:
 
 
 def test_invalid_box_is_rejected() -> None:
-    """Empty extents and zero resolution fail at construction."""
+    """Empty extents, zero resolution and an unknown face set fail at construction."""
     with pytest.raises(ValueError, match="x_range"):
         ColliderBoxCfg(x_range=(0.1, 0.1))
     with pytest.raises(ValueError, match="resolution"):
         ColliderBoxCfg(resolution=0)
+    with pytest.raises(ValueError, match=r"'sole'.*'box'"):
+        ColliderBoxCfg(faces="boxes")  # type: ignore[arg-type]

@@ -49,6 +49,8 @@ class ColliderBoxCfg:
                 raise ValueError(f"{name}={(lo, hi)} [m]: need max > min")
         if min(self.counts) < 1:
             raise ValueError(f"resolution={self.resolution}: need >= 1 cell per edge")
+        if self.faces not in ("sole", "box"):
+            raise ValueError(f"faces={self.faces!r}: use 'sole' (the -z face) or 'box' (all six faces)")
 
     @property
     def counts(self) -> tuple[int, int, int]:
