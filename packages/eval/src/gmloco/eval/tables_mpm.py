@@ -2,8 +2,8 @@
 """The MPM evaluation's paper-shaped tables (markdown + CSV) from the per-episode rows of ``episodes.jsonl``.
 
 * ``table_terrains``: one row per (policy, terrain, scenario): episodes, success rate, velocity and yaw tracking
-  error, DTW path error, mean sinkage, swing apex and lift (GM-Loco's per-terrain and contact-model tables; several policies'
-  ``episodes.jsonl`` concatenated give the ablation rows).
+  error, DTW path error, mean sinkage, swing apex and lift (GM-Loco's per-terrain and contact-model tables;
+  several policies' ``episodes.jsonl`` concatenated give the ablation rows).
 * ``table_speeds``: success rate per commanded forward speed (rows terrain x scenario).
 * ``table_transition``: on the layered ``transition`` course, per (scenario, medium): episodes that reached the
   medium, the student's mean decoded stiffness eta and the swing apex / lift there (GM-Loco's terrain-transition
