@@ -147,3 +147,19 @@ def test_g1_sole_stiffness() -> None:
     pts = sole.points + np.array([0, 0, 0.03539 - 0.01])
     f = rft3d_forces(pts, sole.normals, np.tile([0, 0, -0.1], (25, 1)), sole.areas, rho_c=1500, mu_int=0.6, mu_surf=0.4)
     np.testing.assert_allclose(f.sum(0)[2] / 0.01, 2.10e4, rtol=3e-3)
+
+
+def test_a_rising_buried_foot_meets_sand_only_on_the_whole_box() -> None:
+    """A G1 foot 6 cm deep moving forward and up meets no sand on the sole-only collider, ~44 N of drag on the box.
+
+    The sole is not a leading surface when it rises; the whole box's front and top faces are.
+    """
+    velocity = np.tile([1.5, 0.0, 0.2], (1, 1))
+    forces = {}
+    for faces in ("sole", "box"):
+        col = g1_foot_collider(faces, 5)
+        pts = col.points - np.array([0.0, 0.0, 0.06 - 0.03539])  # sole 6 cm below the surface, top 2.5 cm
+        vel = np.repeat(velocity, len(pts), axis=0)
+        forces[faces] = rft3d_forces(pts, col.normals, vel, col.areas, rho_c=1500, mu_int=0.6, mu_surf=0.4).sum(0)
+    np.testing.assert_array_equal(forces["sole"], 0.0)
+    assert forces["box"][0] < -20.0
