@@ -35,6 +35,28 @@ def sole_corners(pos: np.ndarray, mat: np.ndarray, sole: SoleCfg) -> np.ndarray:
     return np.einsum("fij,kj->fki", mat, local) + pos[:, None, :]
 
 
+def probe_row(env: Any, foot_ids: list[int], sole: SoleCfg, t: float, i: int = 0) -> dict[str, Any]:
+    """The MPM probe's quantities of env ``i`` now: pelvis, both sole boxes' depths and pitch, sand force per foot."""
+    robot, d = env.scene["robot"], env.sim.data
+    pos = d.xpos[i, foot_ids].cpu().numpy()
+    mat = d.xmat[i, foot_ids].cpu().numpy().reshape(2, 3, 3)
+    c = sole_corners(pos, mat, sole)
+    low, mid = -c[..., 2].min(axis=1), -c[..., 2].mean(axis=1)
+    pitch = np.degrees(np.arctan2(c[:, 4:, 2].mean(1) - c[:, :4, 2].mean(1), c[:, 4:, 0].mean(1) - c[:, :4, 0].mean(1)))
+    w, x, y, z = robot.data.root_link_quat_w[i].cpu().numpy()
+    bpitch = float(np.degrees(np.arcsin(np.clip(2 * (w * y - z * x), -1, 1))))
+    coupling = env.sand.coupling
+    ff = coupling.foot_force_w[i].cpu().numpy() if coupling is not None else np.zeros((2, 3))
+    rp = robot.data.root_link_pos_w[i].cpu().numpy()
+    rv = robot.data.root_link_lin_vel_w[i].cpu().numpy()
+    return dict(
+        t=round(t, 3), pz=round(float(rp[2]), 4), px=round(float(rp[0]), 3), vx=round(float(rv[0]), 3),
+        vz=round(float(rv[2]), 3), low=[round(float(v), 4) for v in low], mid=[round(float(v), 4) for v in mid],
+        pitch=[round(float(v), 1) for v in pitch], fz=[round(float(v), 1) for v in ff[:, 2]],
+        fx=[round(float(v), 1) for v in ff[:, 0]], pitch_deg=round(bpitch, 1),
+    )  # fmt: skip
+
+
 def main() -> None:
     """Run one rollout and append its record to the log."""
     p = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
@@ -67,33 +89,11 @@ def main() -> None:
         robot = env.scene["robot"]
         local_ids = robot.find_bodies(FOOT_BODIES, preserve_order=True)[0]
         foot_ids = [int(robot.indexing.body_ids[i]) for i in local_ids]
-        coupling = env.sand.coupling
         mass = float(env.sim.mj_model.body_subtreemass[1])
         steps = round(args.duration / env.step_dt)
         fell_at = None
         for k in range(steps + 1):
-            d = env.sim.data
-            pos = d.xpos[0, foot_ids].cpu().numpy()
-            mat = d.xmat[0, foot_ids].cpu().numpy().reshape(2, 3, 3)
-            c = sole_corners(pos, mat, sole)
-            low, mid = -c[..., 2].min(axis=1), -c[..., 2].mean(axis=1)
-            pitch = np.degrees(
-                np.arctan2(c[:, 4:, 2].mean(1) - c[:, :4, 2].mean(1), c[:, 4:, 0].mean(1) - c[:, :4, 0].mean(1))
-            )
-            q = robot.data.root_link_quat_w[0].cpu().numpy()  # w, x, y, z
-            w, x, y, z = q
-            bpitch = float(np.degrees(np.arcsin(np.clip(2 * (w * y - z * x), -1, 1))))
-            ff = coupling.foot_force_w[0].cpu().numpy() if coupling is not None else np.zeros((2, 3))
-            fz, fx = ff[:, 2], ff[:, 0]
-            rp = robot.data.root_link_pos_w[0].cpu().numpy()
-            rv = robot.data.root_link_lin_vel_w[0].cpu().numpy()
-            rows.append(dict(
-                t=round(k * env.step_dt, 3), pz=round(float(rp[2]), 4), px=round(float(rp[0]), 3),
-                vx=round(float(rv[0]), 3), vz=round(float(rv[2]), 3),
-                low=[round(float(v), 4) for v in low], mid=[round(float(v), 4) for v in mid],
-                pitch=[round(float(v), 1) for v in pitch], fz=[round(float(v), 1) for v in fz],
-                fx=[round(float(v), 1) for v in fx], pitch_deg=round(bpitch, 1),
-            ))  # fmt: skip
+            rows.append(probe_row(env, foot_ids, sole, k * env.step_dt))
             if k == steps:
                 break
             actor_obs = obs["actor"].cpu().numpy().astype(np.float32)

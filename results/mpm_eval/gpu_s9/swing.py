@@ -3,9 +3,10 @@
 
     uv run python results/mpm_eval/gpu_s9/swing.py
 
-Reads the probe records (``policy_probe.py`` on MPM, ``cpu_s5/rft_probe.py`` in MuJoCo + 3D-RFT), prints one
-markdown row per run with ``policy_probe.swing_summary`` (swings before the fall: apex and lift of the lowest sole
-corner and of the sole mid-plane above the initial surface, mean x sand force on swinging feet), and draws
+Reads the probe records (``policy_probe.py`` on MPM; ``cpu_s5/rft_probe.py`` and ``rft_probe_ts.py`` in MuJoCo +
+3D-RFT), prints one markdown row per run with ``policy_probe.swing_summary`` (swings before the fall: apex and
+lift of the lowest sole corner and of the sole mid-plane above the initial surface, mean x sand force on swinging
+feet), and draws
 ``swing_trip.png``: the same policy (PPO-3D-RFT, 1.0 m/s, dry sand) in both simulators.
 """
 
@@ -22,6 +23,8 @@ HERE = Path(__file__).resolve().parent
 MPM_EVAL = HERE.parent
 RUNS = {  # label -> (record file, simulator)
     "rft3d_train_v1_fx": (MPM_EVAL / "cpu_s5/runs.jsonl", "3D-RFT (training sim)"),
+    "student_clr50_it1081_rft3d_sole": (HERE / "rft_probe_ts.jsonl", "3D-RFT (training sim)"),
+    "student_clr50_it1081_rft3d_box": (HERE / "rft_probe_ts.jsonl", "3D-RFT, whole-box collider"),
     "ppo_rft3d_v3_i250_dt0.005_sub1_3s": (MPM_EVAL / "gpu_s7/g1_students_v3cm_dt005.jsonl", "MPM 3 cm / 5 ms"),
     "student_it2418_v3_i250_dt0.005_sub1": (MPM_EVAL / "gpu_s7/g1_students_v3cm_dt005.jsonl", "MPM 3 cm / 5 ms"),
     "student_clr50_it419_v3_i250_dt0.005_sub1": (MPM_EVAL / "gpu_s7/g1_students_v3cm_dt005.jsonl", "MPM 3 cm / 5 ms"),
