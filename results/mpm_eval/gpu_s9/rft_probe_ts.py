@@ -13,11 +13,9 @@ picks the RFT collider (``GranularTaskCfg.foot_faces``). Appends one record per 
 from __future__ import annotations
 
 import argparse
-import importlib.util
 import json
 import time
 from pathlib import Path
-from typing import Any
 
 import torch
 
@@ -26,15 +24,6 @@ from gmloco.eval.mpm.g1_scene import SoleCfg
 from gmloco.train.sand import FOOT_BODIES
 
 MPM_EVAL = Path(__file__).resolve().parent.parent
-
-
-def _script(name: str, path: Path) -> Any:
-    """Load a results script as a module (they are scripts, not package modules)."""
-    spec = importlib.util.spec_from_file_location(name, path)
-    assert spec is not None and spec.loader is not None
-    mod = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(mod)
-    return mod
 
 
 def main() -> None:
@@ -46,8 +35,10 @@ def main() -> None:
     p.add_argument("--duration", type=float, default=3.0, help="simulated time [s]")
     p.add_argument("--log", type=Path, default=Path(__file__).resolve().parent / "rft_probe_ts.jsonl")
     args = p.parse_args()
-    rft_probe = _script("rft_probe", MPM_EVAL / "cpu_s5/rft_probe.py")
-    policy_probe = _script("policy_probe", MPM_EVAL / "policy_probe.py")
+    from swing import load_script  # this folder's table script, on sys.path when run as a script
+
+    rft_probe = load_script("rft_probe", MPM_EVAL / "cpu_s5/rft_probe.py")
+    policy_probe = load_script("policy_probe", MPM_EVAL / "policy_probe.py")
     t0 = time.time()
     cfg = ets.TsEvalCfg(student_checkpoint=args.student, baseline_policy=None, device="cpu", foot_faces=args.faces)
     runner = ets._build_runner(cfg, 1, args.duration)

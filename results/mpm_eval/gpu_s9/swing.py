@@ -38,8 +38,9 @@ RUNS = {  # label -> (record file, simulator)
 FIGURE_PAIR = ("rft3d_train_v1_fx", "ppo_rft3d_v3_i250_dt0.005_sub1_3s")
 
 
-def _probe_module() -> Any:
-    spec = importlib.util.spec_from_file_location("policy_probe", MPM_EVAL / "policy_probe.py")
+def load_script(name: str, path: Path) -> Any:
+    """Load a results script as a module (they are scripts beside the data, not package modules)."""
+    spec = importlib.util.spec_from_file_location(name, path)
     assert spec is not None and spec.loader is not None
     mod = importlib.util.module_from_spec(spec)
     spec.loader.exec_module(mod)
@@ -57,7 +58,7 @@ def load(label: str) -> dict[str, Any]:
 
 def table() -> None:
     """Print the swing table (cm and N)."""
-    swing_summary = _probe_module().swing_summary
+    swing_summary = load_script("policy_probe", MPM_EVAL / "policy_probe.py").swing_summary
     print("| run | simulator | fall [s] | swings | apex low / mid [cm] | lift low / mid [cm] | x force in swing [N] |")
     print("|---|---|---|---|---|---|---|")
     for label, (_, sim) in RUNS.items():
