@@ -3,7 +3,7 @@
     python scripts/gpu/eval_ts.py --out $OUT/eval_ts
 
 Runs :func:`gmloco.train.evaluation_ts.evaluate_teacher_student` on ``--student`` (default the committed
-``artifacts/gm_loco_student/checkpoint.pt``): R^2 of the decoded vs true eta for the teacher encoder and the student
+``artifacts/gm_loco_student_clr50/checkpoint.pt``): R^2 of the decoded vs true eta for the teacher encoder and the student
 TCN on a grid over the held-out (rho_c, mu_int) region and on the named presets; student-vs-teacher action error;
 success rate and tracking error per material and speed, next to the PPO-3D-RFT baseline (``--baseline``) on the
 presets; the adaptation walk basalt -> dry sand -> poppy seed. Writes ``summary.json``, ``materials.csv``,
@@ -13,7 +13,7 @@ presets; the adaptation walk basalt -> dry sand -> poppy seed. Writes ``summary.
         --adaptation-envs 16 --out <dir>
 
 ``--actor teacher`` walks only the adaptation course, with the teacher of a ``TeacherPPO`` checkpoint acting
-(``--teacher``, default the committed ``artifacts/gm_loco_teacher/checkpoint.pt``) on ``--adaptation-envs`` envs,
+(``--teacher``, default the committed ``artifacts/gm_loco_teacher_clr50/checkpoint.pt``) on ``--adaptation-envs`` envs,
 and writes ``summary.json`` (per material: left-foot swing apex mean / std / 90th percentile and count, forward
 speed, true and decoded eta), ``adaptation.png`` and ``adaptation_env0.json``. Reward weights do not enter a
 rollout, so a teacher trained with ``--reward-weight`` overrides needs none here.
@@ -36,8 +36,8 @@ def _floats(text: str) -> tuple[float, ...]:
 def _parse(argv: list[str] | None) -> argparse.Namespace:
     p = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     p.add_argument("--actor", choices=["student", "teacher"], default="student", help="teacher: adaptation walk only")
-    p.add_argument("--student", default="artifacts/gm_loco_student/checkpoint.pt")
-    p.add_argument("--teacher", default="artifacts/gm_loco_teacher/checkpoint.pt", help="TeacherPPO checkpoint")
+    p.add_argument("--student", default="artifacts/gm_loco_student_clr50/checkpoint.pt")
+    p.add_argument("--teacher", default="artifacts/gm_loco_teacher_clr50/checkpoint.pt", help="TeacherPPO checkpoint")
     p.add_argument("--baseline", default="artifacts/ppo_rft3d/policy.onnx", help="'none' to skip")
     p.add_argument("--contact-model", default="rft3d")
     p.add_argument("--foot-faces", choices=["sole", "box"], default="sole", help="foot-box faces the RFT models sample")

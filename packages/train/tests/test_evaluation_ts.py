@@ -18,7 +18,7 @@ from gmloco.train.evaluation_ts import (
     swing_apexes,
 )
 
-TEACHER_CHECKPOINT = Path(__file__).parents[3] / "artifacts" / "gm_loco_teacher" / "checkpoint.pt"
+TEACHER_CHECKPOINT = Path(__file__).parents[3] / "artifacts" / "gm_loco_teacher_clr50" / "checkpoint.pt"
 """Committed ``TeacherPPO`` checkpoint (the env-building test skips without it)."""
 ADAPTATION_KEYS = {
     "material",

@@ -62,9 +62,9 @@ class TsEvalCfg(RolloutCriteriaCfg):
     actor: Literal["student", "teacher"] = "student"
     """Acting policy: ``"student"`` (every evaluation) or ``"teacher"`` (``teacher_checkpoint``; the adaptation walk
     alone, as the held-out eta, action-error and baseline parts are about the student)."""
-    student_checkpoint: str = "artifacts/gm_loco_student/checkpoint.pt"
+    student_checkpoint: str = "artifacts/gm_loco_student_clr50/checkpoint.pt"
     """``StudentPPO`` checkpoint (holds the frozen teacher in ``teacher_state_dict``)."""
-    teacher_checkpoint: str = "artifacts/gm_loco_teacher/checkpoint.pt"
+    teacher_checkpoint: str = "artifacts/gm_loco_teacher_clr50/checkpoint.pt"
     """``TeacherPPO`` checkpoint, used when ``actor`` is ``"teacher"``."""
     baseline_policy: str | None = "artifacts/ppo_rft3d/policy.onnx"
     """PPO baseline (mjlab ONNX export) scored on the named presets; None: skip."""
