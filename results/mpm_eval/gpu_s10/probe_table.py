@@ -5,7 +5,9 @@
 
 Reads the ``policy_probe.py`` records of session 10 (``probe_td.jsonl``: the new student after 282 iterations
 (chunk A) and after 672 (chunk B), 3 s and 10 s walks at 1.0 and 1.5 m/s) and the delivered student's record of
-session 8 (same numerics: 3 cm voxels, 250 iterations, 5 ms frames x 1 step, 30 cm of dry sand). Prints one
+session 8 (same numerics: 3 cm voxels, 250 iterations, 5 ms frames x 1 step, 30 cm of dry sand), and the
+resolution check run on the CPU (``probe_td_cpu.jsonl``: the it-672 walk at 5 cm with 250 / 100 / 50 iterations and
+5 or 10 ms frames). Prints one
 markdown row per walk (fall time, mean forward speed, the stance depth of the soles, and
 ``policy_probe.swing_summary``'s swing apex / lift / drag before the fall) and draws ``fig_probe_td.png``: pelvis
 height, forward speed and the left sole's lowest corner over time.
@@ -31,6 +33,11 @@ RUNS = {  # label -> (record file, short name)
     "student_td_A_v3_i250_dt0.005_sub1_10s_vx1.5": (HERE / "probe_td.jsonl", "td student, it 282 (chunk A)"),
     "student_td_B_v3_i250_dt0.005_sub1_10s": (HERE / "probe_td.jsonl", "td student, it 672 (chunk B)"),
     "student_td_B_v3_i250_dt0.005_sub1_10s_vx1.5": (HERE / "probe_td.jsonl", "td student, it 672 (chunk B)"),
+    # resolution check, on the CPU (2 cores) with Warp's CPU device: the same walk at coarser numerics
+    "student_td_B_v5_i250_dt0.005_sub1_10s_cpu": (HERE / "probe_td_cpu.jsonl", "td student, it 672, CPU"),
+    "student_td_B_v5_i100_dt0.005_sub1_10s_cpu": (HERE / "probe_td_cpu.jsonl", "td student, it 672, CPU"),
+    "student_td_B_v5_i50_dt0.005_sub1_10s_cpu": (HERE / "probe_td_cpu.jsonl", "td student, it 672, CPU"),
+    "student_td_B_v5_i50_dt0.01_sub2_10s_cpu": (HERE / "probe_td_cpu.jsonl", "td student, it 672, CPU"),
 }
 FIGURE_RUNS = (
     "student_clr50_it1081_v3_i250_dt0.005_sub1",
@@ -72,10 +79,10 @@ def table() -> None:
     """Print the table (cm, m/s, N)."""
     swing_summary = _swing_module().load_script("policy_probe", MPM_EVAL / "policy_probe.py").swing_summary
     print(
-        "| policy | command [m/s] | walk [s] | fall [s] | mean speed before a fall [m/s] | max tilt [deg] | stance depth [cm] "
+        "| policy | voxel / iterations / frame | command [m/s] | walk [s] | fall [s] | mean speed before a fall [m/s] | max tilt [deg] | stance depth [cm] "
         "| swings | swing apex low / mid [cm] | lift low / mid [cm] | x force in swing [N] |"
     )
-    print("|---|---|---|---|---|---|---|---|---|---|---|")
+    print("|---|---|---|---|---|---|---|---|---|---|---|---|")
     for label, (_, name) in RUNS.items():
         rec = load(label)
         fall = rec.get("first_fall_s")
@@ -87,14 +94,24 @@ def table() -> None:
         tilt = f"{rec['max_tilt_deg']:.0f}" if fall is None else "-"
         speed = np.mean([r["vx"] for r in rec["rows"] if fall is None or r["t"] < fall])
         print(
-            f"| {name} | {rec['vx_cmd']:.1f} | {walk:.0f} | {'no' if fall is None else f'{fall:.2f}'} "
+            f"| {name} | {100 * rec['voxel']:.0f} cm / {rec['iterations']} / {1000 * rec['frame_dt']:.0f} ms "
+            f"| {rec['vx_cmd']:.1f} | {walk:.0f} | {'no' if fall is None else f'{fall:.2f}'} "
             f"| {speed:.2f} | {tilt} | {cm(depth)} | {s.get('swings', 0)} "
             f"| {cm(s.get('swing_apex_low'))} / {cm(s.get('swing_apex_mid'))} "
             f"| {cm(s.get('swing_lift_low'))} / {cm(s.get('swing_lift_mid'))} | {drag} |"
         )
 
 
-def figure(path: Path) -> None:
+RESOLUTION_RUNS = (
+    "student_td_B_v3_i250_dt0.005_sub1_10s",
+    "student_td_B_v5_i250_dt0.005_sub1_10s_cpu",
+    "student_td_B_v5_i100_dt0.005_sub1_10s_cpu",
+    "student_td_B_v5_i50_dt0.005_sub1_10s_cpu",
+    "student_td_B_v5_i50_dt0.01_sub2_10s_cpu",
+)
+
+
+def figure(path: Path, runs: tuple[str, ...] = FIGURE_RUNS, title: str = "", numerics: bool = False) -> None:
     """Pelvis height, forward speed and the left sole's lowest corner over time, one line per walk."""
     import matplotlib
 
@@ -102,14 +119,19 @@ def figure(path: Path) -> None:
     import matplotlib.pyplot as plt
 
     fig, axes = plt.subplots(3, 1, figsize=(10, 8), sharex=True)
-    for label in FIGURE_RUNS:
+    for label in runs:
         rec = load(label)
         rows = rec["rows"]
         fall = rec.get("first_fall_s")
         end = fall + 0.3 if fall is not None else rows[-1]["t"]
         rows = [r for r in rows if r["t"] <= end]
         t = np.array([r["t"] for r in rows])
-        tag = f"{RUNS[label][1]}, {rec['vx_cmd']:.1f} m/s" + (f" (falls {fall:.1f} s)" if fall else " (no fall)")
+        what = (
+            f"{100 * rec['voxel']:.0f} cm, {rec['iterations']} its, {1000 * rec['frame_dt']:.0f} ms"
+            if numerics
+            else f"{RUNS[label][1]}, {rec['vx_cmd']:.1f} m/s"
+        )
+        tag = what + (f" (falls {fall:.1f} s)" if fall else " (no fall)")
         (line,) = axes[0].plot(t, [r["pz"] for r in rows], label=tag, lw=1.2)
         axes[1].plot(t, [r["vx"] for r in rows], color=line.get_color(), lw=0.8)
         axes[2].plot(t, [-100 * r["low"][0] for r in rows], color=line.get_color(), lw=0.8)
@@ -123,11 +145,20 @@ def figure(path: Path) -> None:
     axes[2].set_ylabel("left sole, lowest corner\nabove initial surface [cm]")
     axes[2].set_ylim(-25, 20)
     axes[2].set_xlabel("time [s]")
-    fig.suptitle("G1 students on MPM dry sand (3 cm voxels, 200 Hz coupling): delivered vs touchdown-lift student")
+    fig.suptitle(title)
     fig.tight_layout()
     fig.savefig(path, dpi=120)
 
 
 if __name__ == "__main__":
     table()
-    figure(HERE / "fig_probe_td.png")
+    figure(
+        HERE / "fig_probe_td.png",
+        title="G1 students on MPM dry sand (3 cm voxels, 200 Hz coupling): delivered vs touchdown-lift student",
+    )
+    figure(
+        HERE / "fig_resolution.png",
+        RESOLUTION_RUNS,
+        "The it-672 student at 1.0 m/s on MPM dry sand: resolution check (3 cm on the GPU, 5 cm on the CPU)",
+        numerics=True,
+    )
