@@ -15,7 +15,6 @@ height, forward speed and the left sole's lowest corner over time.
 
 from __future__ import annotations
 
-import json
 from pathlib import Path
 from typing import Any
 
@@ -50,7 +49,7 @@ STANCE_N = 150.0
 
 
 def _swing_module() -> Any:
-    """``gpu_s9/swing.py`` (its script loader, and through it ``policy_probe.swing_summary``)."""
+    """``gpu_s9/swing.py``: its script loader (and through it ``policy_probe.swing_summary``) and record reader."""
     import importlib.util
 
     spec = importlib.util.spec_from_file_location("swing_s9", MPM_EVAL / "gpu_s9/swing.py")
@@ -60,13 +59,12 @@ def _swing_module() -> Any:
     return mod
 
 
+SWING = _swing_module()
+
+
 def load(label: str) -> dict[str, Any]:
     """The last record of ``label`` in its file."""
-    path, _ = RUNS[label]
-    recs = [r for r in map(json.loads, path.read_text().splitlines()) if r.get("label") == label]
-    if not recs:
-        raise SystemExit(f"{path}: no record labelled {label!r}")
-    return recs[-1]
+    return SWING.load(label, RUNS)
 
 
 def stance_depth(rows: list[dict[str, Any]], fall: float | None) -> float | None:
@@ -77,7 +75,7 @@ def stance_depth(rows: list[dict[str, Any]], fall: float | None) -> float | None
 
 def table() -> None:
     """Print the table (cm, m/s, N)."""
-    swing_summary = _swing_module().load_script("policy_probe", MPM_EVAL / "policy_probe.py").swing_summary
+    swing_summary = SWING.load_script("policy_probe", MPM_EVAL / "policy_probe.py").swing_summary
     print(
         "| policy | voxel / iterations / frame | command [m/s] | walk [s] | fall [s] | mean speed before a fall [m/s] | max tilt [deg] | stance depth [cm] "
         "| swings | swing apex low / mid [cm] | lift low / mid [cm] | x force in swing [N] |"

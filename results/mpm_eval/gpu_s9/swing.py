@@ -47,9 +47,9 @@ def load_script(name: str, path: Path) -> Any:
     return mod
 
 
-def load(label: str) -> dict[str, Any]:
-    """The last record of ``label`` in its file."""
-    path, _ = RUNS[label]
+def load(label: str, runs: dict[str, tuple[Path, str]] | None = None) -> dict[str, Any]:
+    """The last record of ``label`` in its file (``runs``: label -> (file, name); default this script's ``RUNS``)."""
+    path, _ = (RUNS if runs is None else runs)[label]
     recs = [r for r in map(json.loads, path.read_text().splitlines()) if r.get("label") == label]
     if not recs:
         raise SystemExit(f"{path}: no record labelled {label!r}")
