@@ -106,7 +106,7 @@ def _parse(argv: list[str] | None) -> argparse.Namespace:
         type=Path,
         default=None,
         help="student, first chunk of a new run: start the history encoder from this earlier student checkpoint "
-        "(e.g. artifacts/gm_loco_student/checkpoint.pt) instead of from scratch",
+        "(e.g. artifacts/gm_loco_student_clr50/checkpoint.pt) instead of from scratch",
     )
     p.add_argument(
         "--curriculum-scale",

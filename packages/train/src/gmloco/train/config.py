@@ -164,7 +164,9 @@ class GranularTaskCfg:
     while tracking earned 17 %, no walking; see artifacts/ppo_rft3d/manifest.json); ``"touchdown"``: the penalty
     plus ``swing_height_at_touchdown`` (weight +100, lift out of the footprint up to 0.12 m, paid per completed
     swing), which pays neither standing nor an early fall (the penalty alone at weight -300 taught a teacher to fall
-    early, results/mpm_eval/gpu_s9/README.md). Its weight is a starting value, not yet tuned by a training run."""
+    early, results/mpm_eval/gpu_s9/README.md). With ``foot_faces="box"`` it trained ``artifacts/gm_loco_teacher_td``,
+    whose student is the first policy to walk 10 s on MPM sand (results/mpm_eval/gpu_s10/README.md); the weight
+    is that run's, not tuned against others."""
     reward_weights: dict[str, float] = field(default_factory=dict)
     """Overrides of reward term weights by name (see ``mdp.rewards``)."""
     play: bool = False
