@@ -46,6 +46,12 @@ def _parse(argv: list[str] | None) -> argparse.Namespace:
     p.add_argument("--static-bed", action="store_true", help="naive baseline: a bed covering the course")
     p.add_argument("--window-length", type=float, default=1.8)
     p.add_argument("--window-width", type=float, default=1.0)
+    p.add_argument(
+        "--window-lead", type=float, default=SandWindowCfg.lead, help="window centre ahead of the pelvis [m]"
+    )
+    p.add_argument(
+        "--particles-per-voxel", type=int, default=SandWindowCfg.particles_per_voxel, help="particles per voxel edge"
+    )
     p.add_argument("--no-mcap", action="store_true")
     p.add_argument("--max-minutes", type=float, default=None)
     p.add_argument("--fresh", action="store_true", help="discard episodes.jsonl instead of resuming")
@@ -54,6 +60,8 @@ def _parse(argv: list[str] | None) -> argparse.Namespace:
     a = p.parse_args(argv)
     if (problem := frame_dt_problem(a.frame_dt)) is not None:
         p.error(f"--frame-dt: {problem}")
+    if a.particles_per_voxel < 1:
+        p.error(f"--particles-per-voxel {a.particles_per_voxel} must be >= 1")
     if a.substeps < 1:
         p.error(f"--substeps {a.substeps} must be >= 1 (rigid steps per MPM frame)")
     return a
@@ -72,7 +80,13 @@ def main(argv: list[str] | None = None) -> None:
         speeds=tuple(a.speeds),
         num_episodes=a.num_episodes,
         episode_s=a.episode_s,
-        window=SandWindowCfg(moving=not a.static_bed, length=a.window_length, width=a.window_width),
+        window=SandWindowCfg(
+            moving=not a.static_bed,
+            length=a.window_length,
+            width=a.window_width,
+            lead=a.window_lead,
+            particles_per_voxel=a.particles_per_voxel,
+        ),
         robots_per_batch=a.robots_per_batch,
         solver=replace(
             base.solver, voxel_size=a.voxel, max_iterations=a.iters, frame_dt=a.frame_dt, rigid_substeps=a.substeps
