@@ -40,6 +40,11 @@ def _parse(argv: list[str] | None) -> argparse.Namespace:
         default=_SOLVER.frame_dt,
         help="MPM frame = coupling period [s]; must divide the 0.02 s policy step (0.01, 0.005, 0.0025)",
     )
+    p.add_argument(
+        "--rheology-solver",
+        default=_SOLVER.rheology_solver,
+        help="SolverImplicitMPM rheology solver: auto, gs, jacobi, or a warm-start sequence such as cr,gs",
+    )
     p.add_argument("--substeps", type=int, default=_SOLVER.rigid_substeps, help="rigid steps per frame")
     p.add_argument("--bed-depth", type=float, default=G1EvalCfg.bed_depth, help="sand depth of flat / rough beds [m]")
     p.add_argument("--robots-per-batch", type=int, default=25)
@@ -89,7 +94,12 @@ def main(argv: list[str] | None = None) -> None:
         ),
         robots_per_batch=a.robots_per_batch,
         solver=replace(
-            base.solver, voxel_size=a.voxel, max_iterations=a.iters, frame_dt=a.frame_dt, rigid_substeps=a.substeps
+            base.solver,
+            voxel_size=a.voxel,
+            max_iterations=a.iters,
+            frame_dt=a.frame_dt,
+            rigid_substeps=a.substeps,
+            rheology_solver=a.rheology_solver,
         ),
         bed_depth=a.bed_depth,
         record_mcap=not a.no_mcap,

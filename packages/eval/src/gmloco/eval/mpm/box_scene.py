@@ -74,6 +74,9 @@ class MpmSolverCfg:
     """Active-cell capacity; raise it at fine voxels or the fixed grid overflows (issue 5 timings)."""
     strain_basis: str = "P0"
     """Strain basis (Newton's coupled example: P0)."""
+    rheology_solver: str = "auto"
+    """Rheology solver (``SolverImplicitMPM.Config.solver``): ``"auto"`` (Gauss-Seidel for the Q1 velocity basis),
+    one name, or a comma-separated warm-start sequence such as ``"cr,gs"`` (a Krylov solve, then Gauss-Seidel)."""
     velocity_handover: VelocityHandover = "predict"
     """Collider velocity the MPM solve sees (the coupling scheme; :func:`hand_over_velocity`): ``"predict"``
     (velocity + g frame_dt), ``"rewind"`` (velocity minus the lagged sand wrench's change; every MPM result before

@@ -9,7 +9,7 @@ from typing import Any
 from gmloco.eval.mpm.bed import SandBedCfg, emit_sand_bed
 from gmloco.eval.mpm.materials import MpmMaterialCfg, apply_mpm_material
 
-__all__ = ["CoupledStates", "build_sand_model", "make_coupled_states", "make_mpm_solver"]
+__all__ = ["CoupledStates", "build_sand_model", "make_coupled_states", "make_mpm_solver", "rheology_solver_arg"]
 
 
 @dataclass
@@ -49,8 +49,17 @@ def make_mpm_solver(newton: Any, sand_model: Any, solver: Any, mat: MpmMaterialC
         max_active_cell_count=solver.max_active_cell_count,
         strain_basis=solver.strain_basis,
         critical_fraction=mat.critical_fraction,
+        solver=rheology_solver_arg(solver.rheology_solver),
     )
     return newton.solvers.SolverImplicitMPM(sand_model, config=config)
+
+
+def rheology_solver_arg(name: str) -> str | tuple[str, ...]:
+    """``SolverImplicitMPM.Config.solver`` from ``MpmSolverCfg.rheology_solver``: ``"cr,gs"`` -> ``("cr", "gs")``."""
+    parts = tuple(p.strip() for p in name.split(",") if p.strip())
+    if not parts:
+        raise ValueError(f"rheology_solver={name!r}: name a solver (e.g. 'auto', 'gs', 'cr,gs')")
+    return parts[0] if len(parts) == 1 else parts
 
 
 def make_coupled_states(newton: Any, wp: Any, model: Any, sand_model: Any) -> CoupledStates:
