@@ -22,3 +22,45 @@ def test_a_frame_that_does_not_divide_the_policy_step_is_refused(
     with pytest.raises(SystemExit):
         _parse(["--out", "x", *argv])
     assert argv[1] in capsys.readouterr().err
+
+
+def test_window_and_solver_flags_reach_the_evaluation_config(monkeypatch: pytest.MonkeyPatch) -> None:
+    """--window-lead, --particles-per-voxel and --rheology-solver end up in the G1EvalCfg that run() gets."""
+    import gmloco.eval.g1_eval_cli as cli
+
+    seen = {}
+
+    def fake_run(cfg):  # noqa: ANN001, ANN202
+        seen["cfg"] = cfg
+        return {}, True
+
+    monkeypatch.setattr(cli, "run", fake_run)
+    cli.main(["--out", "x", "--window-width", "0.6", "--window-lead", "0.0", "--particles-per-voxel", "1",
+              "--rheology-solver", "cr,gs", "--iters", "500"])  # fmt: skip
+    cfg = seen["cfg"]
+    assert (cfg.window.width, cfg.window.lead, cfg.window.particles_per_voxel) == (0.6, 0.0, 1)
+    assert (cfg.solver.rheology_solver, cfg.solver.max_iterations) == ("cr,gs", 500)
+
+
+def test_zero_particles_per_voxel_is_refused(capsys: pytest.CaptureFixture[str]) -> None:
+    """A window without particles would be an evaluation without sand: a usage error."""
+    with pytest.raises(SystemExit):
+        _parse(["--out", "x", "--particles-per-voxel", "0"])
+    assert "--particles-per-voxel 0" in capsys.readouterr().err
+
+
+@pytest.mark.parametrize(("name", "arg"), [("auto", "auto"), ("gs", "gs"), ("cr,gs", ("cr", "gs")),
+                                           (" cg , jacobi , gs ", ("cg", "jacobi", "gs"))])  # fmt: skip
+def test_rheology_solver_names_become_newton_solver_arguments(name: str, arg: object) -> None:
+    """One name stays a string; a comma-separated warm-start sequence becomes Newton's tuple."""
+    from gmloco.eval.mpm.coupled_setup import rheology_solver_arg
+
+    assert rheology_solver_arg(name) == arg
+
+
+def test_an_empty_rheology_solver_is_refused() -> None:
+    """No solver named: a ValueError that says what to write."""
+    from gmloco.eval.mpm.coupled_setup import rheology_solver_arg
+
+    with pytest.raises(ValueError, match="name a solver"):
+        rheology_solver_arg(" , ")
