@@ -14,7 +14,9 @@ def test_frame_dt_and_substeps_reach_the_parsed_arguments() -> None:
     assert a.frame_dt == 0.005 and a.substeps == 1
 
 
-@pytest.mark.parametrize("argv", [["--frame-dt", "0.003"], ["--frame-dt", "0.04"], ["--substeps", "0"]])
+@pytest.mark.parametrize(
+    "argv", [["--frame-dt", "0.003"], ["--frame-dt", "0.04"], ["--substeps", "0"], ["--tolerance", "0"]]
+)
 def test_a_frame_that_does_not_divide_the_policy_step_is_refused(
     argv: list[str], capsys: pytest.CaptureFixture[str]
 ) -> None:
@@ -36,10 +38,10 @@ def test_window_and_solver_flags_reach_the_evaluation_config(monkeypatch: pytest
 
     monkeypatch.setattr(cli, "run", fake_run)
     cli.main(["--out", "x", "--window-width", "0.6", "--window-lead", "0.0", "--particles-per-voxel", "1",
-              "--rheology-solver", "cr,gs", "--iters", "500"])  # fmt: skip
+              "--rheology-solver", "cr,gs", "--iters", "500", "--tolerance", "2e-4"])  # fmt: skip
     cfg = seen["cfg"]
     assert (cfg.window.width, cfg.window.lead, cfg.window.particles_per_voxel) == (0.6, 0.0, 1)
-    assert (cfg.solver.rheology_solver, cfg.solver.max_iterations) == ("cr,gs", 500)
+    assert (cfg.solver.rheology_solver, cfg.solver.max_iterations, cfg.solver.tolerance) == ("cr,gs", 500, 2e-4)
 
 
 def test_zero_particles_per_voxel_is_refused(capsys: pytest.CaptureFixture[str]) -> None:

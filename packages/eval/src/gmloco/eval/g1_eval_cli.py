@@ -41,6 +41,9 @@ def _parse(argv: list[str] | None) -> argparse.Namespace:
         help="MPM frame = coupling period [s]; must divide the 0.02 s policy step (0.01, 0.005, 0.0025)",
     )
     p.add_argument(
+        "--tolerance", type=float, default=_SOLVER.tolerance, help="rheology residual at which a frame's solve stops"
+    )
+    p.add_argument(
         "--rheology-solver",
         default=_SOLVER.rheology_solver,
         help="SolverImplicitMPM rheology solver: auto, gs, jacobi, or a warm-start sequence such as cr,gs",
@@ -67,6 +70,8 @@ def _parse(argv: list[str] | None) -> argparse.Namespace:
         p.error(f"--frame-dt: {problem}")
     if a.particles_per_voxel < 1:
         p.error(f"--particles-per-voxel {a.particles_per_voxel} must be >= 1")
+    if not a.tolerance > 0.0:
+        p.error(f"--tolerance {a.tolerance} must be > 0 (the rheology residual at which a frame's solve stops)")
     if a.substeps < 1:
         p.error(f"--substeps {a.substeps} must be >= 1 (rigid steps per MPM frame)")
     return a
@@ -97,6 +102,7 @@ def main(argv: list[str] | None = None) -> None:
             base.solver,
             voxel_size=a.voxel,
             max_iterations=a.iters,
+            tolerance=a.tolerance,
             frame_dt=a.frame_dt,
             rigid_substeps=a.substeps,
             rheology_solver=a.rheology_solver,
