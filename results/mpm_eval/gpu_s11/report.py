@@ -30,17 +30,6 @@ def load(names: tuple[str, ...]) -> list[dict]:
     return [json.loads(line) for n in names for line in (HERE / "runs" / n / "episodes.jsonl").read_text().splitlines()]
 
 
-def mann_whitney_u(a: np.ndarray, b: np.ndarray) -> tuple[float, float]:
-    """U of ``a`` against ``b`` (pairs a > b, ties half) and the two-sided p-value (normal approximation)."""
-    u = float(sum((x > y) + 0.5 * (x == y) for x in a for y in b))
-    n, m = len(a), len(b)
-    mu, sd = n * m / 2.0, np.sqrt(n * m * (n + m + 1) / 12.0)
-    z = (u - mu) / sd
-    from math import erfc, sqrt
-
-    return u, erfc(abs(z) / sqrt(2.0))
-
-
 def _short(label: str) -> str:
     """'A 3 cm / 250 it, window 1.8 x 1.0 m, bed 30 cm' -> 'A 3 cm/250 it, 1.8x1.0 m, 30 cm'."""
     head, win, bed = label.split(", ")
@@ -54,16 +43,19 @@ def main() -> None:
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
-    ref = np.array([r["alive_s"] for r in load(GROUPS[0][1])])
+    from gmloco.eval.convergence import compare_runs
+
+    ref_rows = load(GROUPS[0][1])
     lines = ["| configuration | episodes | success | alive time median [s] (min-max) | mean sinkage [cm] | "
-             "velocity error [m/s] | sole reached the floor | alive vs A: Mann-Whitney p |",
+             "velocity error [m/s] | sole reached the floor | against A (`gmloco.eval.convergence`) |",
              "|---|---|---|---|---|---|---|---|"]  # fmt: skip
     fig, ax = plt.subplots(1, 2, figsize=(12, 3.8))
     for k, (label, names) in enumerate(GROUPS):
         rows = load(names)
         alive = np.array([r["alive_s"] for r in rows])
         sink = np.array([r["mean_sinkage"] for r in rows])
-        p = "-" if k == 0 else f"{mann_whitney_u(alive, ref)[1]:.3f}"
+        v = None if k == 0 else compare_runs(ref_rows, rows)
+        p = "-" if v is None else f"{v.decision} (time alive p = {v.alive_p:.2g}, sinkage {v.sinkage_rel_diff:+.0%})"
         lines.append(
             f"| {label} | {len(rows)} | {sum(r['success'] for r in rows)} | {np.median(alive):.1f} "
             f"({alive.min():.1f}-{alive.max():.1f}) | {100 * sink.mean():.1f} | "

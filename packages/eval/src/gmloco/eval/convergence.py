@@ -1,0 +1,150 @@
+# SPDX-License-Identifier: Apache-2.0
+"""Convergence check of an MPM setting (issue 9): does a cheaper or finer setting change the walk?
+
+Two ``g1_eval`` runs of the same policy, terrain and command, one at the reference setting and one at the
+candidate (another voxel size, iteration count, window or bed), are compared episode by episode:
+
+* time alive (until the fall, or the episode length): two-sided Mann-Whitney U test (``scipy.stats``);
+* success: two-sided Fisher exact test on the 2 x 2 table of successes;
+* mean sinkage of the lowest sole point: relative difference of the run means.
+
+The candidate is **accepted** when neither test rejects at ``alpha`` and the sinkage differs by at most
+``sinkage_rel_tol``; **rejected** when any of them does; **undecided** when either run has fewer than
+``min_episodes`` episodes (a verdict on a handful of episodes would be noise). Acceptance means "no difference
+that these episodes can detect", so the number of episodes is part of every verdict.
+
+    python -m gmloco.eval.convergence --reference REF_RUN [REF_RUN ...] --candidate RUN [RUN ...]
+        [--out verdict.json]
+
+where each RUN is a ``g1_eval`` output folder (its ``episodes.jsonl``) or the file itself; several runs of one
+setting are pooled.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import math
+from dataclasses import asdict, dataclass
+from pathlib import Path
+from typing import Any, Literal
+
+import numpy as np
+
+__all__ = ["ConvergenceCfg", "Verdict", "compare_runs", "load_episodes", "main"]
+
+Decision = Literal["accepted", "rejected", "undecided"]
+
+
+@dataclass(frozen=True)
+class ConvergenceCfg:
+    """Thresholds of the check."""
+
+    alpha: float = 0.05
+    """Significance level of the time-alive and success tests [-]."""
+    sinkage_rel_tol: float = 0.15
+    """Largest accepted relative difference of the mean sinkage [-]."""
+    min_episodes: int = 8
+    """Fewer episodes in either run: undecided."""
+
+
+@dataclass(frozen=True)
+class Verdict:
+    """Outcome of one comparison; every number the decision used."""
+
+    decision: Decision
+    reasons: tuple[str, ...]
+    episodes: tuple[int, int]
+    alive_median_s: tuple[float, float]
+    alive_p: float
+    success: tuple[int, int]
+    success_p: float
+    sinkage_mean_m: tuple[float, float]
+    sinkage_rel_diff: float
+
+
+def load_episodes(path: str | Path) -> list[dict[str, Any]]:
+    """Episode rows of a ``g1_eval`` run folder or of an ``episodes.jsonl`` file."""
+    p = Path(path)
+    p = p / "episodes.jsonl" if p.is_dir() else p
+    if not p.is_file():
+        raise FileNotFoundError(f"{path}: no episodes.jsonl here; pass a g1_eval output folder or its episodes.jsonl")
+    rows = [json.loads(line) for line in p.read_text().splitlines() if line.strip()]
+    if not rows:
+        raise ValueError(f"{p}: no episodes; run the evaluation first (python -m gmloco.eval.g1_eval_cli)")
+    return rows
+
+
+def _cells(rows: list[dict[str, Any]]) -> set[tuple[str, str, float]]:
+    return {(r["terrain"], r["scenario"], float(r["speed"])) for r in rows}
+
+
+def compare_runs(ref: list[dict[str, Any]], cand: list[dict[str, Any]], cfg: ConvergenceCfg | None = None) -> Verdict:
+    """Compare the candidate setting's episodes with the reference's (see the module docstring).
+
+    Raises:
+        ValueError: The runs score different (terrain, scenario, speed) cells, so they are not the same experiment.
+    """
+    from scipy.stats import fisher_exact, mannwhitneyu
+
+    cfg = cfg or ConvergenceCfg()
+    if _cells(ref) != _cells(cand):
+        raise ValueError(
+            f"the runs cover different (terrain, scenario, speed) cells: {sorted(_cells(ref))} vs "
+            f"{sorted(_cells(cand))}; compare runs of the same policy, terrain and command"
+        )
+    a_ref = np.array([r["alive_s"] for r in ref], dtype=float)
+    a_cand = np.array([r["alive_s"] for r in cand], dtype=float)
+    s_ref, s_cand = sum(bool(r["success"]) for r in ref), sum(bool(r["success"]) for r in cand)
+    k_ref = float(np.nanmean([r["mean_sinkage"] for r in ref]))
+    k_cand = float(np.nanmean([r["mean_sinkage"] for r in cand]))
+    alive_p = float(mannwhitneyu(a_cand, a_ref, alternative="two-sided").pvalue)
+    table = [[s_cand, len(cand) - s_cand], [s_ref, len(ref) - s_ref]]
+    success_p = float(fisher_exact(table, alternative="two-sided").pvalue)  # pyright: ignore[reportAttributeAccessIssue]
+    rel = abs(k_cand - k_ref) / abs(k_ref) if k_ref else math.inf
+    reasons = []
+    if alive_p < cfg.alpha:
+        reasons.append(f"time alive differs (Mann-Whitney p = {alive_p:.3g} < {cfg.alpha})")
+    if success_p < cfg.alpha:
+        reasons.append(f"success differs ({s_cand}/{len(cand)} vs {s_ref}/{len(ref)}, Fisher p = {success_p:.3g})")
+    if rel > cfg.sinkage_rel_tol:
+        reasons.append(f"mean sinkage differs by {rel:.0%} (> {cfg.sinkage_rel_tol:.0%})")
+    decision: Decision = "rejected" if reasons else "accepted"
+    if min(len(ref), len(cand)) < cfg.min_episodes:
+        decision = "undecided"
+        reasons.insert(0, f"too few episodes ({len(cand)} vs {len(ref)}; at least {cfg.min_episodes} each)")
+    return Verdict(decision, tuple(reasons), (len(cand), len(ref)), (float(np.median(a_cand)), float(np.median(a_ref))),
+                   alive_p, (s_cand, s_ref), success_p, (k_cand, k_ref), rel)  # fmt: skip
+
+
+def main(argv: list[str] | None = None) -> Verdict:
+    """Command line: compare two runs, print the verdict, optionally write it as JSON."""
+    p = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    p.add_argument("--reference", nargs="+", required=True, help="g1_eval run folders at the reference setting")
+    p.add_argument("--candidate", nargs="+", required=True, help="g1_eval run folders at the setting under test")
+    p.add_argument("--alpha", type=float, default=ConvergenceCfg.alpha)
+    p.add_argument("--sinkage-rel-tol", type=float, default=ConvergenceCfg.sinkage_rel_tol)
+    p.add_argument("--min-episodes", type=int, default=ConvergenceCfg.min_episodes)
+    p.add_argument("--out", type=Path, default=None, help="write the verdict as JSON here")
+    a = p.parse_args(argv)
+    cfg = ConvergenceCfg(alpha=a.alpha, sinkage_rel_tol=a.sinkage_rel_tol, min_episodes=a.min_episodes)
+    try:
+        ref = [row for path in a.reference for row in load_episodes(path)]
+        cand = [row for path in a.candidate for row in load_episodes(path)]
+        v = compare_runs(ref, cand, cfg)
+    except (FileNotFoundError, ValueError) as exc:
+        p.error(str(exc))
+    print(f"{v.decision}: candidate {v.episodes[0]} episodes vs reference {v.episodes[1]}")
+    print(f"  time alive median {v.alive_median_s[0]:.2f} vs {v.alive_median_s[1]:.2f} s (p = {v.alive_p:.3g})")
+    print(f"  success {v.success[0]}/{v.episodes[0]} vs {v.success[1]}/{v.episodes[1]} (p = {v.success_p:.3g})")
+    print(f"  mean sinkage {100 * v.sinkage_mean_m[0]:.1f} vs {100 * v.sinkage_mean_m[1]:.1f} cm "
+          f"({v.sinkage_rel_diff:.0%})")  # fmt: skip
+    for r in v.reasons:
+        print(f"  - {r}")
+    if a.out is not None:
+        a.out.write_text(json.dumps({"cfg": asdict(cfg), **asdict(v)}, indent=1))
+    return v
+
+
+if __name__ == "__main__":
+    main()

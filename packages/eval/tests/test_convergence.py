@@ -1,0 +1,76 @@
+# SPDX-License-Identifier: Apache-2.0
+"""The MPM setting check: same walks are accepted, a changed walk is rejected, a handful of episodes decides nothing."""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from gmloco.eval.convergence import ConvergenceCfg, compare_runs, load_episodes, main
+
+
+def _rows(alive: np.ndarray, sink: float, success_frac: float, speed: float = 1.0) -> list[dict]:
+    n = len(alive)
+    wins = round(success_frac * n)
+    return [{"terrain": "dry_sand", "scenario": "straight", "speed": speed, "alive_s": float(a),
+             "success": k < wins, "mean_sinkage": sink} for k, a in enumerate(alive)]  # fmt: skip
+
+
+def test_the_same_walk_twice_is_accepted() -> None:
+    """Two draws from one distribution of fall times, equal sinkage and success: accepted."""
+    rng = np.random.default_rng(0)
+    v = compare_runs(_rows(rng.uniform(4, 10, 20), 0.08, 0.3), _rows(rng.uniform(4, 10, 20), 0.082, 0.3))
+    assert v.decision == "accepted" and not v.reasons
+    assert v.episodes == (20, 20)
+
+
+def test_earlier_falls_are_rejected_and_named() -> None:
+    """Falls 3 s earlier at the candidate setting: rejected, the reason names the time alive."""
+    rng = np.random.default_rng(1)
+    v = compare_runs(_rows(rng.uniform(5, 9, 16), 0.08, 0.0), _rows(rng.uniform(2, 6, 16), 0.08, 0.0))
+    assert v.decision == "rejected"
+    assert any("time alive" in r for r in v.reasons)
+
+
+def test_deeper_sinkage_alone_is_rejected() -> None:
+    """Same falls but 30 % more sinkage: rejected on sinkage only."""
+    alive = np.linspace(3, 10, 12)
+    v = compare_runs(_rows(alive, 0.08, 0.25), _rows(alive, 0.104, 0.25))
+    assert v.decision == "rejected" and len(v.reasons) == 1 and "sinkage" in v.reasons[0]
+    assert v.sinkage_rel_diff == pytest.approx(0.3)
+
+
+def test_a_handful_of_episodes_is_undecided() -> None:
+    """Four episodes against sixteen: undecided, whatever the tests say."""
+    alive = np.linspace(3, 10, 16)
+    v = compare_runs(_rows(alive, 0.08, 0.25), _rows(alive[:4], 0.08, 0.25), ConvergenceCfg(min_episodes=8))
+    assert v.decision == "undecided" and "too few episodes" in v.reasons[0]
+
+
+def test_runs_of_different_commands_are_refused() -> None:
+    """1.0 m/s against 1.5 m/s is not a setting comparison: a ValueError that says so."""
+    alive = np.linspace(3, 10, 10)
+    with pytest.raises(ValueError, match="different"):
+        compare_runs(_rows(alive, 0.08, 0.2), _rows(alive, 0.08, 0.2, speed=1.5))
+
+
+def test_command_line_pools_runs_and_writes_the_verdict(tmp_path: Path) -> None:
+    """Two reference folders are pooled; the verdict JSON holds the decision and the episode counts."""
+    alive = np.linspace(3, 10, 10)
+    for name, rows in (("a", _rows(alive, 0.08, 0.2)), ("b", _rows(alive, 0.08, 0.2)), ("c", _rows(alive, 0.08, 0.2))):
+        (tmp_path / name).mkdir()
+        (tmp_path / name / "episodes.jsonl").write_text("".join(json.dumps(r) + "\n" for r in rows))
+    out = tmp_path / "verdict.json"
+    v = main(["--reference", str(tmp_path / "a"), str(tmp_path / "b"), "--candidate", str(tmp_path / "c"),
+              "--out", str(out)])  # fmt: skip
+    assert v.episodes == (10, 20)
+    assert json.loads(out.read_text())["decision"] == "accepted"
+
+
+def test_a_folder_without_episodes_is_a_clear_error(tmp_path: Path) -> None:
+    """No episodes.jsonl: FileNotFoundError naming what to pass."""
+    with pytest.raises(FileNotFoundError, match=r"episodes\.jsonl"):
+        load_episodes(tmp_path)
