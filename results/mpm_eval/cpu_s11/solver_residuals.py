@@ -43,8 +43,14 @@ def run(solver: str, args: argparse.Namespace) -> None:
     cfg = G1MpmSceneCfg(
         terrain=terrain_cfg("dry_sand", depth=0.3),
         window=SandWindowCfg(moving=True, length=1.8, width=0.6, lead=0.2),
-        solver=MpmSolverCfg(voxel_size=args.voxel, frame_dt=0.005, rigid_substeps=1, max_iterations=args.iters,
-                            tolerance=args.tol, rheology_solver=solver),  # fmt: skip
+        solver=MpmSolverCfg(
+            voxel_size=args.voxel,
+            frame_dt=0.005,
+            rigid_substeps=1,
+            max_iterations=args.iters,
+            tolerance=args.tol,
+            rheology_solver=solver,
+        ),
         commands=((1.0, 0.0, 0.0),),
         device="cpu",
     )
