@@ -7,16 +7,19 @@ import math
 import time
 from dataclasses import replace
 from pathlib import Path
+from types import SimpleNamespace
+from typing import ClassVar
 
 import numpy as np
+import pytest
 
 from gmloco.eval.g1_eval import (
     EpisodeSpec,
     G1EvalCfg,
     episode_batches,
     episode_specs,
+    run_cell,
     score_episode,
-    step_frames,
     summarize,
 )
 from gmloco.eval.tables_mpm import table_speeds, table_terrains
@@ -132,36 +135,129 @@ def test_episode_mcap_round_trip(tmp_path: Path) -> None:
     assert lg.metadata.contact_model == "mpm" and lg.metadata.material == "dry_sand"
 
 
-class _FakeScene:
-    """Counts frames; robot 0 falls (pelvis 0.1 m) at ``fall_frame``, robot 1 stays up unless ``both_fall``."""
+class _LaneScene:
+    """Stand-in for ``G1MpmScene`` in ``run_cell``: 4 frames per policy step, one upright robot per lane.
 
-    frames_per_policy = 2
+    The robot of the episode with spec index k tips over (pelvis 0.1 m) at its own policy step ``FALLS[k]``.
+    """
 
-    def __init__(self, fall_frame: int, both_fall: bool = False) -> None:
-        self.frame, self.fall_frame, self.both_fall = 0, fall_frame, both_fall
-        self.z: list[list[float]] = []
+    FALLS: ClassVar[dict[int, int]] = {}
+    made: ClassVar[list[_LaneScene]] = []
+
+    def __init__(self, cfg: object, policy: object) -> None:
+        n = cfg.num_robots  # type: ignore[attr-defined]
+        self.frames_per_policy, self.frame_dt, self.frame, self.n = 4, 0.005, 0, n
+        self.lane_y = np.arange(n) * cfg.lane_spacing  # type: ignore[attr-defined]
+        self.commands = np.array(cfg.commands, dtype=float)  # type: ignore[attr-defined]
+        self.spec = SimpleNamespace(joint_names=["j"], kp=np.ones(1), kd=np.ones(1))
+        self.robot_mass, self.particle_count, self.wall_time, self.frames_per_second = 30.0, 1, 1.0, 1.0
+        self.mpm = SimpleNamespace(check_sparse_grid_rebuild_status=lambda: None)
+        self.lane_episode, self.lane_step = list(range(n)), [0] * n
+        self.resets: list[tuple[list[int], list[int], int]] = []
+        self.base_q: list[np.ndarray] = []
+        self.base_qd: list[np.ndarray] = []
+        self.foot_force: list[np.ndarray] = []
+        self.sinkage: list[np.ndarray] = []
+        self.foot_sinkage: list[np.ndarray] = []
+        self.joint_q: list[np.ndarray] = []
+        self.joint_qd: list[np.ndarray] = []
+        self.target: list[np.ndarray] = []
+        self.action: list[np.ndarray] = []
+        self.eta: list[np.ndarray] = []
+        _LaneScene.made.append(self)
+
+    def capture(self) -> None:
+        pass
 
     def step(self) -> None:
+        if self.frame % self.frames_per_policy == 0:
+            q = np.zeros((self.n, 7))
+            q[:, 6] = 1.0
+            for r in range(self.n):
+                fall = self.FALLS.get(self.lane_episode[r])
+                q[r, 2] = 0.1 if fall is not None and self.lane_step[r] >= fall else 0.7
+                self.lane_step[r] += 1
+            self.base_q.append(q)
+            self.base_qd.append(np.zeros((self.n, 6)))
+            self.foot_force.append(np.full((self.n, 2, 3), 150.0))
+            self.sinkage.append(np.full(self.n, 0.02))
+            self.foot_sinkage.append(np.full((self.n, 2), 0.02))
+            for name in ("joint_q", "joint_qd", "target", "action"):
+                getattr(self, name).append(np.zeros((self.n, 1)))
+            self.eta.append(np.full(self.n, np.nan))
         self.frame += 1
-        down = self.frame >= self.fall_frame
-        self.z.append([0.1 if down else 0.7, 0.1 if down and self.both_fall else 0.7])
 
-    @property
-    def base_q(self) -> np.ndarray:
-        q = np.zeros((len(self.z), 2, 7))
-        q[:, :, 2] = self.z
-        return q
+    def reset_robots(self, robots: list[int], commands: list, seeds: list[int]) -> None:
+        if robots:
+            self.resets.append((list(robots), list(seeds), len(self.base_q)))
+        for r, seed in zip(robots, seeds, strict=True):
+            self.lane_episode[r], self.lane_step[r] = seed - 1, 0
 
 
-def test_step_frames_stops_when_all_fell_and_at_the_time_box() -> None:
-    """All robots down: the batch ends early (True); a passed deadline: abandoned (False) at the next policy step."""
-    cfg = G1EvalCfg()
-    scene = _FakeScene(fall_frame=5, both_fall=True)
-    assert step_frames(scene, 100, cfg) and scene.frame == 5  # the fall lands on a policy step (frame index 4)
-    scene = _FakeScene(fall_frame=5)
-    assert step_frames(scene, 100, cfg) and scene.frame == 100  # one robot still up: runs to the end
-    scene = _FakeScene(fall_frame=1000)
-    assert not step_frames(scene, 100, cfg, deadline=time.perf_counter() - 1.0) and scene.frame == 1
+class _Policy:
+    num_robots = 2
+
+    def reset(self, robots: object = None) -> None:
+        pass
+
+
+def _cell(monkeypatch: pytest.MonkeyPatch, falls: dict[int, int], **kw: object) -> tuple[G1EvalCfg, list[EpisodeSpec]]:
+    import gmloco.eval.mpm.g1_scene as g1_scene
+
+    monkeypatch.setattr(g1_scene, "G1MpmScene", _LaneScene)
+    monkeypatch.setattr(_LaneScene, "FALLS", falls)
+    monkeypatch.setattr(_LaneScene, "made", [])
+    cfg = replace(G1EvalCfg(), num_episodes=5, speeds=(1.0,), episode_s=0.2, robots_per_batch=2, record_mcap=False,
+                  **kw)  # fmt: skip
+    return cfg, episode_specs(cfg)
+
+
+def test_a_fallen_lane_takes_the_next_episode(monkeypatch: pytest.MonkeyPatch) -> None:
+    """5 episodes in 2 lanes of 10 policy steps; episode 0 tips over at its step 3.
+
+    Lane 0: episode 0 ends with the failing sample (rows 0-3), then episodes 2 (rows 4-13) and 4 (14-23); lane 1:
+    episodes 1 (0-9) and 3 (10-19). Each refill passes seed offset index + 1.
+    """
+    cfg, specs = _cell(monkeypatch, {0: 3})
+    logs: list[dict] = []
+    assert run_cell(specs, cfg, _Policy(), logs.append)
+    assert [lg["spec"].index for lg in logs] == [0, 1, 2, 3, 4]
+    assert [len(lg["base_q"]) for lg in logs] == [4, 10, 10, 10, 10]
+    scene = _LaneScene.made[0]
+    assert scene.resets == [([0], [3], 4), ([1], [4], 10), ([0], [5], 14)]
+    rows = [score_episode(lg["spec"], cfg, lg) for lg in logs]
+    assert (rows[0]["reason"], rows[0]["alive_s"]) == ("base_height", 3 * 0.02)
+    assert [r["reason"] for r in rows[1:]] == ["timeout"] * 4  # standing still at a 1 m/s command
+
+
+def test_without_refill_lanes_idle_and_batches_get_their_own_solver(monkeypatch: pytest.MonkeyPatch) -> None:
+    """refill=False: batches of 2, 2, 1 episodes, one scene each, no resets; the run writes all 5 episodes."""
+    cfg, _ = _cell(monkeypatch, {0: 3}, refill=False)
+    monkeypatch.setattr("gmloco.eval.g1_eval.load_policy", lambda path, n=1: _Policy())
+    _, complete = _run_in(cfg, monkeypatch)
+    assert complete and len(_LaneScene.made) == 3 and all(not s.resets for s in _LaneScene.made)
+
+
+def test_the_time_box_keeps_finished_episodes_only(monkeypatch: pytest.MonkeyPatch) -> None:
+    """A deadline already passed: the cell stops at its first check (after one policy step), nothing handed out."""
+    cfg, specs = _cell(monkeypatch, {})
+    logs: list[dict] = []
+    assert not run_cell(specs, cfg, _Policy(), logs.append, deadline=time.perf_counter() - 1.0)
+    assert logs == [] and _LaneScene.made[0].frame == 4  # one policy step, then the check
+
+
+def _run_in(cfg: G1EvalCfg, monkeypatch: pytest.MonkeyPatch) -> tuple[dict, bool]:
+    """``run`` in a temporary folder without tables and figures."""
+    import tempfile
+
+    import gmloco.eval.g1_eval as g1_eval
+
+    monkeypatch.setattr(g1_eval, "_write_outputs", lambda *a, **k: None)
+    with tempfile.TemporaryDirectory() as tmp:
+        summary, complete = g1_eval.run(replace(cfg, out_dir=tmp))
+        lines = (Path(tmp) / "episodes.jsonl").read_text().splitlines()
+    assert len(lines) == cfg.num_episodes
+    return summary, complete
 
 
 def test_transition_course_per_medium(tmp_path: Path) -> None:

@@ -216,3 +216,51 @@ def test_frame_dt_must_divide_the_policy_step(frame_dt: float, ok: bool) -> None
         if POLICY.exists():
             with pytest.raises(ValueError, match="must divide"):
                 G1MpmScene(G1MpmSceneCfg(solver=MpmSolverCfg(frame_dt=frame_dt)), MjlabOnnxPolicy(POLICY))
+
+
+def test_reset_robot_restarts_its_lane_on_fresh_sand() -> None:
+    """Robot 1 of two standing robots reset after 10 frames: a fresh start on fresh sand, robot 0 untouched.
+
+    Start pose at rest, new command, new stress-free grains (another jitter) in its window; robot 0 and its sand
+    keep their state; its new stand sinks as its first one did (within a quarter of the particle spacing).
+    """
+    if not POLICY.exists():
+        pytest.skip(f"no exported policy at {POLICY}")
+    spec = MjlabOnnxPolicy(POLICY).spec
+    cfg = G1MpmSceneCfg(window=SandWindowCfg(moving=True, length=0.9, width=0.6, lead=0.0), num_robots=2,
+                        solver=MpmSolverCfg(voxel_size=0.05, frame_dt=0.01, rigid_substeps=2))  # fmt: skip
+    scene = G1MpmScene(cfg, spec)
+    q_start = scene.state_0.joint_q.numpy().copy()
+    scene.run(10)
+    nq, nd, p = scene.coords_per_robot, scene.dofs_per_robot, scene.window.particles_per_robot
+    q_before, x_before = scene.state_0.joint_q.numpy().copy(), scene.sand_state.particle_q.numpy().copy()
+    assert not np.allclose(q_before[nq:], q_start[nq:])  # it has settled into the sand
+    scene.reset_robots([1], [(0.5, 0.0, 0.0)], [7])
+    q = scene.state_0.joint_q.numpy()
+    np.testing.assert_allclose(q[nq:], q_start[nq:], atol=1e-6)
+    np.testing.assert_array_equal(q[:nq], q_before[:nq])
+    assert not scene.state_0.joint_qd.numpy()[nd:].any() and tuple(scene.commands[1]) == (0.5, 0.0, 0.0)
+    x = scene.sand_state.particle_q.numpy()
+    np.testing.assert_array_equal(x[:p], x_before[:p])
+    assert np.abs(x[p:] - x_before[p:]).max() > 0.1 * scene.window.h  # new grains
+    assert not scene.sand_state.mpm.particle_stress.numpy()[p:].any()
+    scene.run(10)
+    z = np.asarray(scene.sinkage)[:, 1]
+    np.testing.assert_allclose(z[5:], z[:5], atol=0.25 * scene.window.h)  # policy steps 0-4 again after the reset
+
+
+def test_policy_reset_of_one_robot_back_fills_its_history_only() -> None:
+    """After ``reset([1])`` robot 1's history holds its next frame in every slot; robot 0's keeps shifting."""
+    if not POLICY.exists():
+        pytest.skip(f"no exported policy at {POLICY}")
+    pol = MjlabOnnxPolicy(POLICY, num_robots=2)
+    dims = dict(zip(pol.term_names, pol.term_dims, strict=True))
+    frame = lambda v: {n: np.full((2, d), v) for n, d in dims.items()}  # noqa: E731
+    pol.act(frame(1.0))
+    pol.act(frame(2.0))
+    pol.reset([1])
+    pol.act(frame(3.0))
+    assert pol._hist is not None
+    for h, s in zip(pol._hist, pol.term_scale, strict=True):
+        np.testing.assert_allclose(h[1], 3.0 * s)  # back-filled with the new frame
+        np.testing.assert_allclose(h[0, -3:], np.array([[1.0], [2.0], [3.0]]) * s * np.ones_like(h[0, -3:]))

@@ -1,9 +1,10 @@
 # SPDX-License-Identifier: Apache-2.0
 """Episodes of the G1 on MPM sand and their paper metrics (issue 9): batched, resumable, time-boxed, CPU or CUDA.
 
-Episodes of one (terrain, scenario) cell run in batches of ``robots_per_batch`` robots that share one MPM solver,
-each in its own lane on its own sand window (:mod:`gmloco.eval.mpm.window`; moving with the robot, or a static
-bed covering the course). An episode = the robot dropped onto fresh sand in its default pose, a constant command
+The episodes of one (terrain, scenario) cell run in ``robots_per_batch`` lanes of one MPM solver, each robot on
+its own sand window (:mod:`gmloco.eval.mpm.window`; moving with the robot, or a static bed covering the course).
+A lane whose robot fell or whose episode ended starts the cell's next episode at once (``refill``: start pose,
+fresh sand), so a failing policy's episodes cost only the time they last (``run_cell``). An episode = the robot dropped onto fresh sand in its default pose, a constant command
 for ``episode_s``: ``straight`` (v, 0, 0) or ``circle`` (v, 0, v / R). Logged at the policy rate (50 Hz) and scored
 with :mod:`gmloco.eval.metrics.locomotion`:
 
@@ -28,6 +29,7 @@ from __future__ import annotations
 import json
 import math
 import time
+from collections.abc import Callable
 from dataclasses import asdict, dataclass, field, replace
 from pathlib import Path
 from typing import Any, Literal
@@ -48,7 +50,10 @@ from gmloco.eval.metrics.locomotion import (
 from gmloco.eval.mpm.box_scene import MpmSolverCfg
 from gmloco.eval.mpm.window import SandWindowCfg
 
-__all__ = ["EpisodeSpec", "G1EvalCfg", "episode_batches", "episode_specs", "load_policy", "run", "score_episode"]
+__all__ = [
+    "EpisodeSpec", "G1EvalCfg", "episode_batches", "episode_specs", "lane_failed", "load_policy", "run", "run_cell",
+    "score_episode",
+]  # fmt: skip
 
 Scenario = Literal["straight", "circle"]
 
@@ -84,6 +89,9 @@ class G1EvalCfg:
     """Static beds: margin around the commanded path [m]."""
     robots_per_batch: int = 25
     """Robots (lanes) simulated together in one MPM solver."""
+    refill: bool = True
+    """Start a lane's next episode as soon as its robot falls or its episode ends (one solver per cell, episodes
+    of any length share it); False: one solver per batch of ``robots_per_batch`` episodes, lanes idle after."""
     lane_gap: float = 2.0
     """Free space between neighbouring lanes' windows or paths [m] (robots may drift)."""
     cell_capacity_factor: float = 3.0
@@ -167,92 +175,112 @@ def _window_and_lanes(batch: list[EpisodeSpec], cfg: G1EvalCfg) -> tuple[SandWin
     return win, float(size[1]) + cfg.lane_gap
 
 
-def step_frames(scene: Any, frames: int, cfg: G1EvalCfg, deadline: float | None = None, label: str = "") -> bool:
-    """Step ``frames`` frames (or until every robot has fallen); False if ``deadline`` (perf_counter s) passed first.
+def lane_failed(q: np.ndarray, surface_z: float, failure: FailureCfg) -> bool:
+    """The paper's fall rule on one pelvis pose ``q`` = (p, q_xyzw): too low above the sand, or tilted too far."""
+    roll, pitch, _ = quat_wxyz_to_roll_pitch_yaw(np.array([[q[6], q[3], q[4], q[5]]]))[0]
+    return bool(q[2] - surface_z < failure.min_base_height or max(abs(roll), abs(pitch)) > failure.max_tilt)
 
-    Prints a progress line to stderr about every 30 s: frames done, frames/s, robots still up.
+
+def run_cell(
+    specs: list[EpisodeSpec],
+    cfg: G1EvalCfg,
+    policy: Any,
+    on_episode: Callable[[dict[str, Any]], None],
+    deadline: float | None = None,
+    label: str = "",
+) -> bool:
+    """Simulate the episodes of one (terrain, scenario) cell in lanes of one MPM solver; False at the deadline.
+
+    ``min(robots_per_batch, len(specs))`` robots start together, one per lane. A lane's episode ends when its
+    robot falls (``lane_failed``, checked at every policy step) or after ``episode_s``; its log (policy rate, up
+    to and including the failing sample) goes to ``on_episode`` at once. With ``cfg.refill`` the lane then starts
+    the next episode of ``specs`` (``G1MpmScene.reset_robots``: start pose, fresh sand); else it stays idle. The
+    cell ends when every lane is idle. At ``deadline`` (``time.perf_counter`` s) the episodes still running are
+    dropped, those finished before are already out. A progress line goes to stderr about every 30 s.
     """
     import sys
 
-    k = scene.frames_per_policy
-    t_start = last = time.perf_counter()
-    fallen: np.ndarray | None = None
-    seen = 0  # policy-step rows of scene.base_q already checked for falls
-    for f in range(frames):
-        scene.step()
-        if f % k:
-            continue
-        now = time.perf_counter()
-        if deadline is not None and now > deadline:
-            print(f"{label}: time box reached at frame {f + 1}/{frames}; batch abandoned", file=sys.stderr, flush=True)
-            return False
-        for q in scene.base_q[seen:]:
-            low = np.asarray(q)[:, 2] < cfg.failure.min_base_height
-            fallen = low if fallen is None else fallen | low
-        seen = len(scene.base_q)
-        if fallen is not None and fallen.all():
-            break  # every robot has fallen: the rest cannot change any outcome
-        if now - last > 30.0 and fallen is not None:
-            rate = (f + 1) / (now - t_start)
-            print(f"{label}: frame {f + 1}/{frames}, {rate:.1f} frames/s, {int((~fallen).sum())}/{fallen.size} robots up",
-                  file=sys.stderr, flush=True)  # fmt: skip
-            last = now
-    return True
-
-
-def run_batch(
-    batch: list[EpisodeSpec], cfg: G1EvalCfg, policy: Any, deadline: float | None = None, label: str = ""
-) -> list[dict[str, Any]] | None:
-    """Simulate a batch of episodes together; return one log per episode (policy rate) with the batch's timings.
-
-    None when ``deadline`` (``time.perf_counter`` s) passes before the batch ends: its episodes are not kept.
-    """
     from gmloco.eval.mpm.g1_scene import G1MpmScene, G1MpmSceneCfg
     from gmloco.eval.mpm.window_terrain import terrain_cfg, terrain_surface_height
 
     t0 = time.perf_counter()
-    terrain = terrain_cfg(batch[0].terrain, depth=cfg.bed_depth)
-    window, lane = _window_and_lanes(batch, cfg)
-    n = len(batch)
+    terrain = terrain_cfg(specs[0].terrain, depth=cfg.bed_depth)
+    n = min(cfg.robots_per_batch, len(specs))
+    lane_spec, queue = list(specs[:n]), list(specs[n:]) if cfg.refill else []
+    window, lane = _window_and_lanes(specs, cfg)
     solver = cfg.solver
     if cfg.cell_capacity_factor > 0 and solver.grid_type != "dense":
         per_cell = window.particles_per_voxel**3
         est = _window_particles(window, terrain.depth, solver.voxel_size) * n
         solver = replace(solver, max_active_cell_count=int(cfg.cell_capacity_factor * est / per_cell) + 64)
     scene_cfg = G1MpmSceneCfg(terrain=terrain, window=window, num_robots=n, lane_spacing=lane, solver=solver,
-                              commands=tuple(command(s, cfg) for s in batch),
-                              seed=cfg.seed * 100_003 + batch[0].index, device=cfg.device)  # fmt: skip
+                              commands=tuple(command(s, cfg) for s in lane_spec),
+                              seed=cfg.seed * 100_003 + specs[0].index, device=cfg.device)  # fmt: skip
     if hasattr(policy, "num_robots") and policy.num_robots != n:
         policy = load_policy(cfg.policy_path, n)
     policy.reset()
     scene = G1MpmScene(scene_cfg, policy)
     scene.capture()
     build_s = time.perf_counter() - t0
-    frames = round(cfg.episode_s / scene.frame_dt)
     k = scene.frames_per_policy
-    if not step_frames(scene, frames, cfg, deadline, label):
-        return None
+    steps = round(cfg.episode_s / (scene.frame_dt * k))
+    start, active, done = [0] * n, [True] * n, 0
+    last = time.perf_counter()
+    while True:
+        if scene.frame % k == 0 and scene.base_q:
+            rows = len(scene.base_q)
+            resets = []
+            for r in range(n):
+                if not active[r]:
+                    continue
+                q = scene.base_q[-1][r]
+                surf = float(terrain_surface_height(terrain, np.array(q[0]), np.array(q[1] - scene.lane_y[r])))
+                if rows - start[r] < steps and not lane_failed(q, surf, cfg.failure):
+                    continue
+                on_episode(_lane_log(scene, r, start[r], rows, lane_spec[r], terrain, build_s, n))
+                done += 1
+                if queue:
+                    lane_spec[r], start[r] = queue.pop(0), rows
+                    resets.append(r)
+                else:
+                    active[r] = False
+            scene.reset_robots(resets, [command(lane_spec[r], cfg) for r in resets],
+                               [lane_spec[r].index + 1 for r in resets])  # fmt: skip
+            if not any(active):
+                break
+            now = time.perf_counter()
+            if deadline is not None and now > deadline:
+                print(f"{label}: time box reached with {done}/{len(specs)} episodes done; {sum(active)} running "
+                      "episodes dropped", file=sys.stderr, flush=True)  # fmt: skip
+                return False
+            if now - last > 30.0:
+                print(f"{label}: {done}/{len(specs)} episodes done, {sum(active)} running, "
+                      f"{scene.frames_per_second:.1f} frames/s", file=sys.stderr, flush=True)  # fmt: skip
+                last = now
+        scene.step()
     if solver.max_active_cell_count > 0 and solver.grid_type == "sparse":
         scene.mpm.check_sparse_grid_rebuild_status()
+    return True
+
+
+def _lane_log(
+    scene: Any, r: int, a: int, b: int, spec: EpisodeSpec, terrain: Any, build_s: float, n: int
+) -> dict[str, Any]:
+    """One episode's log: lane ``r``'s policy-rate samples ``a:b`` (``score_episode``'s input)."""
+    from gmloco.eval.mpm.window_terrain import terrain_surface_height
+
     names = ("base_q", "base_qd", "foot_force", "sinkage", "foot_sinkage", "joint_q", "joint_qd", "target", "action",
              "eta")  # fmt: skip
-    arr = {name: np.asarray(getattr(scene, name)) for name in names}
-    logs = []
-    for r, spec in enumerate(batch):
-        q = arr["base_q"][:, r]
-        surf = terrain_surface_height(terrain, q[:, 0], q[:, 1] - scene.lane_y[r])
-        logs.append({
-            "spec": spec, "dt": scene.frame_dt * k, "base_q": q, "base_qd": arr["base_qd"][:, r],
-            "base_height": q[:, 2] - surf, "foot_force": arr["foot_force"][:, r], "sinkage": arr["sinkage"][:, r],
-            "foot_sinkage": arr["foot_sinkage"][:, r], "joint_q": arr["joint_q"][:, r],
-            "joint_qd": arr["joint_qd"][:, r], "target": arr["target"][:, r], "action": arr["action"][:, r],
-            "eta": arr["eta"][:, r], "terrain_cfg": terrain,
-            "command": scene.commands[r], "joint_names": scene.spec.joint_names, "kp": scene.spec.kp,
-            "kd": scene.spec.kd, "start_xy": q[0, :2].copy(), "robot_mass": scene.robot_mass,
-            "particles": scene.particle_count, "batch_size": n, "build_s": build_s, "sim_s": scene.wall_time,
-            "frames": scene.frame, "depth": terrain.depth,
-        })  # fmt: skip
-    return logs
+    arr = {name: np.asarray(getattr(scene, name)[a:b])[:, r] for name in names}
+    q = arr["base_q"]
+    surf = terrain_surface_height(terrain, q[:, 0], q[:, 1] - scene.lane_y[r])
+    return arr | {
+        "spec": spec, "dt": scene.frame_dt * scene.frames_per_policy, "base_height": q[:, 2] - surf,
+        "terrain_cfg": terrain, "command": tuple(float(c) for c in scene.commands[r]),
+        "joint_names": scene.spec.joint_names, "kp": scene.spec.kp, "kd": scene.spec.kd, "start_xy": q[0, :2].copy(),
+        "robot_mass": scene.robot_mass, "particles": scene.particle_count, "batch_size": n, "build_s": build_s,
+        "sim_s": scene.wall_time, "frames": scene.frame, "depth": terrain.depth,
+    }  # fmt: skip
 
 
 def _window_particles(window: SandWindowCfg, depth: float, voxel: float) -> int:
@@ -385,9 +413,9 @@ def _record(log: dict[str, Any], row: dict[str, Any], cfg: G1EvalCfg, out: Path)
 def run(cfg: G1EvalCfg) -> tuple[dict[str, float], bool]:
     """Run (or resume) the evaluation; return (summary metrics, complete).
 
-    Writes ``episodes.jsonl`` after every batch, and ``summary.json``, tables and figures at the end of the call.
-    Stops early when ``max_minutes`` is reached (complete = False) with every finished episode kept; a batch still
-    running then is abandoned, since its episodes are unfinished.
+    Appends each episode to ``episodes.jsonl`` as it finishes, and writes ``summary.json``, tables and figures at
+    the end of the call. Stops early when ``max_minutes`` is reached (complete = False) with every finished episode
+    kept; the episodes still running then are dropped, since they are unfinished.
     """
     out = Path(cfg.out_dir)
     out.mkdir(parents=True, exist_ok=True)
@@ -399,29 +427,31 @@ def run(cfg: G1EvalCfg) -> tuple[dict[str, float], bool]:
     recorded = {f"{r['terrain']}/{r['scenario']}/v{r['speed']:g}" for r in rows}
     todo = [s for s in episode_specs(cfg) if s.key not in done]
     policy = load_policy(cfg.policy_path, min(cfg.robots_per_batch, max(len(todo), 1)))
-    t0, sim_s, complete = time.perf_counter(), 0.0, True
+    t0, complete = time.perf_counter(), True
     deadline = None if cfg.max_minutes is None else t0 + 60.0 * cfg.max_minutes
-    batches = episode_batches(todo, cfg.robots_per_batch)
+    batches = episode_batches(todo, len(todo) if cfg.refill else cfg.robots_per_batch)
+
+    def on_episode(lg: dict[str, Any]) -> None:
+        """Score, record (first episode of a group) and append one finished episode to ``episodes.jsonl``."""
+        row = score_episode(lg["spec"], cfg, lg)
+        if cfg.record_mcap and lg["spec"].group not in recorded:
+            try:
+                _record(lg, row, cfg, out)
+            except ImportError as exc:  # no mcap / foxglove schemas installed: keep the episodes
+                row["recording"] = f"skipped: {exc}"
+            recorded.add(lg["spec"].group)
+        rows.append(row)
+        with log_path.open("a") as f:
+            f.write(json.dumps(row) + "\n")
+
     for i, batch in enumerate(batches):
         if deadline is not None and time.perf_counter() > deadline:
             complete = False
             break
-        logs = run_batch(batch, cfg, policy, deadline, label=f"batch {i + 1}/{len(batches)} ({len(batch)} robots)")
-        if logs is None:  # the time box ended inside the batch: its episodes are unfinished, none is kept
-            complete = False
+        label = f"cell {i + 1}/{len(batches)} ({len(batch)} episodes, {min(len(batch), cfg.robots_per_batch)} lanes)"
+        if not run_cell(batch, cfg, policy, on_episode, deadline, label):
+            complete = False  # the time box ended inside the cell: its running episodes are unfinished, not kept
             break
-        sim_s += logs[0]["build_s"] + logs[0]["sim_s"]
-        new = [score_episode(lg["spec"], cfg, lg) for lg in logs]
-        for lg, row in zip(logs, new, strict=True):
-            if cfg.record_mcap and lg["spec"].group not in recorded:
-                try:
-                    _record(lg, row, cfg, out)
-                except ImportError as exc:  # no mcap / foxglove schemas installed: keep the episodes
-                    row["recording"] = f"skipped: {exc}"
-                recorded.add(lg["spec"].group)
-        rows += new
-        with log_path.open("a") as f:
-            f.writelines(json.dumps(r) + "\n" for r in new)
     summary = summarize(rows)
     wall = time.perf_counter() - t0
     summary["throughput/episodes_this_call"] = float(len(rows) - len(done))

@@ -51,6 +51,9 @@ def _parse(argv: list[str] | None) -> argparse.Namespace:
     p.add_argument("--substeps", type=int, default=_SOLVER.rigid_substeps, help="rigid steps per frame")
     p.add_argument("--bed-depth", type=float, default=G1EvalCfg.bed_depth, help="sand depth of flat / rough beds [m]")
     p.add_argument("--robots-per-batch", type=int, default=25)
+    p.add_argument(
+        "--no-refill", action="store_true", help="one solver per batch of robots, lanes idle after their episode"
+    )
     p.add_argument("--static-bed", action="store_true", help="naive baseline: a bed covering the course")
     p.add_argument("--window-length", type=float, default=1.8)
     p.add_argument("--window-width", type=float, default=1.0)
@@ -98,6 +101,7 @@ def main(argv: list[str] | None = None) -> None:
             particles_per_voxel=a.particles_per_voxel,
         ),
         robots_per_batch=a.robots_per_batch,
+        refill=not a.no_refill,
         solver=replace(
             base.solver,
             voxel_size=a.voxel,

@@ -8,6 +8,7 @@ frame of observation terms per robot, ``{name: [num_robots, dim]}``, and return 
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
@@ -82,10 +83,14 @@ class MjlabOnnxPolicy:
         self.input_name = self.session.get_inputs()[0].name
         self.num_robots = num_robots
         self._hist: list[np.ndarray] | None = None
+        self._fresh: list[int] = []
 
-    def reset(self) -> None:
-        """Forget the histories (the next frame is back-filled, as mjlab does after a reset)."""
-        self._hist = None
+    def reset(self, robots: Sequence[int] | None = None) -> None:
+        """Forget the histories of ``robots`` (all if None); their next frame is back-filled, as mjlab does."""
+        if robots is None:
+            self._hist, self._fresh = None, []
+        else:
+            self._fresh = sorted(set(self._fresh) | {int(r) for r in robots})
 
     def act(self, terms: dict[str, np.ndarray]) -> np.ndarray:
         """Push one frame of observation terms ``{name: [R, dim]}`` and return the actions [R, A]."""
@@ -99,6 +104,9 @@ class MjlabOnnxPolicy:
             self._hist = [
                 np.concatenate([b[:, 1:], f[:, None]], axis=1) for b, f in zip(self._hist, frames, strict=True)
             ]
+            for b, f in zip(self._hist, frames, strict=True):
+                b[self._fresh] = f[self._fresh, None]
+        self._fresh = []
         obs = np.concatenate([b.reshape(self.num_robots, -1) for b in self._hist], axis=1).astype(np.float32)
         return np.asarray(self.session.run(None, {self.input_name: obs})[0])
 
@@ -126,9 +134,9 @@ class StudentOnnxPolicy:
             policy_dt=float(meta.policy_dt),
         )
 
-    def reset(self) -> None:
-        """Forget the histories."""
-        self.runner.reset()
+    def reset(self, robots: Sequence[int] | None = None) -> None:
+        """Forget the histories of ``robots`` (all if None)."""
+        self.runner.reset(None if robots is None else list(robots))
 
     def act(self, terms: dict[str, np.ndarray]) -> np.ndarray:
         """Clip, scale and concatenate the terms ``{name: [R, dim]}`` into o_t; return the actions [R, A]."""

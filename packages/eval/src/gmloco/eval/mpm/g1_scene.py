@@ -233,6 +233,7 @@ class G1MpmScene:
         model.joint_armature.assign(armature)
         model.joint_q.assign(q)
         self._drop_onto_surface(newton, model, q)
+        self._q_init = q.copy()  # every robot's start: default pose, dropped onto the sand (reset_robots)
         return model
 
     def _assemble(self, newton: Any, wp: Any, walls: list[np.ndarray] | None = None) -> Any:
@@ -397,6 +398,44 @@ class G1MpmScene:
         if eta is None:
             return np.full(len(self.lane_y), np.nan)
         return np.asarray(eta, dtype=np.float64).reshape(len(self.lane_y), -1)[:, 0]
+
+    def reset_robots(self, robots: list[int], commands: list[tuple[float, float, float]], seeds: list[int]) -> None:
+        """Start a new episode in each lane of ``robots``: start pose, at rest, new command, fresh sand.
+
+        The robot goes back to its start pose at rest with its new command, its sand window is refilled with
+        fresh sand (jitter seed offsets ``seeds``) and its policy history is forgotten. Call it between frames, right before a policy step (``frame % frames_per_policy == 0``): the next
+        :meth:`step` logs the new episode's first sample. Other robots are untouched.
+        """
+        import newton
+        import warp as wp
+
+        if not robots:
+            return
+        if not (len(robots) == len(commands) == len(seeds)):
+            raise ValueError(f"reset_robots: {len(robots)} robots, {len(commands)} commands, {len(seeds)} seeds")
+        nq, nd = self.coords_per_robot, self.dofs_per_robot
+        for st in (self.state_0, self.state_1):
+            q, qd = st.joint_q.numpy(), st.joint_qd.numpy()
+            for r in robots:
+                q[r * nq : (r + 1) * nq] = self._q_init[r * nq : (r + 1) * nq]
+                qd[r * nd : (r + 1) * nd] = 0.0
+            st.joint_q.assign(q)
+            st.joint_qd.assign(qd)
+            newton.eval_fk(self.model, st.joint_q, st.joint_qd, st,
+                           indices=wp.array(robots, dtype=int, device=self.device))  # fmt: skip
+        nb = self.bodies_per_robot
+        wrench = self.sand_wrench.numpy()
+        targets = self.targets.numpy()
+        for r, cmd in zip(robots, commands, strict=True):
+            wrench[r * nb : (r + 1) * nb] = 0.0
+            targets[r] = self.spec.default_joint_pos
+            self.last_action[r] = 0.0
+            self.commands[r] = cmd
+        self.sand_wrench.assign(wrench)
+        self.targets.assign(targets)
+        if self.policy is not None:
+            self.policy.reset(robots)
+        self.window.reseed_lanes(list(robots), list(seeds), self.state_0.body_q)
 
     # -- stepping -------------------------------------------------------------------------------------------
 

@@ -37,6 +37,8 @@ class WindowArrays:
     """Window centre left of the pelvis heading [m]."""
     seed: int
     """Jitter seed."""
+    lane_seed: wp.array[int]
+    """Jitter seed offset of each robot's current episode (0 for the first), [R]: a refilled lane gets new grains."""
     jitter: float
     """Jitter as a fraction of the spacing [-]."""
     bodies_per_robot: int
@@ -148,7 +150,7 @@ def _window_recycle(
     column_out[p] = col
     # a fresh, cell-centred, jittered lattice position in the new column (the jitter depends on the column,
     # so a column re-entering the window gets new grains)
-    rng = wp.rand_init(w.seed, p * 7919 + col[0] * 104729 + col[1] * 1299709)
+    rng = wp.rand_init(w.seed + w.lane_seed[r] * 15485863, p * 7919 + col[0] * 104729 + col[1] * 1299709)
     x = (float(col[0]) + 0.5 + w.jitter * (wp.randf(rng) - 0.5)) * w.h
     y_lane = (float(col[1]) + 0.5 + w.jitter * (wp.randf(rng) - 0.5)) * w.h
     hz = (surface_z(w, x, y_lane) + w.depth) / float(w.nz)

@@ -88,6 +88,7 @@ class SandWindow:
         w.offset_y = float(self.cfg.offset_y)
         w.bodies_per_robot = int(self.bodies_per_robot)
         w.lane_y = wp.array(self.lane_y.astype(np.float32), dtype=float, device=device)
+        w.lane_seed = wp.zeros(self.num_robots, dtype=int, device=device)
         w.rough_amplitude = float(t.rough_amplitude)
         w.rough_k = float(2.0 * math.pi / t.rough_wavelength)
         w.layer_start, w.layer_length = float(t.layer_start), float(t.layer_length)
@@ -133,7 +134,32 @@ class SandWindow:
 
         if not self.cfg.moving:
             return
-        eval_window_origin(self.arrays, True, body_q, self.origin)
+        eval_window_origin(self.arrays, self.cfg.moving, body_q, self.origin)
+        eval_window_recycle(self.arrays, self.origin, self.column, self._state_arrays, self._model_arrays)
+
+    def reseed_lanes(self, lanes: list[int], seeds: list[int], body_q: Any) -> None:
+        """Fill the windows of ``lanes`` with fresh, stress-free sand (a new episode there); other lanes keep theirs.
+
+        Moving windows are recentred on the robots' poses ``body_q`` (as every frame does); static beds keep their
+        place. ``seeds`` are jitter seed offsets, so a refilled lane gets new grains. Needs :meth:`bind`; runs
+        outside a captured frame (host copies).
+        """
+        import warp as wp
+
+        from gmloco.eval.mpm.kernels_window import eval_window_origin, eval_window_recycle
+
+        if len(lanes) != len(seeds):
+            raise ValueError(f"reseed_lanes: {len(lanes)} lanes but {len(seeds)} seeds")
+        lane_seed = self.arrays.lane_seed.numpy()
+        column = self.column.numpy()
+        for r, sd in zip(lanes, seeds, strict=True):
+            if not 0 <= r < self.num_robots:
+                raise ValueError(f"reseed_lanes: lane {r} outside 0..{self.num_robots - 1}")
+            lane_seed[r] = sd
+            column[r * self.particles_per_robot : (r + 1) * self.particles_per_robot] = _UNSEEDED
+        self.arrays.lane_seed.assign(lane_seed)
+        self.column.assign(wp.array(column, dtype=wp.vec2i, device=self.column.device))
+        eval_window_origin(self.arrays, self.cfg.moving, body_q, self.origin)
         eval_window_recycle(self.arrays, self.origin, self.column, self._state_arrays, self._model_arrays)
 
     def wall_boxes(self, thickness: float, height: float) -> list[tuple[tuple[float, ...], tuple[float, ...]]]:
