@@ -2,7 +2,7 @@
 """Command line of the MPM evaluation without Hydra (the GPU machine): ``python -m gmloco.eval.g1_eval_cli``.
 
     python -m gmloco.eval.g1_eval_cli --out results/mpm_eval/ppo_rft3d --terrains dry_sand --num-episodes 100
-        --robots-per-batch 50 --voxel 0.05 --max-minutes 8.5
+        --robots-per-batch 32 --max-minutes 8.5
 
 Time-boxed and resumable (rerun with the same ``--out``); prints the summary metrics as JSON.
 """
@@ -21,6 +21,8 @@ __all__ = ["main"]
 
 _SOLVER = G1EvalCfg().solver
 """The evaluation's default MPM numerics (the command line's defaults)."""
+_WINDOW = G1EvalCfg().window
+"""The evaluation's default sand window."""
 
 
 def _parse(argv: list[str] | None) -> argparse.Namespace:
@@ -32,7 +34,7 @@ def _parse(argv: list[str] | None) -> argparse.Namespace:
     p.add_argument("--speeds", type=float, nargs="+", default=[1.0, 1.5, 2.0, 2.5])
     p.add_argument("--num-episodes", type=int, default=100)
     p.add_argument("--episode-s", type=float, default=10.0)
-    p.add_argument("--voxel", type=float, default=0.05)
+    p.add_argument("--voxel", type=float, default=_SOLVER.voxel_size, help="MPM voxel size [m]")
     p.add_argument("--iters", type=int, default=_SOLVER.max_iterations, help="rheology iterations")
     p.add_argument(
         "--frame-dt",
@@ -50,13 +52,13 @@ def _parse(argv: list[str] | None) -> argparse.Namespace:
     )
     p.add_argument("--substeps", type=int, default=_SOLVER.rigid_substeps, help="rigid steps per frame")
     p.add_argument("--bed-depth", type=float, default=G1EvalCfg.bed_depth, help="sand depth of flat / rough beds [m]")
-    p.add_argument("--robots-per-batch", type=int, default=25)
+    p.add_argument("--robots-per-batch", type=int, default=G1EvalCfg.robots_per_batch)
     p.add_argument(
         "--no-refill", action="store_true", help="one solver per batch of robots, lanes idle after their episode"
     )
     p.add_argument("--static-bed", action="store_true", help="naive baseline: a bed covering the course")
-    p.add_argument("--window-length", type=float, default=1.8)
-    p.add_argument("--window-width", type=float, default=1.0)
+    p.add_argument("--window-length", type=float, default=_WINDOW.length)
+    p.add_argument("--window-width", type=float, default=_WINDOW.width)
     p.add_argument(
         "--window-lead", type=float, default=SandWindowCfg.lead, help="window centre ahead of the pelvis [m]"
     )
