@@ -1,0 +1,55 @@
+# SPDX-License-Identifier: Apache-2.0
+"""The td student's walk at 5 cm against the rheology iteration count (CPU): table and figure.
+
+    uv run python results/mpm_eval/cpu_s11/iteration_series.py   ->  iteration_series.md, fig_iteration_series.png
+
+Session 10's CPU walks at 50 / 100 / 250 iterations (``../gpu_s10/probe_td_cpu.jsonl``, 10 s) and this session's
+at 500 and 1000 (``probe_iters_cpu_i*.jsonl``, 5 s), all ``policy_probe.py --window eval --vx 1.0 --voxel 0.05
+--frame-dt 0.005 --substeps 1 --handover predict --depth 0.3`` with the it-672 td student; the rows and the figure
+come from ``../gpu_s10/probe_table.py`` (same columns: fall, speed, stance depth, swing apex / lift).
+"""
+
+from __future__ import annotations
+
+import contextlib
+import importlib.util
+import io
+from pathlib import Path
+
+HERE = Path(__file__).resolve().parent
+SERIES = {  # label -> record file
+    "student_td_B_v5_i50_dt0.005_sub1_10s_cpu": HERE.parent / "gpu_s10/probe_td_cpu.jsonl",
+    "student_td_B_v5_i100_dt0.005_sub1_10s_cpu": HERE.parent / "gpu_s10/probe_td_cpu.jsonl",
+    "student_td_B_v5_i250_dt0.005_sub1_10s_cpu": HERE.parent / "gpu_s10/probe_td_cpu.jsonl",
+    "student_td_B_v5_i500_dt0.005_sub1_5s_cpu": HERE / "probe_iters_cpu_i500.jsonl",
+    "student_td_B_v5_i1000_dt0.005_sub1_5s_cpu": HERE / "probe_iters_cpu_i1000.jsonl",
+}
+
+
+def main() -> None:
+    """Print and write the table, draw the figure (records that do not exist yet are left out)."""
+    spec = importlib.util.spec_from_file_location("probe_table_s10", HERE.parent / "gpu_s10/probe_table.py")
+    assert spec is not None and spec.loader is not None
+    pt = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(pt)
+    runs = {label: (path, "td student, it 672, CPU") for label, path in SERIES.items() if path.exists()}
+    runs = {k: v for k, v in runs.items() if k in path_labels(v[0])}
+    pt.RUNS.clear()
+    pt.RUNS.update(runs)
+    buf = io.StringIO()
+    with contextlib.redirect_stdout(buf):
+        pt.table()
+    (HERE / "iteration_series.md").write_text(buf.getvalue())
+    print(buf.getvalue())
+    pt.figure(HERE / "fig_iteration_series.png", tuple(runs), title="td student, 5 cm voxels, CPU", numerics=True)
+
+
+def path_labels(path: Path) -> set[str]:
+    """Labels recorded in a probe file."""
+    import json
+
+    return {json.loads(line)["label"] for line in path.read_text().splitlines() if line.strip()}
+
+
+if __name__ == "__main__":
+    main()
