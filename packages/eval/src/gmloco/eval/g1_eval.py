@@ -102,7 +102,8 @@ class G1EvalCfg:
     )
     """MPM numerics: 3 cm voxels, 5 ms frames (200 Hz coupling) and up to 1000 rheology iterations. The solve stops
     at its tolerance, and a frame of a G1 walk needs ~600 (``results/mpm_eval/cpu_s11``); 250 leaves the sand too
-    soft. The convergence check has not accepted a setting yet (``docs/mpm_eval.md``). CPU smoke: ``smoke_cfg``."""
+    soft. The convergence check has not accepted a setting yet (``docs/mpm_eval.md``); the pipeline's smoke scale uses
+    5 cm / 50 iterations / 10 ms frames (``conf/scale/smoke.yaml``)."""
     failure: FailureCfg = field(default_factory=FailureCfg)
     """Failure rules."""
     record_mcap: bool = True
@@ -486,11 +487,3 @@ def _write_outputs(out: Path, cfg: G1EvalCfg, rows: list[dict[str, Any]], summar
 
 def _jsonable(obj: Any) -> Any:
     return json.loads(json.dumps(obj, default=str))
-
-
-def smoke_cfg(out_dir: str, policy_path: str) -> G1EvalCfg:
-    """CPU smoke: one 1 s straight episode at 1 m/s on a 5 cm-voxel moving window over 15 cm of sand."""
-    return replace(G1EvalCfg(), out_dir=out_dir, policy_path=policy_path, num_episodes=1, speeds=(1.0,),
-                   episode_s=1.0, solver=MpmSolverCfg(voxel_size=0.05, frame_dt=0.01, rigid_substeps=2),
-                   bed_depth=0.15, robots_per_batch=1,
-                   window=SandWindowCfg(length=1.0, width=0.6))  # fmt: skip
