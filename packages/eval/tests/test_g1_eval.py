@@ -299,3 +299,20 @@ def test_transition_course_per_medium(tmp_path: Path) -> None:
         EpisodeSpec("dry_sand", "straight", 1.2, 0), cfg, flat_log | {"terrain_cfg": terrain_cfg("dry_sand")}
     )
     assert flat["layers"] is None and table_transition([flat]) == []
+
+
+def test_episodes_are_read_up_to_a_partial_last_line(tmp_path: Path) -> None:
+    """A run killed mid-write leaves half a line: skipped (and cut off with repair); damage earlier is an error."""
+    import json
+
+    from gmloco.eval.g1_eval import read_episodes
+
+    path = tmp_path / "episodes.jsonl"
+    path.write_text(json.dumps({"key": "a"}) + "\n" + json.dumps({"key": "b"}) + "\n" + '{"key": "c", "succ')
+    assert [r["key"] for r in read_episodes(path)] == ["a", "b"]
+    assert path.read_text().count("\n") == 2  # untouched without repair
+    assert [r["key"] for r in read_episodes(path, repair=True)] == ["a", "b"]
+    assert path.read_text() == json.dumps({"key": "a"}) + "\n" + json.dumps({"key": "b"}) + "\n"
+    path.write_text('{"key": "a"}\nnot json\n{"key": "b"}\n')
+    with pytest.raises(ValueError, match=r"episodes\.jsonl:2: not an episode record"):
+        read_episodes(path)

@@ -69,7 +69,9 @@ def load_episodes(path: str | Path) -> list[dict[str, Any]]:
     p = p / "episodes.jsonl" if p.is_dir() else p
     if not p.is_file():
         raise FileNotFoundError(f"{path}: no episodes.jsonl here; pass a g1_eval output folder or its episodes.jsonl")
-    rows = [json.loads(line) for line in p.read_text().splitlines() if line.strip()]
+    from gmloco.eval.g1_eval import read_episodes
+
+    rows = read_episodes(p)
     if not rows:
         raise ValueError(f"{p}: no episodes; run the evaluation first (python -m gmloco.eval.g1_eval_cli)")
     return rows

@@ -51,8 +51,8 @@ from gmloco.eval.mpm.box_scene import MpmSolverCfg
 from gmloco.eval.mpm.window import SandWindowCfg
 
 __all__ = [
-    "EpisodeSpec", "G1EvalCfg", "episode_batches", "episode_specs", "lane_failed", "load_policy", "run", "run_cell",
-    "score_episode",
+    "EpisodeSpec", "G1EvalCfg", "episode_batches", "episode_specs", "lane_failed", "load_policy", "read_episodes",
+    "run", "run_cell", "score_episode",
 ]  # fmt: skip
 
 Scenario = Literal["straight", "circle"]
@@ -416,6 +416,34 @@ def _record(log: dict[str, Any], row: dict[str, Any], cfg: G1EvalCfg, out: Path)
                                    "end_reason": "completed" if row["success"] else row["reason"]})  # fmt: skip
 
 
+def read_episodes(path: Path, repair: bool = False) -> list[dict[str, Any]]:
+    """Episode rows of an ``episodes.jsonl``, read up to the damage.
+
+    Episodes are appended one line at a time, so a run killed mid-write can leave a partial last line: it is
+    skipped with a note on stderr (with ``repair``, cut off the file so a resumed run appends after the last whole
+    episode). A damaged line before the last means the file was edited: ValueError naming the line.
+    """
+    import sys
+
+    text = path.read_text()
+    lines = text.splitlines()
+    rows: list[dict[str, Any]] = []
+    for k, line in enumerate(lines):
+        if not line.strip():
+            continue
+        try:
+            rows.append(json.loads(line))
+        except json.JSONDecodeError as exc:
+            if k < len(lines) - 1:
+                raise ValueError(f"{path}:{k + 1}: not an episode record ({exc}); remove the line or rerun with "
+                                 "--fresh") from exc  # fmt: skip
+            print(f"{path}: last line is a partial record (run stopped while writing); it is skipped",
+                  file=sys.stderr)  # fmt: skip
+            if repair:
+                path.write_text("".join(f"{good}\n" for good in lines[:k]))
+    return rows
+
+
 def run(cfg: G1EvalCfg) -> tuple[dict[str, float], bool]:
     """Run (or resume) the evaluation; return (summary metrics, complete).
 
@@ -428,7 +456,7 @@ def run(cfg: G1EvalCfg) -> tuple[dict[str, float], bool]:
     log_path = out / "episodes.jsonl"
     if not cfg.resume and log_path.exists():
         log_path.unlink()
-    rows = [json.loads(line) for line in log_path.read_text().splitlines()] if log_path.exists() else []
+    rows = read_episodes(log_path, repair=True) if log_path.exists() else []
     done = {r["key"] for r in rows}
     recorded = {f"{r['terrain']}/{r['scenario']}/v{r['speed']:g}" for r in rows}
     todo = [s for s in episode_specs(cfg) if s.key not in done]
