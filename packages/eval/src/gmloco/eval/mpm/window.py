@@ -134,7 +134,7 @@ class SandWindow:
 
         if not self.cfg.moving:
             return
-        eval_window_origin(self.arrays, self.cfg.moving, body_q, self.origin)
+        eval_window_origin(self.arrays, True, body_q, self.origin)
         eval_window_recycle(self.arrays, self.origin, self.column, self._state_arrays, self._model_arrays)
 
     def reseed_lanes(self, lanes: list[int], seeds: list[int], body_q: Any) -> None:
