@@ -12,11 +12,12 @@ import pytest
 from gmloco.eval.convergence import ConvergenceCfg, compare_runs, load_episodes, main
 
 
-def _rows(alive: np.ndarray, sink: float, success_frac: float, speed: float = 1.0) -> list[dict]:
+def _rows(alive: np.ndarray, sink: float, success_frac: float, speed: float = 1.0, vel: float = 0.2) -> list[dict]:
     n = len(alive)
     wins = round(success_frac * n)
     return [{"terrain": "dry_sand", "scenario": "straight", "speed": speed, "alive_s": float(a),
-             "success": k < wins, "mean_sinkage": sink} for k, a in enumerate(alive)]  # fmt: skip
+             "success": k < wins, "mean_sinkage": sink, "vel_error": vel + 0.002 * (k % 5),
+             "yaw_error": 0.5 + 0.01 * (k % 3)} for k, a in enumerate(alive)]  # fmt: skip
 
 
 def test_the_same_walk_twice_is_accepted() -> None:
@@ -41,6 +42,24 @@ def test_deeper_sinkage_alone_is_rejected() -> None:
     v = compare_runs(_rows(alive, 0.08, 0.25), _rows(alive, 0.104, 0.25))
     assert v.decision == "rejected" and len(v.reasons) == 1 and "sinkage" in v.reasons[0]
     assert v.sinkage_rel_diff == pytest.approx(0.3)
+
+
+def test_worse_velocity_tracking_alone_is_rejected() -> None:
+    """Same falls and sinkage, velocity error 0.30 instead of 0.20 m/s (a table metric): rejected on it alone."""
+    alive = np.full(8, 5.0)
+    v = compare_runs(_rows(alive, 0.045, 1.0), _rows(alive, 0.045, 1.0, vel=0.3))
+    assert v.decision == "rejected" and len(v.reasons) == 1 and "velocity tracking" in v.reasons[0]
+    assert v.vel_error_median[0] > v.vel_error_median[1]
+    assert v.yaw_error_p == pytest.approx(1.0)
+
+
+def test_episodes_without_a_tracking_error_are_left_out() -> None:
+    """``vel_error`` None (no measured motion) drops that episode from the velocity test only."""
+    alive = np.linspace(3, 10, 10)
+    cand = _rows(alive, 0.08, 0.2)
+    cand[0]["vel_error"] = None
+    v = compare_runs(_rows(alive, 0.08, 0.2), cand)
+    assert v.decision == "accepted" and np.isfinite(v.vel_error_median[0])
 
 
 def test_a_handful_of_episodes_is_undecided() -> None:
@@ -74,3 +93,11 @@ def test_a_folder_without_episodes_is_a_clear_error(tmp_path: Path) -> None:
     """No episodes.jsonl: FileNotFoundError naming what to pass."""
     with pytest.raises(FileNotFoundError, match=r"episodes\.jsonl"):
         load_episodes(tmp_path)
+
+
+def test_a_file_that_is_not_an_episodes_file_is_a_clear_error(tmp_path: Path) -> None:
+    """A run's log passed by mistake: ValueError naming what to pass, not a complaint about its first line."""
+    log = tmp_path / "run.log"
+    log.write_text("cell 1/1 ...\n")
+    with pytest.raises(ValueError, match=r"not an episodes file"):
+        load_episodes(log)

@@ -6,9 +6,10 @@ candidate (another voxel size, iteration count, window or bed), are compared epi
 
 * time alive (until the fall, or the episode length): two-sided Mann-Whitney U test (``scipy.stats``);
 * success: two-sided Fisher exact test on the 2 x 2 table of successes;
+* velocity and yaw tracking errors (the tables' metrics, per episode): two-sided Mann-Whitney U tests;
 * mean sinkage of the lowest sole point: relative difference of the run means.
 
-The candidate is **accepted** when neither test rejects at ``alpha`` and the sinkage differs by at most
+The candidate is **accepted** when none of the tests rejects at ``alpha`` and the sinkage differs by at most
 ``sinkage_rel_tol``; **rejected** when any of them does; **undecided** when either run has fewer than
 ``min_episodes`` episodes (a verdict on a handful of episodes would be noise). Acceptance means "no difference
 that these episodes can detect", so the number of episodes is part of every verdict.
@@ -59,6 +60,12 @@ class Verdict:
     alive_p: float
     success: tuple[int, int]
     success_p: float
+    vel_error_median: tuple[float, float]
+    """Median velocity tracking error, candidate and reference [m/s]."""
+    vel_error_p: float
+    yaw_error_median: tuple[float, float]
+    """Median yaw tracking error, candidate and reference [rad] (rad/s for circle commands)."""
+    yaw_error_p: float
     sinkage_mean_m: tuple[float, float]
     sinkage_rel_diff: float
 
@@ -69,6 +76,8 @@ def load_episodes(path: str | Path) -> list[dict[str, Any]]:
     p = p / "episodes.jsonl" if p.is_dir() else p
     if not p.is_file():
         raise FileNotFoundError(f"{path}: no episodes.jsonl here; pass a g1_eval output folder or its episodes.jsonl")
+    if p.suffix != ".jsonl":
+        raise ValueError(f"{path}: not an episodes file (.jsonl); pass a g1_eval output folder or its episodes.jsonl")
     from gmloco.eval.g1_eval import read_episodes
 
     rows = read_episodes(p)
@@ -81,13 +90,27 @@ def _cells(rows: list[dict[str, Any]]) -> set[tuple[str, str, float]]:
     return {(r["terrain"], r["scenario"], float(r["speed"])) for r in rows}
 
 
+def _metric(rows: list[dict[str, Any]], key: str) -> np.ndarray:
+    """One per-episode metric; episodes without it (``None``) are left out."""
+    return np.array([r[key] for r in rows if r.get(key) is not None], dtype=float)
+
+
+def _mw_p(cand: np.ndarray, ref: np.ndarray) -> float:
+    """Two-sided Mann-Whitney p-value; 1.0 where either side is empty (nothing to compare)."""
+    from scipy.stats import mannwhitneyu
+
+    if len(cand) == 0 or len(ref) == 0:
+        return 1.0
+    return float(mannwhitneyu(cand, ref, alternative="two-sided").pvalue)
+
+
 def compare_runs(ref: list[dict[str, Any]], cand: list[dict[str, Any]], cfg: ConvergenceCfg | None = None) -> Verdict:
     """Compare the candidate setting's episodes with the reference's (see the module docstring).
 
     Raises:
         ValueError: The runs score different (terrain, scenario, speed) cells, so they are not the same experiment.
     """
-    from scipy.stats import fisher_exact, mannwhitneyu
+    from scipy.stats import fisher_exact
 
     cfg = cfg or ConvergenceCfg()
     if _cells(ref) != _cells(cand):
@@ -100,7 +123,11 @@ def compare_runs(ref: list[dict[str, Any]], cand: list[dict[str, Any]], cfg: Con
     s_ref, s_cand = sum(bool(r["success"]) for r in ref), sum(bool(r["success"]) for r in cand)
     k_ref = float(np.nanmean([r["mean_sinkage"] for r in ref]))
     k_cand = float(np.nanmean([r["mean_sinkage"] for r in cand]))
-    alive_p = float(mannwhitneyu(a_cand, a_ref, alternative="two-sided").pvalue)
+    alive_p = _mw_p(a_cand, a_ref)
+    tracking = {k: (_metric(cand, k), _metric(ref, k)) for k in ("vel_error", "yaw_error")}
+    track_p = {k: _mw_p(c, r) for k, (c, r) in tracking.items()}
+    track_med = {k: (float(np.median(c)) if len(c) else math.nan, float(np.median(r)) if len(r) else math.nan)
+                 for k, (c, r) in tracking.items()}  # fmt: skip
     table = [[s_cand, len(cand) - s_cand], [s_ref, len(ref) - s_ref]]
     success_p = float(fisher_exact(table, alternative="two-sided").pvalue)  # pyright: ignore[reportAttributeAccessIssue]
     rel = abs(k_cand - k_ref) / abs(k_ref) if k_ref else math.inf
@@ -109,6 +136,10 @@ def compare_runs(ref: list[dict[str, Any]], cand: list[dict[str, Any]], cfg: Con
         reasons.append(f"time alive differs (Mann-Whitney p = {alive_p:.3g} < {cfg.alpha})")
     if success_p < cfg.alpha:
         reasons.append(f"success differs ({s_cand}/{len(cand)} vs {s_ref}/{len(ref)}, Fisher p = {success_p:.3g})")
+    for key, name in (("vel_error", "velocity tracking error"), ("yaw_error", "yaw tracking error")):
+        if track_p[key] < cfg.alpha:
+            c, r = track_med[key]
+            reasons.append(f"{name} differs (median {c:.3g} vs {r:.3g}, Mann-Whitney p = {track_p[key]:.3g})")
     if rel > cfg.sinkage_rel_tol:
         reasons.append(f"mean sinkage differs by {rel:.0%} (> {cfg.sinkage_rel_tol:.0%})")
     decision: Decision = "rejected" if reasons else "accepted"
@@ -116,7 +147,8 @@ def compare_runs(ref: list[dict[str, Any]], cand: list[dict[str, Any]], cfg: Con
         decision = "undecided"
         reasons.insert(0, f"too few episodes ({len(cand)} vs {len(ref)}; at least {cfg.min_episodes} each)")
     return Verdict(decision, tuple(reasons), (len(cand), len(ref)), (float(np.median(a_cand)), float(np.median(a_ref))),
-                   alive_p, (s_cand, s_ref), success_p, (k_cand, k_ref), rel)  # fmt: skip
+                   alive_p, (s_cand, s_ref), success_p, track_med["vel_error"], track_p["vel_error"],
+                   track_med["yaw_error"], track_p["yaw_error"], (k_cand, k_ref), rel)  # fmt: skip
 
 
 def main(argv: list[str] | None = None) -> Verdict:
@@ -139,6 +171,9 @@ def main(argv: list[str] | None = None) -> Verdict:
     print(f"{v.decision}: candidate {v.episodes[0]} episodes vs reference {v.episodes[1]}")
     print(f"  time alive median {v.alive_median_s[0]:.2f} vs {v.alive_median_s[1]:.2f} s (p = {v.alive_p:.3g})")
     print(f"  success {v.success[0]}/{v.episodes[0]} vs {v.success[1]}/{v.episodes[1]} (p = {v.success_p:.3g})")
+    print(f"  velocity error median {v.vel_error_median[0]:.3f} vs {v.vel_error_median[1]:.3f} m/s "
+          f"(p = {v.vel_error_p:.3g}); yaw error {v.yaw_error_median[0]:.3f} vs {v.yaw_error_median[1]:.3f} "
+          f"(p = {v.yaw_error_p:.3g})")  # fmt: skip
     print(f"  mean sinkage {100 * v.sinkage_mean_m[0]:.1f} vs {100 * v.sinkage_mean_m[1]:.1f} cm "
           f"({v.sinkage_rel_diff:.0%})")  # fmt: skip
     for r in v.reasons:
