@@ -1,8 +1,8 @@
 # SPDX-License-Identifier: Apache-2.0
 """The MPM evaluation's paper-shaped tables (markdown + CSV) from the per-episode rows of ``episodes.jsonl``.
 
-* ``table_terrains``: one row per (policy, terrain, scenario): episodes, success rate, velocity and yaw tracking
-  error, DTW path error, mean sinkage, swing apex and lift (GM-Loco's per-terrain and contact-model tables;
+* ``table_terrains``: one row per (policy, terrain, scenario): episodes, success rate with its 95 % Wilson
+  interval, velocity and yaw tracking error, DTW path error, mean sinkage, swing apex and lift (GM-Loco's per-terrain and contact-model tables;
   several policies' ``episodes.jsonl`` concatenated give the ablation rows).
 * ``table_speeds``: success rate per commanded forward speed (rows terrain x scenario).
 * ``table_transition``: on the layered ``transition`` course, per (scenario, medium): episodes that reached the
@@ -19,9 +19,18 @@ from typing import Any
 
 import numpy as np
 
-__all__ = ["TRANSITION_COLUMNS", "table_speeds", "table_terrains", "table_transition", "write_tables"]
+__all__ = [
+    "TRANSITION_COLUMNS",
+    "table_speeds",
+    "table_terrains",
+    "table_transition",
+    "wilson_interval",
+    "write_table",
+    "write_tables",
+]
 
-TERRAIN_COLUMNS = ("policy", "terrain", "scenario", "episodes", "success_rate_pct", "vel_error_mps",
+TERRAIN_COLUMNS = ("policy", "terrain", "scenario", "episodes", "success_rate_pct", "success_lo95_pct",
+                   "success_hi95_pct", "vel_error_mps",
                    "yaw_error_radps", "path_error_m", "mean_sinkage_cm", "swing_apex_cm", "swing_lift_cm")  # fmt: skip
 """Columns of ``table_terrains``."""
 
@@ -30,6 +39,20 @@ def _mean(rows: list[dict[str, Any]], key: str) -> float:
     """Mean of a finite metric over rows (NaN when none)."""
     vals = [float(r[key]) for r in rows if r.get(key) is not None and math.isfinite(float(r[key]))]
     return float(np.mean(vals)) if vals else float("nan")
+
+
+def wilson_interval(successes: int, n: int, z: float = 1.959964) -> tuple[float, float]:
+    """95 % Wilson score interval of a success rate, as fractions (NaN, NaN for no episodes).
+
+    With 100 episodes a rate of 50 % is known to about +-10 points; with 8, 8 of 8 only says "at least 68 %".
+    """
+    if n <= 0:
+        return float("nan"), float("nan")
+    p = successes / n
+    denom = 1.0 + z * z / n
+    centre = (p + z * z / (2 * n)) / denom
+    half = z * math.sqrt(p * (1 - p) / n + z * z / (4 * n * n)) / denom
+    return max(0.0, centre - half), min(1.0, centre + half)
 
 
 def _cells(rows: list[dict[str, Any]]) -> dict[tuple[str, str], list[dict[str, Any]]]:
@@ -44,15 +67,20 @@ def table_terrains(rows: list[dict[str, Any]], policy: str) -> list[list[Any]]:
     """Rows of ``table_terrains`` (``TERRAIN_COLUMNS``), one per (terrain, scenario)."""
     out = []
     for (terrain, scenario), rs in _cells(rows).items():
-        out.append([policy, terrain, scenario, len(rs), 100.0 * _mean(rs, "success"), _mean(rs, "vel_error"),
+        lo, hi = wilson_interval(sum(bool(r["success"]) for r in rs), len(rs))
+        out.append([policy, terrain, scenario, len(rs), 100.0 * _mean(rs, "success"), 100.0 * lo, 100.0 * hi,
+                    _mean(rs, "vel_error"),
                     _mean(rs, "yaw_error"), _mean(rs, "path_error"), 100.0 * _mean(rs, "mean_sinkage"),
                     100.0 * _mean(rs, "swing_apex"), 100.0 * _mean(rs, "swing_lift")])  # fmt: skip
     return out
 
 
-def table_speeds(rows: list[dict[str, Any]]) -> tuple[list[str], list[list[Any]]]:
-    """(header, rows) of the success rate [%] per commanded speed, one row per (terrain, scenario)."""
-    speeds = sorted({float(r["speed"]) for r in rows})
+def table_speeds(rows: list[dict[str, Any]], speeds: list[float] | None = None) -> tuple[list[str], list[list[Any]]]:
+    """(header, rows) of the success rate [%] per commanded speed, one row per (terrain, scenario).
+
+    ``speeds``: the columns (default: the speeds in ``rows``); a speed without episodes in a row is NaN.
+    """
+    speeds = sorted({float(r["speed"]) for r in rows}) if speeds is None else list(speeds)
     header = ["terrain", "scenario", *[f"v={v:g} m/s" for v in speeds]]
     body = []
     for (terrain, scenario), rs in _cells(rows).items():
@@ -84,7 +112,7 @@ def _fmt(x: Any) -> str:
     return str(x)
 
 
-def _write(path: Path, header: list[str] | tuple[str, ...], body: list[list[Any]]) -> list[Path]:
+def write_table(path: Path, header: list[str] | tuple[str, ...], body: list[list[Any]]) -> list[Path]:
     """Write ``<path>.csv`` and ``<path>.md``."""
     with path.with_suffix(".csv").open("w", newline="") as f:
         w = csv.writer(f)
@@ -99,9 +127,9 @@ def _write(path: Path, header: list[str] | tuple[str, ...], body: list[list[Any]
 def write_tables(rows: list[dict[str, Any]], out_dir: str | Path, policy: str) -> list[Path]:
     """Write both tables under ``out_dir``; return their paths."""
     out = Path(out_dir)
-    paths = _write(out / "table_terrains", TERRAIN_COLUMNS, table_terrains(rows, policy))
+    paths = write_table(out / "table_terrains", TERRAIN_COLUMNS, table_terrains(rows, policy))
     header, body = table_speeds(rows)
-    paths += _write(out / "table_speeds", header, body)
+    paths += write_table(out / "table_speeds", header, body)
     if transition := table_transition(rows):
-        paths += _write(out / "table_transition", TRANSITION_COLUMNS, transition)
+        paths += write_table(out / "table_transition", TRANSITION_COLUMNS, transition)
     return paths

@@ -1,0 +1,140 @@
+# SPDX-License-Identifier: Apache-2.0
+"""The paper's MPM tables across policies: several ``g1_eval`` runs, one table (issue 9).
+
+GM-Loco's contact-model ablation and per-terrain tables put several policies side by side. Each policy is scored
+by its own ``g1_eval`` run (often over several machines: a run folder resumes from its ``episodes.jsonl``); this
+tool labels each run's episodes with the policy's name and writes the combined tables:
+
+    python -m gmloco.eval.paper_tables --run td=RUN_DIR --run clr50=RUN_DIR [...] --out DIR [--episodes 100]
+
+* ``table_terrains.{md,csv}``: one row per (policy, terrain, scenario) with the success rate and its 95 % Wilson
+  interval, tracking errors, DTW path error, sinkage and swing (``gmloco.eval.tables_mpm``);
+* ``table_speeds.{md,csv}``: success rate per commanded speed, one row per (policy, terrain, scenario);
+* ``table_transition.{md,csv}`` when a run walked the layered course;
+* ``tables.json``: the runs, their common MPM setting, and which rows are partial.
+
+A table mixes like with like only: runs whose MPM setting (voxel, iterations, frame, bed, window, episode length,
+failure rules) differs are refused, naming the differing fields, unless ``--allow-mixed-settings``. A row with
+fewer than ``--episodes`` episodes says ``no`` in the ``complete`` column (and is listed in ``tables.json``): such a
+row is a measurement, not the paper's 100-episode row.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+from pathlib import Path
+from typing import Any
+
+__all__ = ["SETTING_KEYS", "combine", "main", "setting_of"]
+
+SETTING_KEYS = ("solver", "window", "bed_depth", "episode_s", "failure", "course_slack", "circle_radius")
+"""Fields of a run's ``summary.json`` ``cfg`` that define the experiment; runs in one table must agree on them."""
+
+
+def setting_of(run_dir: Path) -> dict[str, Any]:
+    """The MPM setting of a ``g1_eval`` run (``SETTING_KEYS`` of its ``summary.json`` cfg)."""
+    path = run_dir / "summary.json"
+    if not path.is_file():
+        raise FileNotFoundError(f"{run_dir}: no summary.json; pass a g1_eval output folder (python -m "
+                                "gmloco.eval.g1_eval_cli --out DIR writes it)")  # fmt: skip
+    cfg = json.loads(path.read_text())["cfg"]
+    return {k: cfg.get(k) for k in SETTING_KEYS}
+
+
+def _differences(a: dict[str, Any], b: dict[str, Any], prefix: str = "") -> list[str]:
+    """Dotted names of the fields where two nested settings differ."""
+    out = []
+    for k in sorted(set(a) | set(b)):
+        va, vb = a.get(k), b.get(k)
+        if isinstance(va, dict) and isinstance(vb, dict):
+            out += _differences(va, vb, f"{prefix}{k}.")
+        elif va != vb:
+            out.append(f"{prefix}{k} ({va!r} vs {vb!r})")
+    return out
+
+
+def combine(
+    runs: list[tuple[str, Path]], out_dir: Path, episodes: int = 100, allow_mixed: bool = False
+) -> dict[str, Any]:
+    """Write the combined tables of ``runs`` (label, run folder) under ``out_dir``; return ``tables.json``'s content.
+
+    Raises:
+        ValueError: Two runs differ in their MPM setting (and ``allow_mixed`` is False), a label repeats, or a run
+            holds no episodes.
+    """
+    from gmloco.eval.convergence import load_episodes
+    from gmloco.eval.tables_mpm import (
+        TERRAIN_COLUMNS,
+        TRANSITION_COLUMNS,
+        table_speeds,
+        table_terrains,
+        table_transition,
+        write_table,
+    )
+
+    labels = [label for label, _ in runs]
+    if len(set(labels)) != len(labels):
+        raise ValueError(f"policy labels repeat ({labels}); give each run its own LABEL=DIR")
+    settings = {label: setting_of(d) for label, d in runs}
+    first = labels[0]
+    mixed = {label: diff for label in labels[1:] if (diff := _differences(settings[first], settings[label]))}
+    if mixed and not allow_mixed:
+        lines = "; ".join(f"{label}: {', '.join(diff)}" for label, diff in mixed.items())
+        raise ValueError(f"runs were scored at different MPM settings than {first!r} ({lines}); rerun them at one "
+                         "setting, or pass --allow-mixed-settings to tabulate them anyway")  # fmt: skip
+    loaded = [(label, load_episodes(d)) for label, d in runs]
+    all_speeds = sorted({float(r["speed"]) for _, rows in loaded for r in rows})
+    terrains, speeds, transition, partial = [], [], [], []
+    for label, rows in loaded:
+        for row in table_terrains(rows, label):
+            complete = row[3] >= episodes
+            terrains.append([*row, "yes" if complete else "no"])
+            if not complete:
+                partial.append(f"{label}/{row[1]}/{row[2]}: {row[3]} of {episodes} episodes")
+        speeds += [[label, *r] for r in table_speeds(rows, all_speeds)[1]]
+        transition += [[label, *r] for r in table_transition(rows)]
+    out_dir.mkdir(parents=True, exist_ok=True)
+    write_table(out_dir / "table_terrains", (*TERRAIN_COLUMNS, "complete"), terrains)
+    write_table(out_dir / "table_speeds", ["policy", *table_speeds([], all_speeds)[0]], speeds)
+    if transition:
+        write_table(out_dir / "table_transition", ("policy", *TRANSITION_COLUMNS), transition)
+    summary = {
+        "runs": {label: str(d) for label, d in runs},
+        "setting": settings[first],
+        "mixed_settings": mixed,
+        "episodes_expected": episodes,
+        "partial_rows": partial,
+    }
+    (out_dir / "tables.json").write_text(json.dumps(summary, indent=1) + "\n")
+    return summary
+
+
+def _run_arg(text: str) -> tuple[str, Path]:
+    """``LABEL=DIR`` -> (label, folder)."""
+    label, sep, d = text.partition("=")
+    if not sep or not label or not d:
+        raise argparse.ArgumentTypeError(f"{text!r}: expected LABEL=RUN_DIR, e.g. td=results/mpm_eval/my_run")
+    return label, Path(d)
+
+
+def main(argv: list[str] | None = None) -> dict[str, Any]:
+    """Command line: combine runs into the paper's tables."""
+    p = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    p.add_argument("--run", type=_run_arg, action="append", required=True, help="LABEL=RUN_DIR (repeat per policy)")
+    p.add_argument("--out", type=Path, required=True, help="folder for the tables")
+    p.add_argument("--episodes", type=int, default=100, help="episodes a complete row has (the paper: 100)")
+    p.add_argument("--allow-mixed-settings", action="store_true", help="tabulate runs scored at different settings")
+    a = p.parse_args(argv)
+    try:
+        summary = combine(a.run, a.out, a.episodes, a.allow_mixed_settings)
+    except (FileNotFoundError, ValueError) as exc:
+        p.error(str(exc))
+    print((a.out / "table_terrains.md").read_text(), end="")
+    for row in summary["partial_rows"]:
+        print(f"partial: {row}")
+    return summary
+
+
+if __name__ == "__main__":
+    main()

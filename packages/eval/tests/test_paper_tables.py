@@ -1,0 +1,79 @@
+# SPDX-License-Identifier: Apache-2.0
+"""Combined paper tables: policies side by side, like settings only, partial rows named, the success interval."""
+
+from __future__ import annotations
+
+import csv
+import json
+from pathlib import Path
+
+import pytest
+
+from gmloco.eval.paper_tables import combine, main
+from gmloco.eval.tables_mpm import wilson_interval
+
+SETTING = {"solver": {"voxel_size": 0.03, "max_iterations": 500, "frame_dt": 0.005}, "window": {"length": 1.4},
+           "bed_depth": 0.3, "episode_s": 10.0, "failure": {"max_tilt": 0.785}, "course_slack": 0.2,
+           "circle_radius": 2.0}  # fmt: skip
+
+
+def _run(root: Path, name: str, wins: int, n: int, speeds: tuple[float, ...] = (1.0,), **setting: object) -> Path:
+    """A g1_eval-shaped run folder: ``wins`` successes of ``n`` dry-sand straight episodes."""
+    d = root / name
+    d.mkdir()
+    cfg = json.loads(json.dumps(SETTING)) | setting | {"seed": len(name), "max_minutes": 9.0}
+    (d / "summary.json").write_text(json.dumps({"cfg": cfg}))
+    rows = [{"terrain": "dry_sand", "scenario": "straight", "speed": speeds[k % len(speeds)], "success": k < wins,
+             "alive_s": 10.0, "vel_error": 0.2, "yaw_error": 0.1, "path_error": 0.3, "mean_sinkage": 0.05,
+             "swing_apex": 0.02, "swing_lift": 0.08} for k in range(n)]  # fmt: skip
+    (d / "episodes.jsonl").write_text("".join(json.dumps(r) + "\n" for r in rows))
+    return d
+
+
+def test_wilson_interval_known_values() -> None:
+    """50 of 100: 40.4-59.6 %; 8 of 8: at least 67.6 %; 0 of 10: at most 27.8 % (textbook Wilson values)."""
+    assert wilson_interval(50, 100) == pytest.approx((0.4038, 0.5962), abs=1e-4)
+    assert wilson_interval(8, 8) == pytest.approx((0.6756, 1.0), abs=1e-4)
+    assert wilson_interval(0, 10) == pytest.approx((0.0, 0.2775), abs=1e-4)
+
+
+def test_two_policies_side_by_side_with_partial_rows_named(tmp_path: Path) -> None:
+    """100 episodes of one policy and 8 of another: two rows, the short one marked incomplete."""
+    a, b = _run(tmp_path, "a", 50, 100, speeds=(1.0, 2.0)), _run(tmp_path, "b", 8, 8)
+    summary = combine([("td", a), ("clr50", b)], tmp_path / "out")
+    rows = list(csv.DictReader((tmp_path / "out" / "table_terrains.csv").open()))
+    assert [r["policy"] for r in rows] == ["td", "clr50"]
+    assert float(rows[0]["success_rate_pct"]) == pytest.approx(50.0)
+    assert float(rows[0]["success_lo95_pct"]) == pytest.approx(40.38, abs=0.01)
+    assert [r["complete"] for r in rows] == ["yes", "no"]
+    assert summary["partial_rows"] == ["clr50/dry_sand/straight: 8 of 100 episodes"]
+    speeds = list(csv.DictReader((tmp_path / "out" / "table_speeds.csv").open()))
+    # the union of speeds is the header (td: the first 50 episodes, alternating speeds, won: 50 % each); clr50 ran
+    # no 2 m/s episode: NaN there
+    assert (speeds[0]["v=1 m/s"], speeds[0]["v=2 m/s"], speeds[1]["v=2 m/s"]) == ("50.0", "50.0", "nan")
+
+
+def test_runs_at_different_settings_are_refused_by_name(tmp_path: Path) -> None:
+    """500 vs 250 iterations: a ValueError naming the field; with allow_mixed the difference is recorded."""
+    a = _run(tmp_path, "a", 5, 10)
+    b = _run(tmp_path, "b", 5, 10, solver={"voxel_size": 0.03, "max_iterations": 250, "frame_dt": 0.005})
+    with pytest.raises(ValueError, match=r"solver\.max_iterations \(500 vs 250\)"):
+        combine([("x", a), ("y", b)], tmp_path / "out")
+    summary = combine([("x", a), ("y", b)], tmp_path / "out", allow_mixed=True)
+    assert summary["mixed_settings"]["y"] == ["solver.max_iterations (500 vs 250)"]
+
+
+def test_seeds_and_time_boxes_may_differ(tmp_path: Path) -> None:
+    """Fields outside the setting (seed, max_minutes) do not split a table."""
+    summary = combine([("x", _run(tmp_path, "a", 1, 2)), ("y", _run(tmp_path, "bb", 2, 2))], tmp_path / "o", 2)
+    assert summary["mixed_settings"] == {} and summary["partial_rows"] == []
+
+
+def test_command_line_errors_say_what_to_pass(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    """A --run without LABEL=, a folder without summary.json and a repeated label are usage errors."""
+    run = _run(tmp_path, "a", 1, 2)
+    for argv, msg in ((["--run", str(run)], "LABEL=RUN_DIR"), (["--run", f"x={tmp_path}"], "no summary.json"),
+                      (["--run", f"x={run}", "--run", f"x={run}"], "labels repeat")):  # fmt: skip
+        with pytest.raises(SystemExit):
+            main([*argv, "--out", str(tmp_path / "out")])
+        assert msg in capsys.readouterr().err
