@@ -16,6 +16,7 @@ import pytest
 from gmloco.eval.g1_eval import (
     EpisodeSpec,
     G1EvalCfg,
+    cell_minutes_left,
     episode_batches,
     episode_specs,
     run_cell,
@@ -229,6 +230,15 @@ def test_a_fallen_lane_takes_the_next_episode(monkeypatch: pytest.MonkeyPatch) -
     rows = [score_episode(lg["spec"], cfg, lg) for lg in logs]
     assert (rows[0]["reason"], rows[0]["alive_s"]) == ("base_height", 3 * 0.02)
     assert [r["reason"] for r in rows[1:]] == ["timeout"] * 4  # standing still at a 1 m/s command
+
+
+def test_minutes_left_counts_waves_of_lanes() -> None:
+    """2 lanes with 10 and 40 steps left, 3 queued episodes of 100 steps, 4 frames per step at 2 frames/s.
+
+    Lane A: 10 -> 110 -> 210; lane B: 40 -> 140; the last ends at step 210 = 840 frames = 420 s = 7 min.
+    """
+    assert cell_minutes_left([10, 40], 3, 100, 4, 2.0) == pytest.approx(7.0)
+    assert cell_minutes_left([], 5, 100, 4, 2.0) == 0.0 and cell_minutes_left([1], 0, 100, 4, 0.0) == 0.0
 
 
 def test_without_refill_lanes_idle_and_batches_get_their_own_solver(monkeypatch: pytest.MonkeyPatch) -> None:

@@ -51,7 +51,7 @@ from gmloco.eval.mpm.box_scene import MpmSolverCfg
 from gmloco.eval.mpm.window import SandWindowCfg
 
 __all__ = [
-    "EpisodeSpec", "G1EvalCfg", "episode_batches", "episode_specs", "lane_failed", "load_policy", "read_episodes",
+    "EpisodeSpec", "G1EvalCfg", "cell_minutes_left", "episode_batches", "episode_specs", "lane_failed", "load_policy", "read_episodes",
     "run", "run_cell", "score_episode",
 ]  # fmt: skip
 
@@ -188,6 +188,25 @@ def lane_failed(q: np.ndarray, surface_z: float, failure: FailureCfg) -> bool:
     return bool(q[2] - surface_z < failure.min_base_height or max(abs(roll), abs(pitch)) > failure.max_tilt)
 
 
+def cell_minutes_left(steps_left: list[int], queued: int, steps: int, frames_per_step: int, fps: float) -> float:
+    """Minutes until a cell's last lane ends if no robot falls: its lanes step together at ``fps`` frames/s.
+
+    Args:
+        steps_left: Policy steps still to go of each running episode.
+        queued: Episodes not started yet (each ``steps`` long; a lane takes one as its episode ends).
+        steps: Policy steps of a whole episode.
+        frames_per_step: MPM frames per policy step.
+        fps: Frames per second of the solver (all lanes at once).
+    """
+    if not steps_left or fps <= 0.0:
+        return 0.0
+    ends = sorted(steps_left)
+    for _ in range(queued):  # the lane that frees first takes the next episode
+        ends[0] += steps
+        ends.sort()
+    return ends[-1] * frames_per_step / fps / 60.0
+
+
 def run_cell(
     specs: list[EpisodeSpec],
     cfg: G1EvalCfg,
@@ -261,8 +280,11 @@ def run_cell(
                       "episodes dropped", file=sys.stderr, flush=True)  # fmt: skip
                 return False
             if now - last > 30.0:
+                left = [steps - (rows - start[r]) for r in range(n) if active[r]]
+                eta = cell_minutes_left(left, len(queue), steps, k, scene.frames_per_second)
                 print(f"{label}: {done}/{len(specs)} episodes done, {sum(active)} running, "
-                      f"{scene.frames_per_second:.1f} frames/s", file=sys.stderr, flush=True)  # fmt: skip
+                      f"{scene.frames_per_second:.1f} frames/s, ~{eta:.0f} min left if none falls",
+                      file=sys.stderr, flush=True)  # fmt: skip
                 last = now
         scene.step()
     if solver.max_active_cell_count > 0 and solver.grid_type == "sparse":
