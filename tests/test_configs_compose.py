@@ -80,8 +80,7 @@ def test_smoke_scale_shrinks_the_experiment(compose: Callable[..., DictConfig]) 
 
 
 def test_full_scale_scores_mpm_at_the_accepted_setting(compose: Callable[..., DictConfig]) -> None:
-    """Full scale: the setting the convergence check accepted (3 cm / 500 iterations / 5 ms x 1 step, 30 cm of sand,
-    1.4 x 0.6 m windows); smoke keeps the fast numerics."""
+    """Full scale: the accepted setting (3 cm / 500 it / 5 ms x 1 step, 30 cm, 1.4 x 0.6 m); smoke: fast numerics."""
     full = _instantiate(compose("+exp=gm_loco", "+scale=full")).eval_mpm
     smoke = _instantiate(compose("+exp=gm_loco", "+scale=smoke")).eval_mpm
     assert (full.voxel_size, full.max_iterations, full.frame_dt, full.rigid_substeps) == (0.03, 500, 0.005, 1)
