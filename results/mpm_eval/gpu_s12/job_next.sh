@@ -7,6 +7,7 @@
 # 50 lanes finish their 10 s episodes in ~23 min (H200): one machine scores ~50 episodes. The run folder resumes
 # from its episodes.jsonl: carry it to the second machine (tar it into $OUT at the end of the first; it is small)
 # and run the same command; the episodes in flight at a time box are dropped and rerun, never faked.
+# Poll with poll_next.sh (copy both scripts into ~/src with the launch): it copies the run folder into $OUT each call.
 # Usage (in ~/src, after the wheels and the Warp cache): bash job_next.sh END_EPOCH [RUN_TGZ]
 END=$1
 cd ~/src && source scripts/gpu/env.sh && mkdir -p ~/chunks/g1_eval
