@@ -22,7 +22,7 @@ def _run(root: Path, name: str, wins: int, n: int, speeds: tuple[float, ...] = (
     d = root / name
     d.mkdir()
     cfg = json.loads(json.dumps(SETTING)) | setting | {"seed": len(name), "max_minutes": 9.0}
-    (d / "summary.json").write_text(json.dumps({"cfg": cfg}))
+    (d / "summary.json").write_text(json.dumps({"cfg": cfg, "policy": f"artifacts/{name}/policy.onnx"}))
     rows = [{"terrain": "dry_sand", "scenario": "straight", "speed": speeds[k % len(speeds)], "success": k < wins,
              "alive_s": 10.0, "vel_error": 0.2, "yaw_error": 0.1, "path_error": 0.3, "mean_sinkage": 0.05,
              "swing_apex": 0.02, "swing_lift": 0.08} for k in range(n)]  # fmt: skip
@@ -47,6 +47,7 @@ def test_two_policies_side_by_side_with_partial_rows_named(tmp_path: Path) -> No
     assert float(rows[0]["success_lo95_pct"]) == pytest.approx(40.38, abs=0.01)
     assert [r["complete"] for r in rows] == ["yes", "no"]
     assert summary["partial_rows"] == ["clr50/dry_sand/straight: 8 of 100 episodes"]
+    assert summary["runs"]["clr50"]["policy"] == "artifacts/b/policy.onnx"  # provenance of every row
     speeds = list(csv.DictReader((tmp_path / "out" / "table_speeds.csv").open()))
     # the union of speeds is the header (td: the first 50 episodes, alternating speeds, won: 50 % each); clr50 ran
     # no 2 m/s episode: NaN there

@@ -100,7 +100,10 @@ def combine(
     if transition:
         write_table(out_dir / "table_transition", ("policy", *TRANSITION_COLUMNS), transition)
     summary = {
-        "runs": {label: str(d) for label, d in runs},
+        "runs": {
+            label: {"dir": str(d), "policy": json.loads((d / "summary.json").read_text()).get("policy")}
+            for label, d in runs
+        },
         "setting": settings[first],
         "mixed_settings": mixed,
         "episodes_expected": episodes,
