@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Prepared in session 11 for the next GPU session (issue 9); NOT yet run.
+# Prepared in session 11 for the next GPU session (issue 9); run as is in session 12 on an H100 (results: ../gpu_s12/).
 # The iteration axis of the convergence check at 3 cm, on the accepted window (1.8 x 0.6 m, 30 cm bed), 5 s
 # episodes of the td student at 1.0 m/s, 8 robots per run (one batch each), 5 ms frames, one rigid step:
 #   it250 (reference, Newton's default cap), it500, it1000 (1000 = cap; the captured loop stops at the 1e-4
