@@ -55,7 +55,12 @@ def main() -> None:
         alive = np.array([r["alive_s"] for r in rows])
         sink = np.array([r["mean_sinkage"] for r in rows])
         v = None if k == 0 else compare_runs(ref_rows, rows)
-        p = "-" if v is None else f"{v.decision} (time alive p = {v.alive_p:.2g}, sinkage {v.sinkage_rel_diff:+.0%})"
+        why = "" if v is None or not v.reasons else ": " + "; ".join(r.split(" (")[0] for r in v.reasons)
+        p = (
+            "-"
+            if v is None
+            else f"{v.decision} (time alive p = {v.alive_p:.2g}, sinkage {v.sinkage_rel_diff:+.0%}){why}"
+        )
         lines.append(
             f"| {label} | {len(rows)} | {sum(r['success'] for r in rows)} | {np.median(alive):.1f} "
             f"({alive.min():.1f}-{alive.max():.1f}) | {100 * sink.mean():.1f} | "

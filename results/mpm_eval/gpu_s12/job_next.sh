@@ -2,7 +2,8 @@
 # Prepared in session 12 for the next GPU session (issue 9); NOT yet run.
 # The first 100-episode table row at the accepted setting (the defaults of g1_eval_cli since session 12: 3 cm, 500
 # iterations, 5 ms frames x 1, bed 30 cm, window 1.4 x 0.6 m): the td student on dry sand, straight, speeds cycled
-# 1.0 / 1.5 / 2.0 / 2.5 m/s (25 each), one MCAP recording per speed.
+# 1.0 / 1.5 / 2.0 / 2.5 m/s (25 each), one MCAP recording per speed. Run job_next_checks.sh first: if it rejects
+# the 0.6 m window width against 1.0 m, add --window-width 1.0 below (~1.7x the cells: ~30 lanes per machine).
 # Cost (results/mpm_eval/gpu_s12/README.md): ~73 robot-frames/s on an H200 (~60 on an H100) from ~32 lanes, so
 # 50 lanes finish their 10 s episodes in ~23 min (H200): one machine scores ~50 episodes. The run folder resumes
 # from its episodes.jsonl: carry it to the second machine (tar it into $OUT at the end of the first; it is small)
