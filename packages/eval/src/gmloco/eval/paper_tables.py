@@ -32,14 +32,18 @@ SETTING_KEYS = ("solver", "window", "bed_depth", "episode_s", "failure", "course
 """Fields of a run's ``summary.json`` ``cfg`` that define the experiment; runs in one table must agree on them."""
 
 
-def setting_of(run_dir: Path) -> dict[str, Any]:
-    """The MPM setting of a ``g1_eval`` run (``SETTING_KEYS`` of its ``summary.json`` cfg)."""
+def _summary(run_dir: Path) -> dict[str, Any]:
+    """A ``g1_eval`` run's ``summary.json``."""
     path = run_dir / "summary.json"
     if not path.is_file():
         raise FileNotFoundError(f"{run_dir}: no summary.json; pass a g1_eval output folder (python -m "
                                 "gmloco.eval.g1_eval_cli --out DIR writes it)")  # fmt: skip
-    cfg = json.loads(path.read_text())["cfg"]
-    return {k: cfg.get(k) for k in SETTING_KEYS}
+    return json.loads(path.read_text())
+
+
+def setting_of(summary: dict[str, Any]) -> dict[str, Any]:
+    """The MPM setting of a ``g1_eval`` run: ``SETTING_KEYS`` of its ``summary.json`` cfg."""
+    return {k: summary["cfg"].get(k) for k in SETTING_KEYS}
 
 
 def _differences(a: dict[str, Any], b: dict[str, Any], prefix: str = "") -> list[str]:
@@ -76,7 +80,8 @@ def combine(
     labels = [label for label, _ in runs]
     if len(set(labels)) != len(labels):
         raise ValueError(f"policy labels repeat ({labels}); give each run its own LABEL=DIR")
-    settings = {label: setting_of(d) for label, d in runs}
+    summaries = {label: _summary(d) for label, d in runs}
+    settings = {label: setting_of(sm) for label, sm in summaries.items()}
     first = labels[0]
     mixed = {label: diff for label in labels[1:] if (diff := _differences(settings[first], settings[label]))}
     if mixed and not allow_mixed:
@@ -100,10 +105,7 @@ def combine(
     if transition:
         write_table(out_dir / "table_transition", ("policy", *TRANSITION_COLUMNS), transition)
     summary = {
-        "runs": {
-            label: {"dir": str(d), "policy": json.loads((d / "summary.json").read_text()).get("policy")}
-            for label, d in runs
-        },
+        "runs": {label: {"dir": str(d), "policy": summaries[label].get("policy")} for label, d in runs},
         "setting": settings[first],
         "mixed_settings": mixed,
         "episodes_expected": episodes,
