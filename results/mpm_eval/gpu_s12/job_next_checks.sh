@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Prepared in session 12 for the next GPU session (issue 9); NOT yet run. ~15 minutes on an H200; run it before
+# Prepared in session 12 for the next GPU session (issue 9); NOT yet run. ~15-23 minutes on an H200; run it before
 # job_next.sh (the table run), whose window width depends on (1).
 # (1) The window width at the accepted setting (3 cm, 500 iterations, 1.4 m long): 1.0 m against session 12's
 #     0.6 m runs (results/mpm_eval/gpu_s12/runs/td_v0.03_it500_d0.3_l1.4_r8_5s{,_seed1}: 16 episodes). Session 11
@@ -30,4 +30,11 @@ for it in 500 1000 2000; do
     --out $HOME/chunks/sweep12/h200_v0.03_it${it}_r32_l1.4_jacobi > ~/chunks/sweep12/jacobi_$it.log 2>&1
   log "cost jacobi $it rc=$?"
 done
+# (3) If time is left: the voxel axis below 3 cm, 2 cm at 500 iterations (~3.4x the cells of 3 cm: ~8 min for
+#     8 robots x 5 s on an H200), against the 3 cm / 500 runs of (1) or gpu_s12 (same width).
+M=$(left 0.5)
+L=td_v0.02_it500_d0.3_l1.4_r8_5s
+timeout $(python3 -c "print(int(max(30,$M*60)))") $P --voxel 0.02 --episode-s 5 --num-episodes 8 --robots-per-batch 8 \
+  --max-minutes $(python3 -c "print(max(0.5,$M-0.2))") --out $HOME/chunks/g1_eval/$L > ~/chunks/g1_eval/$L.log 2>&1
+log "g1_eval $L rc=$?"
 touch ~/chunks/CHECKS_DONE
