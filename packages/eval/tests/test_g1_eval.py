@@ -96,6 +96,7 @@ def test_episode_specs_batches_summary_and_tables() -> None:
              "swing_lift": float("nan") if s.index else 0.06} for s in specs]  # fmt: skip
     m = summarize(rows)
     assert math.isclose(m["all/success_rate"], 1 / 3) and m["all/num_episodes"] == 6
+    assert m["all/success_lo95"] < 1 / 3 < m["all/success_hi95"]  # 2 of 6: the Wilson interval holds the rate
     assert math.isclose(m["dry_sand/straight/v1/vel_error"], 0.1) and m["poppy_seed/straight/v2/num_episodes"] == 1
     # table: dry sand success 1/3 = 33.3 %, velocity error mean(0, 0.1, 0.2) = 0.1 m/s, sinkage 0.5 cm, swing apex
     # mean(0, 2, 4) = 2 cm, lift 6 cm (episodes without a finished swing, NaN, are left out of the mean)

@@ -413,7 +413,12 @@ METRIC_KEYS = (
 
 
 def summarize(rows: list[dict[str, Any]]) -> dict[str, float]:
-    """Mean metrics per (terrain, scenario, speed), per (terrain, scenario) and over all episodes."""
+    """Mean metrics per (terrain, scenario, speed), per (terrain, scenario) and over all episodes.
+
+    The success rate comes with its 95 % Wilson interval (``success_lo95`` / ``success_hi95``).
+    """
+    from gmloco.eval.tables_mpm import wilson_interval
+
     groups: dict[str, list[dict[str, Any]]] = {"all": rows}
     for r in rows:
         groups.setdefault(f"{r['terrain']}/{r['scenario']}", []).append(r)
@@ -425,6 +430,9 @@ def summarize(rows: list[dict[str, Any]]) -> dict[str, float]:
             vals = [float(r[k]) for r in rs if r.get(k) is not None and math.isfinite(float(r[k]))]
             name = "success_rate" if k == "success" else k
             out[f"{g}/{name}"] = float(np.mean(vals)) if vals else float("nan")
+        out[f"{g}/success_lo95"], out[f"{g}/success_hi95"] = wilson_interval(
+            sum(bool(r["success"]) for r in rs), len(rs)
+        )
     return out
 
 
