@@ -23,6 +23,7 @@ from gmloco.eval.g1_eval import (
     score_episode,
     summarize,
 )
+from gmloco.eval.mpm.g1_scene import LOG_FIELDS
 from gmloco.eval.tables_mpm import table_speeds, table_terrains
 
 
@@ -158,15 +159,8 @@ class _LaneScene:
         self.lane_episode, self.lane_step = list(range(n)), [0] * n
         self.resets: list[tuple[list[int], list[int], int]] = []
         self.base_q: list[np.ndarray] = []
-        self.base_qd: list[np.ndarray] = []
-        self.foot_force: list[np.ndarray] = []
-        self.sinkage: list[np.ndarray] = []
-        self.foot_sinkage: list[np.ndarray] = []
-        self.joint_q: list[np.ndarray] = []
-        self.joint_qd: list[np.ndarray] = []
-        self.target: list[np.ndarray] = []
-        self.action: list[np.ndarray] = []
-        self.eta: list[np.ndarray] = []
+        for name in LOG_FIELDS[1:]:  # the scene's per-robot logs (base_q typed above: run_cell reads it)
+            setattr(self, name, [])
         _LaneScene.made.append(self)
 
     def capture(self) -> None:
@@ -180,14 +174,11 @@ class _LaneScene:
                 fall = self.FALLS.get(self.lane_episode[r])
                 q[r, 2] = 0.1 if fall is not None and self.lane_step[r] >= fall else 0.7
                 self.lane_step[r] += 1
-            self.base_q.append(q)
-            self.base_qd.append(np.zeros((self.n, 6)))
-            self.foot_force.append(np.full((self.n, 2, 3), 150.0))
-            self.sinkage.append(np.full(self.n, 0.02))
-            self.foot_sinkage.append(np.full((self.n, 2), 0.02))
-            for name in ("joint_q", "joint_qd", "target", "action"):
-                getattr(self, name).append(np.zeros((self.n, 1)))
-            self.eta.append(np.full(self.n, np.nan))
+            sample = {"base_q": q, "base_qd": np.zeros((self.n, 6)), "foot_force": np.full((self.n, 2, 3), 150.0),
+                      "sinkage": np.full(self.n, 0.02), "foot_sinkage": np.full((self.n, 2), 0.02),
+                      "eta": np.full(self.n, np.nan)}  # fmt: skip
+            for name in LOG_FIELDS:
+                getattr(self, name).append(sample.get(name, np.zeros((self.n, 1))))
         self.frame += 1
 
     def reset_robots(self, robots: list[int], commands: list, seeds: list[int]) -> None:

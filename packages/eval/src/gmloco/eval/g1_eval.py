@@ -297,11 +297,10 @@ def _lane_log(
     scene: Any, r: int, a: int, b: int, spec: EpisodeSpec, terrain: Any, build_s: float, n: int
 ) -> dict[str, Any]:
     """One episode's log: lane ``r``'s policy-rate samples ``a:b`` (``score_episode``'s input)."""
+    from gmloco.eval.mpm.g1_scene import LOG_FIELDS
     from gmloco.eval.mpm.window_terrain import terrain_surface_height
 
-    names = ("base_q", "base_qd", "foot_force", "sinkage", "foot_sinkage", "joint_q", "joint_qd", "target", "action",
-             "eta")  # fmt: skip
-    arr = {name: np.asarray(getattr(scene, name)[a:b])[:, r] for name in names}
+    arr = {name: np.asarray(getattr(scene, name)[a:b])[:, r] for name in LOG_FIELDS}
     q = arr["base_q"]
     surf = terrain_surface_height(terrain, q[:, 0], q[:, 1] - scene.lane_y[r])
     return arr | {

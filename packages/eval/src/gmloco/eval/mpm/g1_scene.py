@@ -45,6 +45,7 @@ from gmloco.eval.mpm.window import SandWindow, SandWindowCfg
 from gmloco.eval.mpm.window_terrain import TerrainCfg, terrain_materials, terrain_surface_height
 
 __all__ = [
+    "LOG_FIELDS",
     "G1MpmScene",
     "G1MpmSceneCfg",
     "MjlabOnnxPolicy",
@@ -54,6 +55,11 @@ __all__ = [
     "g1_mjcf_path",
     "quat_rotate_inv",
 ]
+
+LOG_FIELDS = ("base_q", "base_qd", "foot_force", "sinkage", "foot_sinkage", "joint_q", "joint_qd", "target", "action",
+              "eta")  # fmt: skip
+"""The per-robot logs :class:`G1MpmScene` appends at the policy rate (one ``[R, ...]`` array per sample each)."""
+
 
 FOOT_BODIES = ("left_ankle_roll_link", "right_ankle_roll_link")
 # MuJoCo Warp constraint rows per robot: both soles on the rigid floor (8 corners x 2 soles x 4 pyramidal rows) plus
