@@ -8,7 +8,7 @@ import time
 from dataclasses import replace
 from pathlib import Path
 from types import SimpleNamespace
-from typing import ClassVar
+from typing import ClassVar, Literal
 
 import numpy as np
 import pytest
@@ -319,3 +319,49 @@ def test_episodes_are_read_up_to_a_partial_last_line(tmp_path: Path) -> None:
     path.write_text('{"key": "a"}\nnot json\n{"key": "b"}\n')
     with pytest.raises(ValueError, match=r"episodes\.jsonl:2: not an episode record"):
         read_episodes(path)
+
+
+def _grid_scene(fail: bool, calls: list[int]) -> SimpleNamespace:
+    """A scene whose MPM solver reports a grid overflow (``fail``) or none; each check is counted in ``calls``."""
+
+    def check() -> None:
+        calls.append(1)
+        if fail:
+            raise RuntimeError("overflow")
+
+    return SimpleNamespace(mpm=SimpleNamespace(check_sparse_grid_rebuild_status=check))
+
+
+def test_grid_overflow_invalidates_the_cell() -> None:
+    """A sparse grid that outgrew its reserved cells: an error naming the capacity and --cell-capacity-factor."""
+    from gmloco.eval.g1_eval import check_grid_capacity
+    from gmloco.eval.mpm.box_scene import MpmSolverCfg
+
+    calls: list[int] = []
+    with pytest.raises(RuntimeError, match="--cell-capacity-factor") as info:
+        check_grid_capacity(_grid_scene(True, calls), MpmSolverCfg(grid_type="sparse", max_active_cell_count=100))
+    assert "100" in str(info.value) and "overflow" in str(info.value)
+    assert isinstance(info.value.__cause__, RuntimeError) and calls == [1]
+
+
+@pytest.mark.parametrize(("grid_type", "capacity"), [("sparse", -1), ("dense", 100)])
+def test_grid_capacity_is_not_checked_without_a_reserved_sparse_grid(
+    grid_type: Literal["sparse", "dense"], capacity: int
+) -> None:
+    """Newton's per-step allocation (capacity -1) or a dense grid: the overflow check is never asked."""
+    from gmloco.eval.g1_eval import check_grid_capacity
+    from gmloco.eval.mpm.box_scene import MpmSolverCfg
+
+    calls: list[int] = []
+    check_grid_capacity(_grid_scene(True, calls), MpmSolverCfg(grid_type=grid_type, max_active_cell_count=capacity))
+    assert calls == []
+
+
+def test_grid_within_capacity_passes() -> None:
+    """A sparse grid inside its reserved cells: checked once, no error."""
+    from gmloco.eval.g1_eval import check_grid_capacity
+    from gmloco.eval.mpm.box_scene import MpmSolverCfg
+
+    calls: list[int] = []
+    check_grid_capacity(_grid_scene(False, calls), MpmSolverCfg(grid_type="sparse", max_active_cell_count=100))
+    assert calls == [1]

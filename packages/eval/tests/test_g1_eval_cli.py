@@ -66,3 +66,11 @@ def test_an_empty_rheology_solver_is_refused() -> None:
 
     with pytest.raises(ValueError, match="name a solver"):
         rheology_solver_arg(" , ")
+
+
+def test_cell_capacity_factor_below_one_is_refused(capsys: pytest.CaptureFixture[str]) -> None:
+    """A capacity under the windows' initial cells overflows at once: 0.5 is a usage error, 1.5 parses."""
+    with pytest.raises(SystemExit):
+        _parse(["--out", "x", "--cell-capacity-factor", "0.5"])
+    assert "--cell-capacity-factor 0.5" in capsys.readouterr().err
+    assert _parse(["--out", "x", "--cell-capacity-factor", "1.5"]).cell_capacity_factor == 1.5

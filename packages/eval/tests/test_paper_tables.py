@@ -78,3 +78,17 @@ def test_command_line_errors_say_what_to_pass(tmp_path: Path, capsys: pytest.Cap
         with pytest.raises(SystemExit):
             main([*argv, "--out", str(tmp_path / "out")])
         assert msg in capsys.readouterr().err
+
+
+def test_summary_file_holds_the_rows_as_records(tmp_path: Path) -> None:
+    """--summary writes tables.json's content (rows as records, the tables' folder) to the given file."""
+    run = _run(tmp_path, "a", 3, 4, speeds=(1.0, 2.0))
+    out, summary_path = tmp_path / "tables", tmp_path / "mpm" / "summary.json"
+    main(["--run", f"td={run}", "--out", str(out), "--episodes", "4", "--summary", str(summary_path)])
+    summary = json.loads(summary_path.read_text())
+    assert summary["tables"] == str(out)
+    assert summary["rows"][0]["policy"] == "td" and summary["rows"][0]["complete"] == "yes"
+    assert summary["rows"][0]["success_rate_pct"] == pytest.approx(75.0)
+    assert summary["speed_rows"][0]["v=1 m/s"] == pytest.approx(100.0)
+    assert summary["speed_rows"][0]["v=2 m/s"] == pytest.approx(50.0)
+    assert json.loads((out / "tables.json").read_text())["rows"] == summary["rows"]

@@ -51,7 +51,7 @@ from gmloco.eval.mpm.box_scene import MpmSolverCfg
 from gmloco.eval.mpm.window import SandWindowCfg
 
 __all__ = [
-    "EpisodeSpec", "G1EvalCfg", "cell_minutes_left", "episode_batches", "episode_specs", "lane_failed",
+    "EpisodeSpec", "G1EvalCfg", "build_cell_scene", "cell_minutes_left", "check_grid_capacity", "episode_batches", "episode_specs", "lane_failed",
     "load_policy", "read_episodes", "run", "run_cell", "score_episode",
 ]  # fmt: skip
 
@@ -96,8 +96,10 @@ class G1EvalCfg:
     of any length share it); False: one solver per batch of ``robots_per_batch`` episodes, lanes idle after."""
     lane_gap: float = 2.0
     """Free space between neighbouring lanes' windows or paths [m] (robots may drift)."""
-    cell_capacity_factor: float = 3.0
-    """Grid capacity = factor x particles / particles-per-cell (fixed capacity: CUDA graph); 0 = unbounded."""
+    cell_capacity_factor: float = 1.5
+    """Grid capacity = factor x particles / particles-per-cell (fixed capacity: CUDA graph); 0 = unbounded.
+    The rheology solver sweeps the whole capacity, so its cost grows with the factor: 1.5 gave 1.46x the
+    robot-frames/s of 3.0 (H200, 32 robots, results/mpm_eval/gpu_s13); an overflow stops the cell with an error."""
     solver: MpmSolverCfg = field(
         default_factory=lambda: MpmSolverCfg(voxel_size=0.03, frame_dt=0.005, rigid_substeps=1, max_iterations=500)
     )
@@ -208,6 +210,34 @@ def cell_minutes_left(steps_left: list[int], queued: int, steps: int, frames_per
     return ends[-1] * frames_per_step / fps / 60.0
 
 
+def build_cell_scene(specs: list[EpisodeSpec], cfg: G1EvalCfg, policy: Any) -> tuple[Any, Any, MpmSolverCfg]:
+    """The captured ``G1MpmScene`` of a cell's first ``robots_per_batch`` episodes, its terrain and solver cfg.
+
+    One lane per robot, each commanded as its episode; the active-cell capacity is sized from the windows
+    (``cell_capacity_factor``); ``policy`` is reloaded for the lane count if it was built for another.
+    """
+    from gmloco.eval.mpm.g1_scene import G1MpmScene, G1MpmSceneCfg
+    from gmloco.eval.mpm.window_terrain import terrain_cfg
+
+    terrain = terrain_cfg(specs[0].terrain, depth=cfg.bed_depth)
+    n = min(cfg.robots_per_batch, len(specs))
+    window, lane = _window_and_lanes(specs, cfg)
+    solver = cfg.solver
+    if cfg.cell_capacity_factor > 0 and solver.grid_type != "dense":
+        per_cell = window.particles_per_voxel**3
+        est = _window_particles(window, terrain.depth, solver.voxel_size) * n
+        solver = replace(solver, max_active_cell_count=int(cfg.cell_capacity_factor * est / per_cell) + 64)
+    scene_cfg = G1MpmSceneCfg(terrain=terrain, window=window, num_robots=n, lane_spacing=lane, solver=solver,
+                              commands=tuple(command(s, cfg) for s in specs[:n]),
+                              seed=cfg.seed * 100_003 + specs[0].index, device=cfg.device)  # fmt: skip
+    if hasattr(policy, "num_robots") and policy.num_robots != n:
+        policy = load_policy(cfg.policy_path, n)
+    policy.reset()
+    scene = G1MpmScene(scene_cfg, policy)
+    scene.capture()
+    return scene, terrain, solver
+
+
 def run_cell(
     specs: list[EpisodeSpec],
     cfg: G1EvalCfg,
@@ -227,27 +257,12 @@ def run_cell(
     """
     import sys
 
-    from gmloco.eval.mpm.g1_scene import G1MpmScene, G1MpmSceneCfg
-    from gmloco.eval.mpm.window_terrain import terrain_cfg, terrain_surface_height
+    from gmloco.eval.mpm.window_terrain import terrain_surface_height
 
     t0 = time.perf_counter()
-    terrain = terrain_cfg(specs[0].terrain, depth=cfg.bed_depth)
+    scene, terrain, solver = build_cell_scene(specs, cfg, policy)
     n = min(cfg.robots_per_batch, len(specs))
     lane_spec, queue = list(specs[:n]), list(specs[n:]) if cfg.refill else []
-    window, lane = _window_and_lanes(specs, cfg)
-    solver = cfg.solver
-    if cfg.cell_capacity_factor > 0 and solver.grid_type != "dense":
-        per_cell = window.particles_per_voxel**3
-        est = _window_particles(window, terrain.depth, solver.voxel_size) * n
-        solver = replace(solver, max_active_cell_count=int(cfg.cell_capacity_factor * est / per_cell) + 64)
-    scene_cfg = G1MpmSceneCfg(terrain=terrain, window=window, num_robots=n, lane_spacing=lane, solver=solver,
-                              commands=tuple(command(s, cfg) for s in lane_spec),
-                              seed=cfg.seed * 100_003 + specs[0].index, device=cfg.device)  # fmt: skip
-    if hasattr(policy, "num_robots") and policy.num_robots != n:
-        policy = load_policy(cfg.policy_path, n)
-    policy.reset()
-    scene = G1MpmScene(scene_cfg, policy)
-    scene.capture()
     build_s = time.perf_counter() - t0
     k = scene.frames_per_policy
     steps = round(cfg.episode_s / (scene.frame_dt * k))
@@ -256,7 +271,7 @@ def run_cell(
     while True:
         if scene.frame % k == 0 and scene.base_q:
             rows = len(scene.base_q)
-            resets = []
+            resets, checked = [], False
             for r in range(n):
                 if not active[r]:
                     continue
@@ -264,6 +279,9 @@ def run_cell(
                 surf = float(terrain_surface_height(terrain, np.array(q[0]), np.array(q[1] - scene.lane_y[r])))
                 if rows - start[r] < steps and not lane_failed(q, surf, cfg.failure):
                     continue
+                if not checked:  # an episode is kept only if the grid held all its cells (one device sync)
+                    check_grid_capacity(scene, solver)
+                    checked = True
                 on_episode(_lane_log(scene, r, start[r], rows, lane_spec[r], terrain, build_s, n))
                 done += 1
                 if queue:
@@ -281,6 +299,7 @@ def run_cell(
                       "episodes dropped", file=sys.stderr, flush=True)  # fmt: skip
                 return False
             if now - last > 30.0:
+                check_grid_capacity(scene, solver)
                 left = [steps - (rows - start[r]) for r in range(n) if active[r]]
                 eta = cell_minutes_left(left, len(queue), steps, k, scene.frames_per_second)
                 print(f"{label}: {done}/{len(specs)} episodes done, {sum(active)} running, "
@@ -288,9 +307,21 @@ def run_cell(
                       file=sys.stderr, flush=True)  # fmt: skip
                 last = now
         scene.step()
-    if solver.max_active_cell_count > 0 and solver.grid_type == "sparse":
-        scene.mpm.check_sparse_grid_rebuild_status()
+    check_grid_capacity(scene, solver)
     return True
+
+
+def check_grid_capacity(scene: Any, solver: MpmSolverCfg) -> None:
+    """Raise if the sparse grid outgrew its reserved active cells (the frames since then are not valid sand)."""
+    if solver.max_active_cell_count <= 0 or solver.grid_type != "sparse":
+        return
+    try:
+        scene.mpm.check_sparse_grid_rebuild_status()
+    except RuntimeError as exc:
+        raise RuntimeError(
+            f"the MPM grid needed more than its {solver.max_active_cell_count} reserved active cells ({exc}); "
+            "the episodes of this cell are not valid: rerun it with a larger --cell-capacity-factor"
+        ) from exc
 
 
 def _lane_log(

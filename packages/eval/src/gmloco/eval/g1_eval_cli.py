@@ -65,6 +65,12 @@ def _parse(argv: list[str] | None) -> argparse.Namespace:
     p.add_argument(
         "--particles-per-voxel", type=int, default=SandWindowCfg.particles_per_voxel, help="particles per voxel edge"
     )
+    p.add_argument(
+        "--cell-capacity-factor",
+        type=float,
+        default=G1EvalCfg.cell_capacity_factor,
+        help="active-cell capacity of the sparse grid as a multiple of the windows' initial cells",
+    )
     p.add_argument("--no-mcap", action="store_true")
     p.add_argument("--max-minutes", type=float, default=None)
     p.add_argument("--fresh", action="store_true", help="discard episodes.jsonl instead of resuming")
@@ -77,6 +83,8 @@ def _parse(argv: list[str] | None) -> argparse.Namespace:
         p.error(f"--particles-per-voxel {a.particles_per_voxel} must be >= 1")
     if not a.tolerance > 0.0:
         p.error(f"--tolerance {a.tolerance} must be > 0 (the rheology residual at which a frame's solve stops)")
+    if a.cell_capacity_factor != 0 and a.cell_capacity_factor < 1.0:
+        p.error(f"--cell-capacity-factor {a.cell_capacity_factor}: use >= 1 (or 0 for Newton's per-step allocation)")
     if a.substeps < 1:
         p.error(f"--substeps {a.substeps} must be >= 1 (rigid steps per MPM frame)")
     return a
@@ -104,6 +112,7 @@ def main(argv: list[str] | None = None) -> None:
         ),
         robots_per_batch=a.robots_per_batch,
         refill=not a.no_refill,
+        cell_capacity_factor=a.cell_capacity_factor,
         solver=replace(
             base.solver,
             voxel_size=a.voxel,

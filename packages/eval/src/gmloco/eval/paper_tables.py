@@ -11,7 +11,8 @@ tool labels each run's episodes with the policy's name and writes the combined t
   interval, tracking errors, DTW path error, sinkage and swing (``gmloco.eval.tables_mpm``);
 * ``table_speeds.{md,csv}``: success rate per commanded speed, one row per (policy, terrain, scenario);
 * ``table_transition.{md,csv}`` when a run walked the layered course;
-* ``tables.json``: the runs, their common MPM setting, and which rows are partial.
+* ``tables.json``: the runs, their common MPM setting, which rows are partial, and the rows as records
+  (``--summary FILE`` writes the same to FILE, e.g. ``results/mpm_eval/summary.json``).
 
 A table mixes like with like only: runs whose MPM setting (voxel, iterations, frame, bed, window, episode length,
 failure rules) differs are refused, naming the differing fields, unless ``--allow-mixed-settings``. A row with
@@ -110,6 +111,8 @@ def combine(
         "mixed_settings": mixed,
         "episodes_expected": episodes,
         "partial_rows": partial,
+        "rows": [dict(zip((*TERRAIN_COLUMNS, "complete"), row, strict=True)) for row in terrains],
+        "speed_rows": [dict(zip(["policy", *table_speeds([], all_speeds)[0]], row, strict=True)) for row in speeds],
     }
     (out_dir / "tables.json").write_text(json.dumps(summary, indent=1) + "\n")
     return summary
@@ -130,11 +133,18 @@ def main(argv: list[str] | None = None) -> dict[str, Any]:
     p.add_argument("--out", type=Path, required=True, help="folder for the tables")
     p.add_argument("--episodes", type=int, default=100, help="episodes a complete row has (the paper: 100)")
     p.add_argument("--allow-mixed-settings", action="store_true", help="tabulate runs scored at different settings")
+    p.add_argument("--summary", type=Path, default=None, help="also write tables.json's content here (e.g. "
+                   "results/mpm_eval/summary.json)")  # fmt: skip
     a = p.parse_args(argv)
     try:
         summary = combine(a.run, a.out, a.episodes, a.allow_mixed_settings)
     except (FileNotFoundError, ValueError) as exc:
         p.error(str(exc))
+    if a.summary is not None:
+        a.summary.parent.mkdir(parents=True, exist_ok=True)
+        tmp = a.summary.with_name(a.summary.name + ".tmp")
+        tmp.write_text(json.dumps({"tables": str(a.out), **summary}, indent=1) + "\n")
+        tmp.replace(a.summary)
     print((a.out / "table_terrains.md").read_text(), end="")
     for row in summary["partial_rows"]:
         print(f"partial: {row}")
