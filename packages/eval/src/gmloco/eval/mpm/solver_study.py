@@ -159,7 +159,7 @@ def _probe(scene: Any, variant: str, cfg: SolverStudyCfg) -> dict[str, Any]:
 
 
 def summarize_probes(rows: list[dict[str, Any]], cfg: SolverStudyCfg) -> dict[str, Any]:
-    """Per variant: median residual at fixed sweep counts, and the sweeps to reach the reference's residual."""
+    """Per variant: median L2 and L-inf residuals at fixed sweep counts, and the sweeps to the reference's L2."""
     marks = [n for n in (100, 250, 500, 1000, 2000, 4000) if n <= cfg.probe_iterations]
     ref = [r for r in rows if r["variant"] == cfg.variants[0] and r["iters"]]
     target = (
@@ -174,9 +174,9 @@ def summarize_probes(rows: list[dict[str, Any]], cfg: SolverStudyCfg) -> dict[st
         ok = [r for r in mine if r["iters"]]
         entry: dict[str, Any] = {"probes": len(mine), "errors": [r["error"] for r in mine if r["error"]]}
         for n in marks:
-            entry[f"l2_at_{n}"] = (
-                float(np.median([_residual_at(r["iters"], r["l2"], n) for r in ok])) if ok else math.nan
-            )
+            for norm in ("l2", "linf"):
+                at_n = [_residual_at(r["iters"], r[norm], n) for r in ok]
+                entry[f"{norm}_at_{n}"] = float(np.median(at_n)) if ok else math.nan
         reach = [sweeps_to_reach(r["iters"], r["l2"], target) for r in ok]
         entry["sweeps_to_target_median"] = float(np.median(reach)) if reach else math.nan
         entry["eager_ms_per_sweep_median"] = (
