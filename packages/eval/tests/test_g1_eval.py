@@ -365,3 +365,22 @@ def test_grid_within_capacity_passes() -> None:
     calls: list[int] = []
     check_grid_capacity(_grid_scene(False, calls), MpmSolverCfg(grid_type="sparse", max_active_cell_count=100))
     assert calls == [1]
+
+
+def test_grid_capacity_pads_without_changing_the_walk() -> None:
+    """1.5x and 3x the windows' cells reserved: the same pelvis trajectory (the capacity only pads the solve)."""
+    from gmloco.eval.g1_eval import build_cell_scene, load_policy
+
+    base = G1EvalCfg()
+    final = {}
+    for factor in (3.0, 1.5):
+        cfg = replace(base, policy_path="artifacts/gm_loco_student_td/policy.onnx", speeds=(1.0,), num_episodes=1,
+                      robots_per_batch=1, cell_capacity_factor=factor, record_mcap=False, device="cpu",
+                      solver=replace(base.solver, voxel_size=0.06, max_iterations=50, frame_dt=0.01,
+                                     rigid_substeps=2))  # fmt: skip
+        scene, _, solver = build_cell_scene(episode_specs(cfg), cfg, load_policy(cfg.policy_path, 1))
+        for _ in range(8):
+            scene.step()
+        final[factor] = (np.array(scene.base_q[-1]), solver.max_active_cell_count)
+    assert final[1.5][1] < 0.55 * final[3.0][1]
+    np.testing.assert_allclose(final[1.5][0], final[3.0][0], atol=1e-6)
