@@ -35,6 +35,7 @@ def test_wilson_interval_known_values() -> None:
     assert wilson_interval(50, 100) == pytest.approx((0.4038, 0.5962), abs=1e-4)
     assert wilson_interval(8, 8) == pytest.approx((0.6756, 1.0), abs=1e-4)
     assert wilson_interval(0, 10) == pytest.approx((0.0, 0.2775), abs=1e-4)
+    assert wilson_interval(0, 69)[0] == 0.0 and wilson_interval(69, 69)[1] == 1.0  # exact ends, no rounding noise
 
 
 def test_two_policies_side_by_side_with_partial_rows_named(tmp_path: Path) -> None:

@@ -4,7 +4,9 @@
 #           (~9 min), then  python -m gmloco.eval.convergence --reference <2 cm / 1000> --candidate
 #           results/mpm_eval/gpu_s12/runs/td_v0.03_it500_d0.3_l1.4_r8_5s{,_seed1}  (and the 2 cm / 500 run of
 #           gpu_s13/runs as a second candidate: do iterations or the voxel move the sinkage?);
-#           (2) the contact-model ablation's first row: ppo_rft3d, dry sand, straight, 1.0-2.5 m/s, 100 episodes.
+#           (2) the contact-model ablation's first row: ppo_rft3d, dry sand, straight, 1.0-2.5 m/s, 100 episodes
+#           (69 done in session 13: copy results/mpm_eval/gpu_s13/runs/table_ppo_rft3d_dry_sand to
+#           .devsrc/row/ before the launch and it resumes).
 #   part b: the rows of ppo_rigid and the clr50 student (same cell). Policies that fall within ~3 s cost ~1/4 of a
 #           walking policy's row (lanes refill as robots fall), ~8 min each on an H200.
 # Every row is resumable: carry a run folder back under .devsrc/row/<name> and it continues from its episodes.jsonl.
