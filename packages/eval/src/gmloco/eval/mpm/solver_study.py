@@ -103,8 +103,9 @@ def finite_residuals(counts: list[tuple[int, int]]) -> Any:
     """Within: Newton's residual norm over the finite entries only; (finite, all) entry counts go to ``counts``.
 
     Newton 1.5.2 sizes the rheology arrays by the grid's reserved capacity, and the per-node residual of the
-    reserved-but-inactive nodes is read from uninitialised temporaries (NaN on the CPU), so the reported L2 norm
-    is NaN and the tolerance test never passes. Here the norm skips them (eager solves only: it reads back).
+    reserved-but-inactive nodes is read from uninitialised temporaries (often NaN, on the CPU and the GPU), so the
+    reported L2 norm is NaN and its half of the tolerance test cannot pass (the L-inf half ignores NaN). Here both
+    norms skip them (eager solves only: it reads back).
     """
     import warp as wp
     from newton._src.solvers.implicit_mpm import solve_rheology as sr
