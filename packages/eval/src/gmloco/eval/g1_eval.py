@@ -51,8 +51,8 @@ from gmloco.eval.mpm.box_scene import MpmSolverCfg
 from gmloco.eval.mpm.window import SandWindowCfg
 
 __all__ = [
-    "EpisodeSpec", "G1EvalCfg", "build_cell_scene", "cell_minutes_left", "check_grid_capacity", "episode_batches", "episode_specs", "lane_failed",
-    "load_policy", "read_episodes", "run", "run_cell", "score_episode",
+    "EpisodeSpec", "G1EvalCfg", "build_cell_scene", "cell_minutes_left", "check_grid_capacity", "episode_batches",
+    "episode_specs", "lane_failed", "load_policy", "read_episodes", "run", "run_cell", "score_episode",
 ]  # fmt: skip
 
 Scenario = Literal["straight", "circle"]
