@@ -63,6 +63,8 @@ def test_runs_at_different_settings_are_refused_by_name(tmp_path: Path) -> None:
         combine([("x", a), ("y", b)], tmp_path / "out")
     summary = combine([("x", a), ("y", b)], tmp_path / "out", allow_mixed=True)
     assert summary["mixed_settings"]["y"] == ["solver.max_iterations (500 vs 250)"]
+    for md in (tmp_path / "out").glob("table_*.md"):
+        assert md.read_text().endswith("- `y`: solver.max_iterations (500 vs 250)\n"), md.name
 
 
 def test_seeds_and_time_boxes_may_differ(tmp_path: Path) -> None:

@@ -15,7 +15,8 @@ tool labels each run's episodes with the policy's name and writes the combined t
   (``--summary FILE`` writes the same to FILE, e.g. ``results/mpm_eval/summary.json``).
 
 A table mixes like with like only: runs whose MPM setting (voxel, iterations, frame, bed, window, episode length,
-failure rules) differs are refused, naming the differing fields, unless ``--allow-mixed-settings``. A row with
+failure rules) differs are refused, naming the differing fields, unless ``--allow-mixed-settings`` (then each
+markdown table ends with a note naming the rows and fields that differ). A row with
 fewer than ``--episodes`` episodes says ``no`` in the ``complete`` column (and is listed in ``tables.json``): such a
 row is a measurement, not the paper's 100-episode row.
 """
@@ -105,6 +106,9 @@ def combine(
     write_table(out_dir / "table_speeds", ["policy", *table_speeds([], all_speeds)[0]], speeds)
     if transition:
         write_table(out_dir / "table_transition", ("policy", *TRANSITION_COLUMNS), transition)
+    if mixed:
+        names = ("table_terrains", "table_speeds", *(("table_transition",) if transition else ()))
+        _footnote_mixed([out_dir / f"{n}.md" for n in names], first, mixed)
     summary = {
         "runs": {label: {"dir": str(d), "policy": summaries[label].get("policy")} for label, d in runs},
         "setting": settings[first],
@@ -116,6 +120,14 @@ def combine(
     }
     (out_dir / "tables.json").write_text(json.dumps(summary, indent=1) + "\n")
     return summary
+
+
+def _footnote_mixed(tables: list[Path], first: str, mixed: dict[str, list[str]]) -> None:
+    """Append to each markdown table which rows were scored at another setting than ``first``'s, and how."""
+    lines = [f"- `{label}`: {', '.join(diff)}" for label, diff in mixed.items()]
+    note = f"\nScored at settings other than `{first}`'s (tabulated with `--allow-mixed-settings`):\n\n"
+    for md in tables:
+        md.write_text(md.read_text() + note + "\n".join(lines) + "\n")
 
 
 def _run_arg(text: str) -> tuple[str, Path]:
