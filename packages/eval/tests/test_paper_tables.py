@@ -95,3 +95,12 @@ def test_summary_file_holds_the_rows_as_records(tmp_path: Path) -> None:
     assert summary["speed_rows"][0]["v=1 m/s"] == pytest.approx(100.0)
     assert summary["speed_rows"][0]["v=2 m/s"] == pytest.approx(50.0)
     assert json.loads((out / "tables.json").read_text())["rows"] == summary["rows"]
+
+
+def test_a_figure_per_cell_puts_the_policies_side_by_side(tmp_path: Path) -> None:
+    """Two policies on one dry-sand cell at two speeds: one figure, named after the cell, listed in tables.json."""
+    a = _run(tmp_path, "a", 3, 8, speeds=(1.0, 2.0))
+    b = _run(tmp_path, "b", 0, 8, speeds=(1.0, 2.0))
+    summary = combine([("x", a), ("y", b)], tmp_path / "out")
+    assert summary["figures"] == ["fig_speeds_dry_sand_straight.png"]
+    assert (tmp_path / "out" / "fig_speeds_dry_sand_straight.png").stat().st_size > 10_000

@@ -9,7 +9,7 @@ from typing import Any
 
 import numpy as np
 
-__all__ = ["fig_mpm_speed_sweep", "fig_mpm_transition", "write_figures"]
+__all__ = ["fig_mpm_speed_sweep", "fig_mpm_transition", "fig_policies_by_speed", "write_figures"]
 
 
 def _by_speed(rs: list[dict[str, Any]], key: str) -> tuple[np.ndarray, np.ndarray]:
@@ -69,6 +69,39 @@ def fig_mpm_transition(rows: list[dict[str, Any]], path: str | Path, policy: str
     ax0.legend(fontsize=7)
     ax1.legend(fontsize=7)
     fig.suptitle(f"{policy} on the MPM transition course (media in walking order)", fontsize=9)
+    fig.savefig(path, dpi=120)
+    plt.close(fig)
+    return Path(path)
+
+
+def fig_policies_by_speed(runs: list[tuple[str, list[dict[str, Any]]]], path: str | Path, cell: str) -> Path:
+    """Policies side by side on one (terrain, scenario) cell against the commanded speed [m/s].
+
+    Left: success rate [%] with its 95 % Wilson interval; right: median time alive [s].
+    ``runs``: (policy label, that cell's episodes).
+    """
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    from gmloco.eval.tables_mpm import wilson_interval
+
+    fig, (ax0, ax1) = plt.subplots(1, 2, figsize=(9, 3.4), constrained_layout=True)
+    for k, (label, rs) in enumerate(runs):
+        speeds = sorted({float(r["speed"]) for r in rs})
+        at = [[r for r in rs if float(r["speed"]) == v] for v in speeds]
+        wins = [sum(bool(r["success"]) for r in group) for group in at]
+        rate = [100.0 * w / len(g) for w, g in zip(wins, at, strict=True)]
+        lo_hi = np.array([wilson_interval(w, len(g)) for w, g in zip(wins, at, strict=True)]) * 100.0
+        x = np.array(speeds) + 0.02 * (k - 0.5 * (len(runs) - 1))  # a small dodge so the intervals stay apart
+        err = np.vstack([np.array(rate) - lo_hi[:, 0], lo_hi[:, 1] - np.array(rate)])
+        ax0.errorbar(x, rate, yerr=err, fmt="o-", capsize=3, label=f"{label} ({len(rs)} ep.)")
+        ax1.plot(x, [float(np.median([r["alive_s"] for r in g])) for g in at], "o-", label=label)
+    ax0.set(xlabel="commanded speed [m/s]", ylabel="success rate [%] (95 % interval)", ylim=(-5, 105))
+    ax1.set(xlabel="commanded speed [m/s]", ylabel="median time alive [s]", ylim=(0, None))
+    ax0.legend(fontsize=7)
+    fig.suptitle(f"MPM sand, {cell}: policies side by side", fontsize=9)
     fig.savefig(path, dpi=120)
     plt.close(fig)
     return Path(path)

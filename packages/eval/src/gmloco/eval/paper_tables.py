@@ -11,6 +11,8 @@ tool labels each run's episodes with the policy's name and writes the combined t
   interval, tracking errors, DTW path error, sinkage and swing (``gmloco.eval.tables_mpm``);
 * ``table_speeds.{md,csv}``: success rate per commanded speed, one row per (policy, terrain, scenario);
 * ``table_transition.{md,csv}`` when a run walked the layered course;
+* ``fig_speeds_<terrain>_<scenario>.png``: per cell, the policies' success rate (95 % interval) and median time alive
+  against the commanded speed;
 * ``tables.json``: the runs, their common MPM setting, which rows are partial, and the rows as records
   (``--summary FILE`` writes the same to FILE, e.g. ``results/mpm_eval/summary.json``).
 
@@ -106,6 +108,7 @@ def combine(
     write_table(out_dir / "table_speeds", ["policy", *table_speeds([], all_speeds)[0]], speeds)
     if transition:
         write_table(out_dir / "table_transition", ("policy", *TRANSITION_COLUMNS), transition)
+    figures = _figures_by_cell(loaded, out_dir)
     if mixed:
         names = ("table_terrains", "table_speeds", *(("table_transition",) if transition else ()))
         _footnote_mixed([out_dir / f"{n}.md" for n in names], first, mixed)
@@ -115,11 +118,29 @@ def combine(
         "mixed_settings": mixed,
         "episodes_expected": episodes,
         "partial_rows": partial,
+        "figures": [p.name for p in figures],
         "rows": [dict(zip((*TERRAIN_COLUMNS, "complete"), row, strict=True)) for row in terrains],
         "speed_rows": [dict(zip(["policy", *table_speeds([], all_speeds)[0]], row, strict=True)) for row in speeds],
     }
     (out_dir / "tables.json").write_text(json.dumps(summary, indent=1) + "\n")
     return summary
+
+
+def _figures_by_cell(loaded: list[tuple[str, list[dict[str, Any]]]], out_dir: Path) -> list[Path]:
+    """``fig_speeds_<terrain>_<scenario>.png``: the policies side by side on each (terrain, scenario) cell."""
+    from gmloco.eval.figures_mpm import fig_policies_by_speed
+
+    cells = dict.fromkeys((r["terrain"], r["scenario"]) for _, rows in loaded for r in rows)
+    paths = []
+    for terrain, scenario in cells:
+        runs = [
+            (label, [r for r in rows if (r["terrain"], r["scenario"]) == (terrain, scenario)]) for label, rows in loaded
+        ]
+        runs = [(label, rs) for label, rs in runs if rs]
+        paths.append(
+            fig_policies_by_speed(runs, out_dir / f"fig_speeds_{terrain}_{scenario}.png", f"{terrain} / {scenario}")
+        )
+    return paths
 
 
 def _footnote_mixed(tables: list[Path], first: str, mixed: dict[str, list[str]]) -> None:
