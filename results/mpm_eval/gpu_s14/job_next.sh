@@ -1,0 +1,39 @@
+#!/usr/bin/env bash
+# Prepared in session 14 for the next GPU session (issue 9); NOT yet run. One machine, ~25 min.
+#   (1) The window check at 1.5 m/s that session 14 left undecided: the td student, 16 robots x 5 s at 3 cm / 500,
+#       1.4 x 0.6 m (lead 0.2) and 1.0 x 0.5 m (lead 0.1), each run to the end (~3.5 + ~2.5 min on an H100), then
+#       python -m gmloco.eval.convergence on the two; the verdict picks the window of step (2).
+#   (2) The per-terrain table's first row beyond dry sand: the td student on poppy seed, straight, 1.0-2.5 m/s,
+#       100 episodes (~17-19 min at the small window), time-boxed and resumable (carry the run folder back under
+#       .devsrc/row/<name> and it continues from its episodes.jsonl).
+# Usage (in ~/src, after the wheels and the Warp cache): bash job_next.sh END_EPOCH
+END=$1
+cd ~/src && source scripts/gpu/env.sh && mkdir -p ~/chunks/g1_eval
+[ -d ~/src/.devsrc/row ] && cp -r ~/src/.devsrc/row/* ~/chunks/g1_eval/
+log() { echo "$* at $(date +%T)" >> ~/chunks/job.log; }
+left() { python3 -c "import time;print(round(($END-time.time())/60 - $1,2))"; }
+POL=artifacts/gm_loco_student_td/policy.onnx
+log "start"
+for W in "1.0 0.5 0.1" "1.4 0.6 0.2"; do
+  set -- $W
+  L=td_v0.03_it500_d0.3_l${1}_w${2}_lead${3}_r16_5s_v1.5
+  timeout 420 python3 -m gmloco.eval.g1_eval_cli --policy $POL --terrains dry_sand --speeds 1.5 --no-mcap --fresh \
+    --window-length $1 --window-width $2 --window-lead $3 --episode-s 5 --num-episodes 16 --robots-per-batch 16 \
+    --out $HOME/chunks/g1_eval/$L > ~/chunks/g1_eval/$L.log 2>&1
+  log "g1_eval $L rc=$?"
+done
+python3 -m gmloco.eval.convergence --reference ~/chunks/g1_eval/td_v0.03_it500_d0.3_l1.4_w0.6_lead0.2_r16_5s_v1.5 \
+  --candidate ~/chunks/g1_eval/td_v0.03_it500_d0.3_l1.0_w0.5_lead0.1_r16_5s_v1.5 \
+  --out ~/chunks/verdict_window_v1.5.json >> ~/chunks/job.log 2>&1
+if python3 -c "import json,sys; sys.exit(json.load(open('$HOME/chunks/verdict_window_v1.5.json'))['decision'] != 'accepted')"; then
+  WIN="--window-length 1.0 --window-width 0.5 --window-lead 0.1"; log "small window accepted at 1.5 m/s"
+else
+  WIN=""; log "small window not accepted at 1.5 m/s: the row uses the default window"
+fi
+M=$(left 0.7)
+L=table_td_poppy_seed
+timeout $(python3 -c "print(int(max(30,$M*60+20)))") python3 -m gmloco.eval.g1_eval_cli --policy $POL \
+  --terrains poppy_seed --scenarios straight --speeds 1.0 1.5 2.0 2.5 --num-episodes 100 --robots-per-batch 36 \
+  $WIN --max-minutes $M --out $HOME/chunks/g1_eval/$L >> ~/chunks/g1_eval/$L.log 2>&1
+log "row $L rc=$?"
+touch ~/chunks/DONE
