@@ -101,3 +101,17 @@ def test_a_file_that_is_not_an_episodes_file_is_a_clear_error(tmp_path: Path) ->
     log.write_text("cell 1/1 ...\n")
     with pytest.raises(ValueError, match=r"not an episodes file"):
         load_episodes(log)
+
+
+def test_a_run_cut_short_by_its_time_box_is_undecided(tmp_path: Path) -> None:
+    """Equal walks, but the reference's summary.json says incomplete: undecided, and the reason names the folder."""
+    alive = np.linspace(3, 10, 10)
+    for name, complete in (("ref", False), ("cand", True)):
+        (tmp_path / name).mkdir()
+        (tmp_path / name / "episodes.jsonl").write_text("".join(json.dumps(r) + "\n" for r in _rows(alive, 0.08, 0.2)))
+        (tmp_path / name / "summary.json").write_text(json.dumps({"complete": complete, "cfg": {"num_episodes": 16}}))
+    v = main(["--reference", str(tmp_path / "ref"), "--candidate", str(tmp_path / "cand")])
+    assert v.decision == "undecided"
+    assert len(v.reasons) == 1 and "ref is incomplete (10 of 16 episodes)" in v.reasons[0]
+    complete = compare_runs(_rows(alive, 0.08, 0.2), _rows(alive, 0.08, 0.2))
+    assert complete.decision == "accepted"  # the same episodes without the flag

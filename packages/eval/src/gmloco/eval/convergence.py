@@ -11,8 +11,10 @@ candidate (another voxel size, iteration count, window or bed), are compared epi
 
 The candidate is **accepted** when none of the tests rejects at ``alpha`` and the sinkage differs by at most
 ``sinkage_rel_tol``; **rejected** when any of them does; **undecided** when either run has fewer than
-``min_episodes`` episodes (a verdict on a handful of episodes would be noise). Acceptance means "no difference
-that these episodes can detect", so the number of episodes is part of every verdict.
+``min_episodes`` episodes (a verdict on a handful of episodes would be noise), or when a run folder's
+``summary.json`` says it is incomplete: its time box dropped the episodes still running, which are the ones that
+lived longest, so its sample is biased toward early falls (resume it with the same ``--out`` first). Acceptance
+means "no difference that these episodes can detect", so the number of episodes is part of every verdict.
 
     python -m gmloco.eval.convergence --reference REF_RUN [REF_RUN ...] --candidate RUN [RUN ...]
         [--out verdict.json]
@@ -32,7 +34,7 @@ from typing import Any, Literal
 
 import numpy as np
 
-__all__ = ["ConvergenceCfg", "Verdict", "compare_runs", "load_episodes", "main"]
+__all__ = ["ConvergenceCfg", "Verdict", "compare_runs", "incomplete_runs", "load_episodes", "main"]
 
 Decision = Literal["accepted", "rejected", "undecided"]
 
@@ -86,6 +88,22 @@ def load_episodes(path: str | Path) -> list[dict[str, Any]]:
     return rows
 
 
+def incomplete_runs(paths: list[str | Path]) -> list[str]:
+    """Why each run folder among ``paths`` whose ``summary.json`` says ``complete: false`` is a biased sample."""
+    out = []
+    for path in paths:
+        summary = Path(path) / "summary.json"
+        if Path(path).is_dir() and summary.is_file():
+            doc = json.loads(summary.read_text())
+            if doc.get("complete") is False:
+                kept = len(load_episodes(path))
+                wanted = doc.get("cfg", {}).get("num_episodes", "?")
+                out.append(f"{path} is incomplete ({kept} of {wanted} episodes): its time box dropped the episodes "
+                           "still running, the longest-lived, so its sample leans to early falls; resume it (same "
+                           "--out) and compare again")  # fmt: skip
+    return out
+
+
 def _cells(rows: list[dict[str, Any]]) -> set[tuple[str, str, float]]:
     return {(r["terrain"], r["scenario"], float(r["speed"])) for r in rows}
 
@@ -104,8 +122,15 @@ def _mw_p(cand: np.ndarray, ref: np.ndarray) -> float:
     return float(mannwhitneyu(cand, ref, alternative="two-sided").pvalue)
 
 
-def compare_runs(ref: list[dict[str, Any]], cand: list[dict[str, Any]], cfg: ConvergenceCfg | None = None) -> Verdict:
+def compare_runs(
+    ref: list[dict[str, Any]],
+    cand: list[dict[str, Any]],
+    cfg: ConvergenceCfg | None = None,
+    biased: list[str] | None = None,
+) -> Verdict:
     """Compare the candidate setting's episodes with the reference's (see the module docstring).
+
+    ``biased``: reasons why a run's sample is not representative (``incomplete_runs``); any makes it undecided.
 
     Raises:
         ValueError: The runs score different (terrain, scenario, speed) cells, so they are not the same experiment.
@@ -146,6 +171,9 @@ def compare_runs(ref: list[dict[str, Any]], cand: list[dict[str, Any]], cfg: Con
     if min(len(ref), len(cand)) < cfg.min_episodes:
         decision = "undecided"
         reasons.insert(0, f"too few episodes ({len(cand)} vs {len(ref)}; at least {cfg.min_episodes} each)")
+    if biased:
+        decision = "undecided"
+        reasons[:0] = biased
     return Verdict(decision, tuple(reasons), (len(cand), len(ref)), (float(np.median(a_cand)), float(np.median(a_ref))),
                    alive_p, (s_cand, s_ref), success_p, track_med["vel_error"], track_p["vel_error"],
                    track_med["yaw_error"], track_p["yaw_error"], (k_cand, k_ref), rel)  # fmt: skip
@@ -165,7 +193,7 @@ def main(argv: list[str] | None = None) -> Verdict:
     try:
         ref = [row for path in a.reference for row in load_episodes(path)]
         cand = [row for path in a.candidate for row in load_episodes(path)]
-        v = compare_runs(ref, cand, cfg)
+        v = compare_runs(ref, cand, cfg, biased=incomplete_runs([*a.reference, *a.candidate]))
     except (FileNotFoundError, ValueError) as exc:
         p.error(str(exc))
     print(f"{v.decision}: candidate {v.episodes[0]} episodes vs reference {v.episodes[1]}")
