@@ -71,6 +71,24 @@ def test_swing_clearance_of_a_stepping_foot() -> None:
     assert math.isclose(row["swing_apex"], 0.04) and math.isclose(row["swing_lift"], 0.06)
 
 
+def test_a_sole_outside_the_sand_window_flags_the_episode() -> None:
+    """A sole outside its window from step 30 of a 100-step walk: exit at 0.6 s, flagged; in the last 0.25 s: not."""
+    cfg = replace(G1EvalCfg(), episode_s=2.0)
+    dt, n = 0.02, 100
+    t = (np.arange(n) + 1) * dt
+    log = _log(np.stack([t, 0 * t], 1), np.tile([1.0, 0.0], (n, 1)), np.full(n, 0.7), dt)
+    row = score_episode(EpisodeSpec("dry_sand", "straight", 1.0, 0), cfg, log)
+    assert row["window_exit_s"] is None and not row["window_exit_early"]  # a log without the field: no exit
+    log["sole_out"] = np.zeros(n)
+    log["sole_out"][30:33] = 4
+    row = score_episode(EpisodeSpec("dry_sand", "straight", 1.0, 0), cfg, log)
+    assert math.isclose(row["window_exit_s"], 0.6) and row["window_exit_early"]
+    log["sole_out"][:] = 0
+    log["sole_out"][n - 10 :] = 2  # during the last 0.2 s of the episode: the fall's last moments, not flagged
+    row = score_episode(EpisodeSpec("dry_sand", "straight", 1.0, 0), cfg, log)
+    assert math.isclose(row["window_exit_s"], (n - 10) * dt) and not row["window_exit_early"]
+
+
 def test_standing_still_times_out_and_fall_fails() -> None:
     """Standing at 1 m/s command: timeout with velocity error 1; base at 0.1 m from step 10: base-height failure."""
     cfg = replace(G1EvalCfg(), episode_s=2.0)
@@ -94,16 +112,19 @@ def test_episode_specs_batches_summary_and_tables() -> None:
     rows = [{"terrain": s.terrain, "scenario": s.scenario, "speed": s.speed, "success": s.index == 0,
              "vel_error": 0.1 * s.index, "yaw_error": 0.0, "path_error": 0.0, "support_ratio": 1.0,
              "max_sinkage": 0.01, "mean_sinkage": 0.005, "swing_apex": 0.02 * s.index,
-             "swing_lift": float("nan") if s.index else 0.06} for s in specs]  # fmt: skip
+             "swing_lift": float("nan") if s.index else 0.06, "window_exit_early": s.index == 2}
+            for s in specs]  # fmt: skip
     m = summarize(rows)
     assert math.isclose(m["all/success_rate"], 1 / 3) and m["all/num_episodes"] == 6
     assert m["all/success_lo95"] < 1 / 3 < m["all/success_hi95"]  # 2 of 6: the Wilson interval holds the rate
     assert math.isclose(m["dry_sand/straight/v1/vel_error"], 0.1) and m["poppy_seed/straight/v2/num_episodes"] == 1
     # table: dry sand success 1/3 = 33.3 %, velocity error mean(0, 0.1, 0.2) = 0.1 m/s, sinkage 0.5 cm, swing apex
-    # mean(0, 2, 4) = 2 cm, lift 6 cm (episodes without a finished swing, NaN, are left out of the mean)
+    # mean(0, 2, 4) = 2 cm, lift 6 cm (episodes without a finished swing, NaN, are left out of the mean); one of
+    # the three episodes had a sole outside its sand window early: 33.3 %
     t = table_terrains(rows, "p")
     assert t[0][:4] == ["p", "dry_sand", "straight", 3]
-    np.testing.assert_allclose(t[0][4:5] + t[0][7:], [100 / 3, 0.1, 0.0, 0.0, 0.5, 2.0, 6.0])
+    np.testing.assert_allclose(t[0][4:5] + t[0][7:], [100 / 3, 0.1, 0.0, 0.0, 0.5, 2.0, 6.0, 100 / 3])
+    assert math.isclose(m["all/window_exit_early"], 1 / 3)
     assert t[0][5] < 100 / 3 < t[0][6]  # the 95 % interval of 1 success in 3 episodes holds the rate
     header, body = table_speeds(rows)
     # v = 1: episodes 0 (success) and 2 (fail) -> 50 %; v = 2: episode 1 (fail) -> 0 %

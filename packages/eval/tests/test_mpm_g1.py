@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 
 from gmloco.eval.mpm.box_scene import MpmSolverCfg, frame_dt_problem
-from gmloco.eval.mpm.g1_scene import G1MpmScene, G1MpmSceneCfg, MjlabOnnxPolicy
+from gmloco.eval.mpm.g1_scene import G1MpmScene, G1MpmSceneCfg, MjlabOnnxPolicy, soles_outside
 from gmloco.eval.mpm.window import SandWindowCfg
 
 POLICY = Path(__file__).resolve().parents[3] / "artifacts" / "ppo_rft3d" / "policy.onnx"
@@ -24,6 +24,20 @@ def standing_g1() -> G1MpmScene:
                        MjlabOnnxPolicy(POLICY))  # fmt: skip
     scene.run(20)
     return scene
+
+
+def test_soles_outside_counts_low_corners_beyond_the_window() -> None:
+    """Window x in [0, 1], y in [-0.5, 0.5]: corners behind it count if within 2 cm of the sand, not if higher."""
+    bounds = np.array([[[0.0, -0.5], [1.0, 0.5]]])
+    corners = np.zeros((1, 2, 8, 3))
+    corners[0, 0, :, 0] = 0.5  # left sole inside
+    corners[0, 1, :, 0] = np.linspace(-0.2, 0.15, 8)  # right sole straddles the rear edge: 5 corners behind it
+    surface = np.zeros((1, 2, 8))
+    assert soles_outside(corners, surface, bounds).tolist() == [5]
+    corners[0, 1, :, 2] = 0.05  # the right sole 5 cm up in its swing: no sand needed
+    assert soles_outside(corners, surface, bounds).tolist() == [0]
+    corners[0, 1, :, 2], corners[0, 1, :, 0], corners[0, 1, :, 1] = -0.03, 0.5, 0.6  # sunk, beside the window
+    assert soles_outside(corners, surface, bounds).tolist() == [8]
 
 
 def test_policy_metadata_layout() -> None:
@@ -76,6 +90,7 @@ def test_moving_window_keeps_standing_sinkage() -> None:
     if not POLICY.exists():
         pytest.skip(f"no exported policy at {POLICY}")
     static, moving = _standing(False), _standing(True, num_robots=2)
+    assert not np.asarray(moving.sole_out).any() and not np.asarray(static.sole_out).any()  # soles over sand
     lo_x = moving.window.bounds()[:, 0, 0]
     np.testing.assert_allclose(lo_x, [-0.35, -0.35], atol=1e-6)  # the window did move (was -0.45)
     s_static, s_moving = np.asarray(static.sinkage)[:, 0], np.asarray(moving.sinkage)

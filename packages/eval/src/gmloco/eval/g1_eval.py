@@ -16,6 +16,9 @@ with :mod:`gmloco.eval.metrics.locomotion`:
   |w_z - w_cmd| over alive steps; path error: DTW between executed and commanded xy paths (alive part).
 * swing clearance: mean apex of the completed swings above the local surface and their lift above the stance
   before (``swing_clearance``: a foot is in swing while its sand force is below 40 N).
+* window check: ``window_exit_s``, the first time a sole corner within 2 cm of the surface lay outside its robot's
+  sand window (no particles there), and ``window_exit_early`` when that was more than ``WINDOW_EXIT_GRACE_S`` before
+  the episode ended; its rate is in the summary and the terrain table, and a run warns about it.
 * decoded stiffness: the student's mean decoded eta over the alive steps; on the layered ``transition`` course
   also per medium, with the swings there (``layer_stats``; ``table_transition``, ``fig_mpm_transition.png``).
 
@@ -51,8 +54,21 @@ from gmloco.eval.mpm.box_scene import MpmSolverCfg
 from gmloco.eval.mpm.window import SandWindowCfg
 
 __all__ = [
-    "EpisodeSpec", "G1EvalCfg", "build_cell_scene", "cell_minutes_left", "check_grid_capacity", "episode_batches",
-    "episode_specs", "lane_failed", "load_policy", "read_episodes", "run", "run_cell", "score_episode",
+    "WINDOW_EXIT_GRACE_S",
+    "EpisodeSpec",
+    "G1EvalCfg",
+    "build_cell_scene",
+    "cell_minutes_left",
+    "check_grid_capacity",
+    "episode_batches",
+    "episode_specs",
+    "lane_failed",
+    "load_policy",
+    "read_episodes",
+    "run",
+    "run_cell",
+    "score_episode",
+    "window_exit_time",
 ]  # fmt: skip
 
 Scenario = Literal["straight", "circle"]
@@ -374,6 +390,7 @@ def score_episode(spec: EpisodeSpec, cfg: G1EvalCfg, log: dict[str, Any]) -> dic
     sink = np.asarray(log["sinkage"])[:alive]
     swing = swing_clearance(-np.asarray(log["foot_sinkage"]), np.asarray(log["foot_force"])[..., 2], alive)
     eta = np.asarray(log.get("eta", np.full(len(q), np.nan)), dtype=float)[:alive]
+    exit_s = window_exit_time(log.get("sole_out"), dt, alive)
     return {
         "key": spec.key, "terrain": spec.terrain, "scenario": spec.scenario, "speed": spec.speed,
         "success": out.success, "reason": out.reason, "alive_s": out.alive_steps * dt,
@@ -387,11 +404,30 @@ def score_episode(spec: EpisodeSpec, cfg: G1EvalCfg, log: dict[str, Any]) -> dic
         "swing_apex": swing.apex, "swing_lift": swing.lift, "swings": swing.swings,
         "eta_mean": float(np.mean(eta)) if np.isfinite(eta).any() else float("nan"),
         "layers": layer_stats(log, alive),
+        # a sole that needed sand stood outside its sand window (no particles there): the window was too small
+        "window_exit_s": exit_s,
+        "window_exit_early": exit_s is not None and exit_s < out.alive_steps * dt - WINDOW_EXIT_GRACE_S,
         # a sole reached the rigid floor under the sand (the soles stand on it): the bed was too shallow there
         "floor_reached": bool(len(sink) and np.max(sink) >= log.get("depth", math.inf) - 0.005),
         "particles": log["particles"], "batch_size": log.get("batch_size", 1), "build_s": log["build_s"],
         "sim_s": log["sim_s"], "frames_per_s": log["frames"] / max(log["sim_s"], 1e-9),
     }  # fmt: skip
+
+
+WINDOW_EXIT_GRACE_S = 0.25
+"""A sole leaving the sand window this close to an episode's end (the fall under way) does not flag it [s]."""
+
+
+def window_exit_time(sole_out: Any, dt: float, alive: int) -> float | None:
+    """First time [s] a sole corner that needed sand lay outside the window (``soles_outside``); None if never.
+
+    ``sole_out``: per-sample counts ([T] or [T, 1]); None for logs written before the check existed.
+    """
+    if sole_out is None:
+        return None
+    counts = np.asarray(sole_out, dtype=float).reshape(len(sole_out), -1).sum(axis=1)[:alive]
+    hit = np.flatnonzero(counts > 0)
+    return float(hit[0] * dt) if len(hit) else None
 
 
 def layer_stats(log: dict[str, Any], alive: int) -> list[dict[str, Any]] | None:
@@ -438,7 +474,7 @@ def _runs(mask: np.ndarray) -> list[tuple[int, int]]:
 
 METRIC_KEYS = (
     "success", "vel_error", "yaw_error", "path_error", "support_ratio", "max_sinkage", "mean_sinkage", "floor_reached",
-    "swing_apex", "swing_lift", "eta_mean",
+    "swing_apex", "swing_lift", "eta_mean", "window_exit_early",
 )  # fmt: skip
 
 
@@ -553,7 +589,22 @@ def run(cfg: G1EvalCfg) -> tuple[dict[str, float], bool]:
     summary["throughput/episodes_this_call"] = float(len(rows) - len(done))
     summary["throughput/episodes_per_minute"] = 60.0 * (len(rows) - len(done)) / max(wall, 1e-9)
     _write_outputs(out, cfg, rows, summary, complete)
+    _warn_window_exits(rows)
     return summary, complete
+
+
+def _warn_window_exits(rows: list[dict[str, Any]]) -> None:
+    """Say on stderr how many episodes had a sole outside its sand window before the episode's last moments."""
+    import sys
+
+    early = [r for r in rows if r.get("window_exit_early")]
+    if early:
+        worst = min(early, key=lambda r: r["window_exit_s"])
+        print(f"warning: in {len(early)} of {len(rows)} episodes a sole that needed sand stood outside its sand window "
+              f"more than {WINDOW_EXIT_GRACE_S} s before the episode ended (first at {worst['window_exit_s']:.2f} s, "
+              f"{worst['key']}): those walks lost their support to the window, not to the sand. Lengthen the window "
+              "or move it back (--window-length, --window-lead; soles trail the pelvis further than they lead it)",
+              file=sys.stderr, flush=True)  # fmt: skip
 
 
 def _write_outputs(out: Path, cfg: G1EvalCfg, rows: list[dict[str, Any]], summary: dict, complete: bool) -> None:

@@ -3,6 +3,7 @@
 
 * ``table_terrains``: one row per (policy, terrain, scenario): episodes, success rate with its 95 % Wilson
   interval, velocity and yaw tracking error, DTW path error, mean sinkage, swing apex and lift (GM-Loco's per-terrain and contact-model tables;
+  ``window_exit_pct``: episodes whose soles left the sand window early, a validity check, NaN for older runs;
   several policies' ``episodes.jsonl`` concatenated give the ablation rows).
 * ``table_speeds``: success rate per commanded forward speed (rows terrain x scenario).
 * ``table_transition``: on the layered ``transition`` course, per (scenario, medium): episodes that reached the
@@ -31,7 +32,8 @@ __all__ = [
 
 TERRAIN_COLUMNS = ("policy", "terrain", "scenario", "episodes", "success_rate_pct", "success_lo95_pct",
                    "success_hi95_pct", "vel_error_mps",
-                   "yaw_error_radps", "path_error_m", "mean_sinkage_cm", "swing_apex_cm", "swing_lift_cm")  # fmt: skip
+                   "yaw_error_radps", "path_error_m", "mean_sinkage_cm", "swing_apex_cm", "swing_lift_cm",
+                   "window_exit_pct")  # fmt: skip
 """Columns of ``table_terrains``."""
 
 
@@ -73,7 +75,8 @@ def table_terrains(rows: list[dict[str, Any]], policy: str) -> list[list[Any]]:
         out.append([policy, terrain, scenario, len(rs), 100.0 * _mean(rs, "success"), 100.0 * lo, 100.0 * hi,
                     _mean(rs, "vel_error"),
                     _mean(rs, "yaw_error"), _mean(rs, "path_error"), 100.0 * _mean(rs, "mean_sinkage"),
-                    100.0 * _mean(rs, "swing_apex"), 100.0 * _mean(rs, "swing_lift")])  # fmt: skip
+                    100.0 * _mean(rs, "swing_apex"), 100.0 * _mean(rs, "swing_lift"),
+                    100.0 * _mean(rs, "window_exit_early")])  # fmt: skip
     return out
 
 

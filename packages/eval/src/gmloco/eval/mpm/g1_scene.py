@@ -46,6 +46,7 @@ from gmloco.eval.mpm.window_terrain import TerrainCfg, terrain_materials, terrai
 
 __all__ = [
     "LOG_FIELDS",
+    "SOLE_NEAR_M",
     "G1MpmScene",
     "G1MpmSceneCfg",
     "MjlabOnnxPolicy",
@@ -54,11 +55,37 @@ __all__ = [
     "StudentOnnxPolicy",
     "g1_mjcf_path",
     "quat_rotate_inv",
+    "soles_outside",
 ]
 
 LOG_FIELDS = ("base_q", "base_qd", "foot_force", "sinkage", "foot_sinkage", "joint_q", "joint_qd", "target", "action",
-              "eta")  # fmt: skip
+              "eta", "sole_out")  # fmt: skip
 """The per-robot logs :class:`G1MpmScene` appends at the policy rate (one ``[R, ...]`` array per sample each)."""
+
+
+SOLE_NEAR_M = 0.02
+"""A sole corner this close above the local sand surface, or below it, needs sand under it [m] (``soles_outside``)."""
+
+
+def soles_outside(
+    corners: np.ndarray, surface: np.ndarray, bounds: np.ndarray, near: float = SOLE_NEAR_M
+) -> np.ndarray:
+    """Sole corners that need sand under them but lie outside their robot's sand window, per robot.
+
+    Args:
+        corners: World sole corners [m], [R, 2, 8, 3].
+        surface: Sand surface height under each corner [m], [R, 2, 8].
+        bounds: Window boxes [m], [R, 2, 2]: (lower, upper) xy corners (``SandWindow.bounds``).
+        near: Height above the surface below which a corner counts [m].
+
+    Returns:
+        Number of such corners per robot, [R] (0 when the soles are over sand or in the air).
+    """
+    x, y = corners[..., 0], corners[..., 1]
+    lo, hi = bounds[:, None, None, 0, :], bounds[:, None, None, 1, :]
+    out = (x < lo[..., 0]) | (x > hi[..., 0]) | (y < lo[..., 1]) | (y > hi[..., 1])
+    low = corners[..., 2] - surface <= near
+    return (out & low).reshape(len(corners), -1).sum(axis=1)
 
 
 FOOT_BODIES = ("left_ankle_roll_link", "right_ankle_roll_link")
@@ -183,6 +210,8 @@ class G1MpmScene:
         self.target: list[np.ndarray] = []
         self.action: list[np.ndarray] = []
         self.eta: list[np.ndarray] = []
+        self.sole_out: list[np.ndarray] = []
+        """Per sample: sole corners per robot that need sand but lie outside the window (``soles_outside``)."""
 
     @property
     def particle_count(self) -> int:
@@ -397,6 +426,7 @@ class G1MpmScene:
         self.target.append(target)
         self.action.append(self.last_action.copy())
         self.eta.append(self._decoded_eta())
+        self.sole_out.append(soles_outside(corners, surf, self.window.bounds()))
 
     def _decoded_eta(self) -> np.ndarray:
         """The student's decoded terrain stiffness after its last step, [R] (NaN for policies without one)."""
