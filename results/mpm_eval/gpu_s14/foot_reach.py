@@ -5,8 +5,10 @@ For each recording (the first episode of every speed that a table row kept, ``re
 corners are placed by forward kinematics (MuJoCo, mjlab's G1 MJCF, the sole boxes of ``SoleCfg``) from the
 logged base pose and joint angles, and expressed in the pelvis' yaw frame (x forward). Only frames where a corner
 is below ``--near`` above the sand surface (z = 0) count: those are the ones that need sand under them. Prints,
-per recording, the reach behind / ahead of the pelvis and sideways, and writes ``foot_reach.json`` and
-``fig_foot_reach.png`` with the edges of the windows that were checked.
+per recording, the reach behind / ahead of the pelvis and sideways, the share of those corners outside each window
+and the first time one was (compare with the recording's length: a fall ends it), and writes ``foot_reach.json``
+and ``fig_foot_reach.png`` with the edges of the windows. (Since session 14 every ``g1_eval`` episode records the
+same check against its own window, ``window_exit_s``; this script covers the runs recorded before.)
 
     uv run python results/mpm_eval/gpu_s14/foot_reach.py --runs results/mpm_eval/gpu_s13/runs/table_td_dry_sand
 """
@@ -53,7 +55,7 @@ def reach(path: Path, near: float) -> dict:
     addr = [model.jnt_qposadr[model.joint(name).id] for name in log.joint_names]
     feet = [model.body(f"{side}_ankle_roll_link").id for side in ("left", "right")]
     local = sole_corners_local()
-    rel = []
+    rel, first_exit = [], {}
     for k, t in enumerate(t_q):
         i = min(int(np.searchsorted(t_o, t)), len(t_o) - 1)
         data.qpos[:3], data.qpos[3:7] = pos[i], quat[i]
@@ -67,6 +69,9 @@ def reach(path: Path, near: float) -> dict:
         c, s = np.cos(yaw), np.sin(yaw)
         d = corners[corners[:, 2] <= near][:, :2] - pos[i][:2]
         rel.append(np.stack([c * d[:, 0] + s * d[:, 1], -s * d[:, 0] + c * d[:, 1]], axis=1))
+        for name, w in WINDOWS.items():
+            if name not in first_exit and _outside(rel[-1], *w).any():
+                first_exit[name] = round(float(t - t_q[0]), 2)
     pts = np.concatenate(rel) if rel else np.zeros((0, 2))
     if not len(pts):
         return {"recording": str(path), "frames": 0}
@@ -76,6 +81,7 @@ def reach(path: Path, near: float) -> dict:
         "behind_p1_m": float(-np.percentile(pts[:, 0], 1)), "ahead_p99_m": float(np.percentile(pts[:, 0], 99)),
         "side_m": float(np.abs(pts[:, 1]).max()),
         "outside": {name: float(np.mean(_outside(pts, *w))) for name, w in WINDOWS.items()},
+        "first_exit_s": {name: first_exit.get(name) for name in WINDOWS},
         "points": pts[:: max(1, len(pts) // 4000)].round(4).tolist(),
     }  # fmt: skip
 
@@ -86,27 +92,35 @@ def _outside(pts: np.ndarray, length: float, width: float, lead: float) -> np.nd
 
 
 def figure(rows: list[dict], path: Path) -> None:
-    """The sole points of each recording in the pelvis' yaw frame, with the windows' outlines."""
+    """The sole points of each recording in the pelvis' yaw frame, with the windows' outlines; a row per run."""
     import matplotlib
 
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
     rows = [r for r in rows if r["frames"]]
-    fig, axes = plt.subplots(1, len(rows), figsize=(3.2 * len(rows), 3.8), sharey=True, constrained_layout=True)
-    for ax, r in zip(np.atleast_1d(axes), rows, strict=True):
-        p = np.array(r["points"])
-        ax.plot(p[:, 0], p[:, 1], ".", ms=1, alpha=0.3, color="k")
-        for (name, (length, width, lead)), color in zip(WINDOWS.items(), ("C0", "C1", "C3", "C2", "C4"), strict=True):
-            x0 = lead - length / 2
-            ax.add_patch(plt.Rectangle((x0, -width / 2), length, width, fill=False, ec=color, label=name))
-        title = f"{Path(r['recording']).parents[1].name.removeprefix('table_')}\n{Path(r['recording']).stem.split('__')[-1]}"
-        ax.set(title=title, xlabel="x ahead of the pelvis [m]", aspect="equal", xlim=(-0.85, 0.95))
-        ax.title.set_fontsize(7)
-    np.atleast_1d(axes)[0].set_ylabel("y [m]")
-    np.atleast_1d(axes)[0].legend(fontsize=6, loc="lower left")
-    fig.suptitle("sole corners within 2 cm of the sand surface, pelvis yaw frame, against the windows", fontsize=9)
-    fig.savefig(path, dpi=120)
+    runs = list(dict.fromkeys(Path(r["recording"]).parents[1].name for r in rows))
+    cols = max(sum(Path(r["recording"]).parents[1].name == run for r in rows) for run in runs)
+    fig, axes = plt.subplots(len(runs), cols, figsize=(3.0 * cols, 1.9 * len(runs) + 0.6), sharex=True, sharey=True,
+                             constrained_layout=True, squeeze=False)  # fmt: skip
+    for i, run in enumerate(runs):
+        for j, r in enumerate(r for r in rows if Path(r["recording"]).parents[1].name == run):
+            ax, p = axes[i, j], np.array(r["points"])
+            ax.plot(p[:, 0], p[:, 1], ".", ms=1, alpha=0.3, color="k")
+            for (name, (length, width, lead)), color in zip(
+                WINDOWS.items(), ("C0", "C1", "C3", "C2", "C4"), strict=True
+            ):
+                x0 = lead - length / 2
+                ax.add_patch(plt.Rectangle((x0, -width / 2), length, width, fill=False, ec=color, lw=0.8, label=name))
+            speed = Path(r["recording"]).stem.split("__v")[-1]
+            ax.set_title(f"{run.removeprefix('table_')}, {speed} m/s ({r['duration_s']:.1f} s)", fontsize=7)
+            ax.set(xlim=(-0.85, 0.95), ylim=(-0.45, 0.45), aspect="equal")
+        axes[i, 0].set_ylabel("y [m]")
+    for ax in axes[-1]:
+        ax.set_xlabel("x ahead of the pelvis [m]")
+    axes[0, 0].legend(fontsize=5, loc="lower left")
+    fig.suptitle("sole corners within 2 cm of the sand surface (pelvis yaw frame) against the sand windows", fontsize=9)
+    fig.savefig(path, dpi=110)
     plt.close(fig)
 
 
@@ -125,8 +139,8 @@ def main() -> None:
             if r["frames"]:
                 print(f"{rec}: {r['frames']} frames over {r['duration_s']:.1f} s; behind {r['behind_m']:.2f} m "
                       f"(1 %: {r['behind_p1_m']:.2f}), ahead {r['ahead_m']:.2f} m (99 %: {r['ahead_p99_m']:.2f}), "
-                      f"side {r['side_m']:.2f} m; outside: "
-                      + ", ".join(f"{k.split(',')[0]} {100 * v:.1f} %" for k, v in r["outside"].items()))  # fmt: skip
+                      f"side {r['side_m']:.2f} m; outside (first exit [s]): "
+                      + ", ".join(f"{k} {100 * v:.1f} % ({r['first_exit_s'][k]})" for k, v in r["outside"].items()))  # fmt: skip
     (a.out / "foot_reach.json").write_text(
         json.dumps([{k: v for k, v in r.items() if k != "points"} for r in rows], indent=1) + "\n"
     )
