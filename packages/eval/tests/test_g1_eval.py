@@ -72,7 +72,10 @@ def test_swing_clearance_of_a_stepping_foot() -> None:
 
 
 def test_a_sole_outside_the_sand_window_flags_the_episode() -> None:
-    """A sole outside its window from step 30 of a 100-step walk: exit at 0.6 s, flagged; in the last 0.25 s: not."""
+    """A sole outside its window from step 30 of a 100-step walk: exit at 0.6 s, flagged; in the last 0.25 s: not.
+
+    The soles' reach is the largest over the samples with a sole near the sand (NaN samples skipped).
+    """
     cfg = replace(G1EvalCfg(), episode_s=2.0)
     dt, n = 0.02, 100
     t = (np.arange(n) + 1) * dt
@@ -85,8 +88,12 @@ def test_a_sole_outside_the_sand_window_flags_the_episode() -> None:
     assert math.isclose(row["window_exit_s"], 0.6) and row["window_exit_early"]
     log["sole_out"][:] = 0
     log["sole_out"][n - 10 :] = 2  # during the last 0.2 s of the episode: the fall's last moments, not flagged
+    log["sole_reach"] = np.tile([0.3, 0.15, 0.2], (n, 1))
+    log["sole_reach"][40] = [0.45, 0.1, 0.25]
+    log["sole_reach"][50] = np.nan  # both soles in the air
     row = score_episode(EpisodeSpec("dry_sand", "straight", 1.0, 0), cfg, log)
     assert math.isclose(row["window_exit_s"], (n - 10) * dt) and not row["window_exit_early"]
+    assert (row["sole_behind_m"], row["sole_ahead_m"], row["sole_side_m"]) == (0.45, 0.15, 0.25)
 
 
 def test_standing_still_times_out_and_fall_fails() -> None:

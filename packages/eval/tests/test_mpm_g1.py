@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 
 from gmloco.eval.mpm.box_scene import MpmSolverCfg, frame_dt_problem
-from gmloco.eval.mpm.g1_scene import G1MpmScene, G1MpmSceneCfg, MjlabOnnxPolicy, soles_outside
+from gmloco.eval.mpm.g1_scene import G1MpmScene, G1MpmSceneCfg, MjlabOnnxPolicy, sole_reach, soles_outside
 from gmloco.eval.mpm.window import SandWindowCfg
 
 POLICY = Path(__file__).resolve().parents[3] / "artifacts" / "ppo_rft3d" / "policy.onnx"
@@ -38,6 +38,19 @@ def test_soles_outside_counts_low_corners_beyond_the_window() -> None:
     assert soles_outside(corners, surface, bounds).tolist() == [0]
     corners[0, 1, :, 2], corners[0, 1, :, 0], corners[0, 1, :, 1] = -0.03, 0.5, 0.6  # sunk, beside the window
     assert soles_outside(corners, surface, bounds).tolist() == [8]
+
+
+def test_sole_reach_is_measured_in_the_pelvis_yaw_frame() -> None:
+    """Pelvis at (1, 2) facing +y: a corner at y = 2.5 is 0.5 m ahead, one at x = 0.7 is 0.3 m to the side."""
+    yaw90 = [0.0, 0.0, np.sin(np.pi / 4), np.cos(np.pi / 4)]  # x y z w
+    base_q = np.array([[1.0, 2.0, 0.7, *yaw90], [1.0, 2.0, 0.7, *yaw90]])
+    corners = np.zeros((2, 2, 8, 3))
+    corners[..., 0], corners[..., 1] = 1.0, 2.0
+    corners[0, 0, 0, 1], corners[0, 0, 1, 1], corners[0, 1, 2, 0] = 2.5, 1.8, 0.7
+    corners[1, ..., 2] = 0.1  # robot 1: both soles 10 cm up
+    reach = sole_reach(corners, np.zeros((2, 2, 8)), base_q)
+    np.testing.assert_allclose(reach[0], [0.2, 0.5, 0.3], atol=1e-12)
+    assert np.isnan(reach[1]).all()
 
 
 def test_policy_metadata_layout() -> None:
@@ -91,6 +104,8 @@ def test_moving_window_keeps_standing_sinkage() -> None:
         pytest.skip(f"no exported policy at {POLICY}")
     static, moving = _standing(False), _standing(True, num_robots=2)
     assert not np.asarray(moving.sole_out).any() and not np.asarray(static.sole_out).any()  # soles over sand
+    behind, ahead, side = np.nanmax(np.asarray(static.sole_reach)[:, 0], axis=0)  # standing: heel, toe, outer edge
+    assert 0.02 < behind < 0.1 and 0.1 < ahead < 0.17 and 0.08 < side < 0.2, (behind, ahead, side)
     lo_x = moving.window.bounds()[:, 0, 0]
     np.testing.assert_allclose(lo_x, [-0.35, -0.35], atol=1e-6)  # the window did move (was -0.45)
     s_static, s_moving = np.asarray(static.sinkage)[:, 0], np.asarray(moving.sinkage)

@@ -16,6 +16,8 @@ with :mod:`gmloco.eval.metrics.locomotion`:
   |w_z - w_cmd| over alive steps; path error: DTW between executed and commanded xy paths (alive part).
 * swing clearance: mean apex of the completed swings above the local surface and their lift above the stance
   before (``swing_clearance``: a foot is in swing while its sand force is below 40 N).
+* window size needed: ``sole_behind_m`` / ``sole_ahead_m`` / ``sole_side_m``, the soles' largest reach from the
+  pelvis (its yaw frame) while a corner is within 2 cm of the surface; summaries give their means per group.
 * window check: ``window_exit_s``, the first time a sole corner within 2 cm of the surface lay outside its robot's
   sand window (no particles there), and ``window_exit_early`` when that was more than ``WINDOW_EXIT_GRACE_S`` before
   the episode ended; its rate is in the summary and the terrain table, and a run warns about it.
@@ -68,6 +70,7 @@ __all__ = [
     "run",
     "run_cell",
     "score_episode",
+    "sole_reach_max",
     "window_exit_time",
 ]  # fmt: skip
 
@@ -391,6 +394,7 @@ def score_episode(spec: EpisodeSpec, cfg: G1EvalCfg, log: dict[str, Any]) -> dic
     swing = swing_clearance(-np.asarray(log["foot_sinkage"]), np.asarray(log["foot_force"])[..., 2], alive)
     eta = np.asarray(log.get("eta", np.full(len(q), np.nan)), dtype=float)[:alive]
     exit_s = window_exit_time(log.get("sole_out"), dt, alive)
+    behind, ahead, side = sole_reach_max(log.get("sole_reach"), alive)
     return {
         "key": spec.key, "terrain": spec.terrain, "scenario": spec.scenario, "speed": spec.speed,
         "success": out.success, "reason": out.reason, "alive_s": out.alive_steps * dt,
@@ -407,6 +411,8 @@ def score_episode(spec: EpisodeSpec, cfg: G1EvalCfg, log: dict[str, Any]) -> dic
         # a sole that needed sand stood outside its sand window (no particles there): the window was too small
         "window_exit_s": exit_s,
         "window_exit_early": exit_s is not None and exit_s < out.alive_steps * dt - WINDOW_EXIT_GRACE_S,
+        # how much window the soles needed: their reach from the pelvis (yaw frame) while near or in the sand
+        "sole_behind_m": behind, "sole_ahead_m": ahead, "sole_side_m": side,
         # a sole reached the rigid floor under the sand (the soles stand on it): the bed was too shallow there
         "floor_reached": bool(len(sink) and np.max(sink) >= log.get("depth", math.inf) - 0.005),
         "particles": log["particles"], "batch_size": log.get("batch_size", 1), "build_s": log["build_s"],
@@ -428,6 +434,18 @@ def window_exit_time(sole_out: Any, dt: float, alive: int) -> float | None:
     counts = np.asarray(sole_out, dtype=float).reshape(len(sole_out), -1).sum(axis=1)[:alive]
     hit = np.flatnonzero(counts > 0)
     return float(hit[0] * dt) if len(hit) else None
+
+
+def sole_reach_max(reach: Any, alive: int) -> tuple[float, float, float]:
+    """Largest reach of the soles behind / ahead of / beside the pelvis over the alive samples [m] (``sole_reach``).
+
+    ``reach``: per-sample [T, 3]; NaN entries (soles in the air) are skipped; NaNs when absent (older logs).
+    """
+    arr = None if reach is None else np.asarray(reach, dtype=float)
+    if arr is None or arr.ndim != 2 or arr.shape[1] != 3 or not np.isfinite(arr[:alive]).any():
+        return math.nan, math.nan, math.nan
+    b, a, s = np.nanmax(arr[:alive], axis=0)
+    return float(b), float(a), float(s)
 
 
 def layer_stats(log: dict[str, Any], alive: int) -> list[dict[str, Any]] | None:
@@ -474,7 +492,7 @@ def _runs(mask: np.ndarray) -> list[tuple[int, int]]:
 
 METRIC_KEYS = (
     "success", "vel_error", "yaw_error", "path_error", "support_ratio", "max_sinkage", "mean_sinkage", "floor_reached",
-    "swing_apex", "swing_lift", "eta_mean", "window_exit_early",
+    "swing_apex", "swing_lift", "eta_mean", "window_exit_early", "sole_behind_m", "sole_ahead_m", "sole_side_m",
 )  # fmt: skip
 
 
@@ -600,10 +618,13 @@ def _warn_window_exits(rows: list[dict[str, Any]]) -> None:
     early = [r for r in rows if r.get("window_exit_early")]
     if early:
         worst = min(early, key=lambda r: r["window_exit_s"])
+        reach = [max((r.get(k, math.nan) for r in rows if math.isfinite(r.get(k, math.nan))), default=math.nan)
+                 for k in ("sole_behind_m", "sole_ahead_m", "sole_side_m")]  # fmt: skip
         print(f"warning: in {len(early)} of {len(rows)} episodes a sole that needed sand stood outside its sand window "
               f"more than {WINDOW_EXIT_GRACE_S} s before the episode ended (first at {worst['window_exit_s']:.2f} s, "
-              f"{worst['key']}): those walks lost their support to the window, not to the sand. Lengthen the window "
-              "or move it back (--window-length, --window-lead; soles trail the pelvis further than they lead it)",
+              f"{worst['key']}): those walks lost their support to the window, not to the sand. The soles reached "
+              f"{reach[0]:.2f} m behind the pelvis, {reach[1]:.2f} m ahead and {reach[2]:.2f} m sideways: lengthen "
+              "the window or move it back (--window-length, --window-lead, --window-width)",
               file=sys.stderr, flush=True)  # fmt: skip
 
 

@@ -55,11 +55,12 @@ __all__ = [
     "StudentOnnxPolicy",
     "g1_mjcf_path",
     "quat_rotate_inv",
+    "sole_reach",
     "soles_outside",
 ]
 
 LOG_FIELDS = ("base_q", "base_qd", "foot_force", "sinkage", "foot_sinkage", "joint_q", "joint_qd", "target", "action",
-              "eta", "sole_out")  # fmt: skip
+              "eta", "sole_out", "sole_reach")  # fmt: skip
 """The per-robot logs :class:`G1MpmScene` appends at the policy rate (one ``[R, ...]`` array per sample each)."""
 
 
@@ -86,6 +87,32 @@ def soles_outside(
     out = (x < lo[..., 0]) | (x > hi[..., 0]) | (y < lo[..., 1]) | (y > hi[..., 1])
     low = corners[..., 2] - surface <= near
     return (out & low).reshape(len(corners), -1).sum(axis=1)
+
+
+def sole_reach(corners: np.ndarray, surface: np.ndarray, base_q: np.ndarray, near: float = SOLE_NEAR_M) -> np.ndarray:
+    """How far the sole corners that need sand lie from the pelvis, in its yaw frame (x forward), per robot.
+
+    Args:
+        corners: World sole corners [m], [R, 2, 8, 3].
+        surface: Sand surface height under each corner [m], [R, 2, 8].
+        base_q: Pelvis poses (position, quaternion x y z w), [R, 7].
+        near: Height above the surface below which a corner counts [m].
+
+    Returns:
+        [R, 3]: reach behind the pelvis, ahead of it, and sideways (largest |y|) [m]; NaN for a robot whose soles are
+        all higher than ``near`` above the sand.
+    """
+    x, y, z, w = (base_q[:, k] for k in (3, 4, 5, 6))
+    yaw = np.arctan2(2.0 * (w * z + x * y), 1.0 - 2.0 * (y * y + z * z))
+    c, s = np.cos(yaw)[:, None, None], np.sin(yaw)[:, None, None]
+    dx, dy = corners[..., 0] - base_q[:, None, None, 0], corners[..., 1] - base_q[:, None, None, 1]
+    fwd, side = c * dx + s * dy, -s * dx + c * dy
+    low = corners[..., 2] - surface <= near
+    out = np.full((len(corners), 3), np.nan)
+    for r in np.flatnonzero(low.reshape(len(corners), -1).any(axis=1)):
+        f, sd = fwd[r][low[r]], side[r][low[r]]
+        out[r] = (-f.min(), f.max(), np.abs(sd).max())
+    return out
 
 
 FOOT_BODIES = ("left_ankle_roll_link", "right_ankle_roll_link")
@@ -211,6 +238,8 @@ class G1MpmScene:
         self.action: list[np.ndarray] = []
         self.eta: list[np.ndarray] = []
         self.sole_out: list[np.ndarray] = []
+        self.sole_reach: list[np.ndarray] = []
+        """Per sample: reach of the soles that need sand behind / ahead of / beside the pelvis (``sole_reach``)."""
         """Per sample: sole corners per robot that need sand but lie outside the window (``soles_outside``)."""
 
     @property
@@ -427,6 +456,7 @@ class G1MpmScene:
         self.action.append(self.last_action.copy())
         self.eta.append(self._decoded_eta())
         self.sole_out.append(soles_outside(corners, surf, self.window.bounds()))
+        self.sole_reach.append(sole_reach(corners, surf, st["base_q"]))
 
     def _decoded_eta(self) -> np.ndarray:
         """The student's decoded terrain stiffness after its last step, [R] (NaN for policies without one)."""
