@@ -96,6 +96,19 @@ def test_a_sole_outside_the_sand_window_flags_the_episode() -> None:
     assert (row["sole_behind_m"], row["sole_ahead_m"], row["sole_side_m"]) == (0.45, 0.15, 0.25)
 
 
+def test_a_circle_gets_a_square_moving_window() -> None:
+    """The window does not turn with the robot: on a circle it is max(length, width) square; straight it is as set."""
+    from gmloco.eval.g1_eval import _window_and_lanes
+
+    cfg = G1EvalCfg()
+    straight, lane_s = _window_and_lanes([EpisodeSpec("dry_sand", "straight", 1.0, 0)], cfg)
+    circle, lane_c = _window_and_lanes([EpisodeSpec("dry_sand", "circle", 1.0, 0)], cfg)
+    assert (straight.length, straight.width) == (cfg.window.length, cfg.window.width)
+    side = max(cfg.window.length, cfg.window.width)
+    assert (circle.length, circle.width, circle.lead) == (side, side, cfg.window.lead)
+    assert lane_c == side + 2.0 * cfg.circle_radius + cfg.lane_gap and lane_s == cfg.window.width + cfg.lane_gap
+
+
 def test_standing_still_times_out_and_fall_fails() -> None:
     """Standing at 1 m/s command: timeout with velocity error 1; base at 0.1 m from step 10: base-height failure."""
     cfg = replace(G1EvalCfg(), episode_s=2.0)

@@ -189,11 +189,21 @@ def command(spec: EpisodeSpec, cfg: G1EvalCfg) -> tuple[float, float, float]:
 
 
 def _window_and_lanes(batch: list[EpisodeSpec], cfg: G1EvalCfg) -> tuple[SandWindowCfg, float]:
-    """The batch's sand window (static: covering the fastest course) and its lane spacing [m]."""
+    """The batch's sand window and its lane spacing [m].
+
+    A moving window is a box of the sand grid's axes that follows the pelvis (centred ``lead`` along its heading);
+    it does not turn with the robot. On a circle the heading sweeps all directions, so the window becomes a square
+    of side ``max(length, width)``: along any heading it then reaches at least as far as the straight window does
+    along x, at ``(side / width)`` times its cost. A static window covers the fastest course.
+    """
     circle = batch[0].scenario == "circle"
     if cfg.window.moving:
-        span = cfg.window.width + (2.0 * cfg.circle_radius if circle else 0.0)
-        return cfg.window, span + cfg.lane_gap
+        window = cfg.window
+        if circle:
+            side = max(window.length, window.width)
+            window = replace(window, length=side, width=side)
+        span = window.width + (2.0 * cfg.circle_radius if circle else 0.0)
+        return window, span + cfg.lane_gap
     v = max(s.speed for s in batch)
     vx, _, wz = command(replace(batch[0], speed=v), cfg)
     xy, _ = circular_path(vx, wz, cfg.episode_s, 0.05)
