@@ -51,6 +51,8 @@ def test_sole_reach_is_measured_in_the_pelvis_yaw_frame() -> None:
     reach = sole_reach(corners, np.zeros((2, 2, 8)), base_q)
     np.testing.assert_allclose(reach[0], [0.2, 0.5, 0.3], atol=1e-12)
     assert np.isnan(reach[1]).all()
+    corners[..., 2] = 0.1  # every sole in the air
+    assert np.isnan(sole_reach(corners, np.zeros((2, 2, 8)), base_q)).all()
 
 
 def test_policy_metadata_layout() -> None:

@@ -30,21 +30,12 @@ WINDOWS = {  # name: (length, width, lead) [m]; x spans lead -/+ length / 2 arou
 }
 
 
-def sole_corners_local() -> np.ndarray:
-    """The 8 corners of a sole box in its ankle-roll frame [m], [8, 3]."""
-    from gmloco.eval.mpm.g1_scene import SoleCfg
-
-    c, h = np.array(SoleCfg.center), np.array(SoleCfg.half_extents)
-    signs = np.array([[sx, sy, sz] for sx in (-1, 1) for sy in (-1, 1) for sz in (-1, 1)], dtype=float)
-    return c + signs * h
-
-
 def reach(path: Path, near: float) -> dict:
     """Reach of the soles relative to the pelvis (yaw frame) over the frames a corner is near or in the sand."""
     import mujoco
 
     from gmloco.deploy.logs.reader import read_log
-    from gmloco.eval.mpm.g1_scene import g1_mjcf_path
+    from gmloco.eval.mpm.g1_scene import SoleCfg, g1_mjcf_path, sole_box_corners
 
     log = read_log(path)
     t_q, q = log.signal("lowstate.q")
@@ -54,7 +45,7 @@ def reach(path: Path, near: float) -> dict:
     data = mujoco.MjData(model)
     addr = [model.jnt_qposadr[model.joint(name).id] for name in log.joint_names]
     feet = [model.body(f"{side}_ankle_roll_link").id for side in ("left", "right")]
-    local = sole_corners_local()
+    local = sole_box_corners(SoleCfg())
     rel, first_exit = [], {}
     for k, t in enumerate(t_q):
         i = min(int(np.searchsorted(t_o, t)), len(t_o) - 1)

@@ -55,6 +55,7 @@ __all__ = [
     "StudentOnnxPolicy",
     "g1_mjcf_path",
     "quat_rotate_inv",
+    "sole_box_corners",
     "sole_reach",
     "soles_outside",
 ]
@@ -89,6 +90,12 @@ def soles_outside(
     return (out & low).reshape(len(corners), -1).sum(axis=1)
 
 
+def sole_box_corners(sole: SoleCfg) -> np.ndarray:
+    """The 8 corners of a sole box in its ankle-roll frame [m], [8, 3]."""
+    signs = np.array([[sx, sy, sz] for sx in (-1, 1) for sy in (-1, 1) for sz in (-1, 1)], dtype=float)
+    return np.array(sole.center) + signs * np.array(sole.half_extents)
+
+
 def sole_reach(corners: np.ndarray, surface: np.ndarray, base_q: np.ndarray, near: float = SOLE_NEAR_M) -> np.ndarray:
     """How far the sole corners that need sand lie from the pelvis, in its yaw frame (x forward), per robot.
 
@@ -109,9 +116,12 @@ def sole_reach(corners: np.ndarray, surface: np.ndarray, base_q: np.ndarray, nea
     fwd, side = c * dx + s * dy, -s * dx + c * dy
     low = corners[..., 2] - surface <= near
     out = np.full((len(corners), 3), np.nan)
-    for r in np.flatnonzero(low.reshape(len(corners), -1).any(axis=1)):
-        f, sd = fwd[r][low[r]], side[r][low[r]]
-        out[r] = (-f.min(), f.max(), np.abs(sd).max())
+    some = low.reshape(len(corners), -1).any(axis=1)
+    if not some.any():
+        return out
+    f = np.where(low, fwd, np.nan)[some].reshape(int(some.sum()), -1)
+    sd = np.where(low, np.abs(side), np.nan)[some].reshape(int(some.sum()), -1)
+    out[some] = np.stack([-np.nanmin(f, axis=1), np.nanmax(f, axis=1), np.nanmax(sd, axis=1)], axis=1)
     return out
 
 
@@ -335,8 +345,7 @@ class G1MpmScene:
 
     def _sole_corners(self, body_q: np.ndarray) -> np.ndarray:
         """World corners of every sole box [m], [R, 2, 8, 3]."""
-        c, h = np.array(self.cfg.sole.center), np.array(self.cfg.sole.half_extents)
-        local = c + h * np.array([[sx, sy, sz] for sx in (-1, 1) for sy in (-1, 1) for sz in (-1, 1)])
+        local = sole_box_corners(self.cfg.sole)
         pose = body_q[self.foot_bodies]  # [R, 2, 7]
         quat = np.broadcast_to(pose[:, :, None, 3:7], (*pose.shape[:2], 8, 4))
         return quat_rotate_inv(_conj(quat), np.broadcast_to(local, (*quat.shape[:-1], 3))) + pose[:, :, None, :3]
