@@ -10,14 +10,30 @@
 #   (2) The per-terrain table's first row beyond dry sand: the td student on poppy seed, straight, 1.0-2.5 m/s,
 #       100 episodes (~17-19 min at the small window), time-boxed and resumable (carry the run folder back under
 #       .devsrc/row/<name> and it continues from its episodes.jsonl).
-# Usage (in ~/src, after the wheels and the Warp cache): bash job_next.sh END_EPOCH
+#   part b (a second machine): the rows of ppo_rigid and the clr50 student again (falling policies, ~8 min each),
+#       at the window part a accepted (pass its flags as the third argument; none = the default window).
+# Usage (in ~/src, after the wheels and the Warp cache): bash job_next.sh END_EPOCH [a|b] ["WINDOW FLAGS"]
 END=$1
+PART=${2:-a}
 cd ~/src && source scripts/gpu/env.sh && mkdir -p ~/chunks/g1_eval
 [ -d ~/src/.devsrc/row ] && cp -r ~/src/.devsrc/row/* ~/chunks/g1_eval/
 log() { echo "$* at $(date +%T)" >> ~/chunks/job.log; }
 left() { python3 -c "import time;print(round(($END-time.time())/60 - $1,2))"; }
 POL=artifacts/gm_loco_student_td/policy.onnx
-log "start"
+log "start part $PART"
+if [ "$PART" = b ]; then
+  WIN=${3:-}
+  for R in "table_ppo_rigid_dry_sand artifacts/ppo_rigid/policy.onnx" "table_clr50_dry_sand artifacts/gm_loco_student_clr50/policy.onnx"; do
+    set -- $R
+    M=$(left 0.7)
+    timeout $(python3 -c "print(int(max(30,$M*60+20)))") python3 -m gmloco.eval.g1_eval_cli --policy $2 \
+      --terrains dry_sand --scenarios straight --speeds 1.0 1.5 2.0 2.5 --num-episodes 100 --robots-per-batch 36 \
+      $WIN --max-minutes $M --out $HOME/chunks/g1_eval/$1 >> ~/chunks/g1_eval/$1.log 2>&1
+    log "row $1 rc=$?"
+  done
+  touch ~/chunks/DONE
+  exit 0
+fi
 for W in "1.0 0.5 -0.1" "1.4 0.6 0.2"; do
   set -- $W
   L=td_v0.03_it500_d0.3_l${1}_w${2}_lead${3}_r16_5s_v1.5
