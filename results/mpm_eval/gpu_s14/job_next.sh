@@ -11,7 +11,8 @@
 #       100 episodes (~17-19 min at the small window), time-boxed and resumable (carry the run folder back under
 #       .devsrc/row/<name> and it continues from its episodes.jsonl).
 #   part b (a second machine): the rows of ppo_rigid and the clr50 student again (falling policies, ~8 min each),
-#       at the window part a accepted (pass its flags as the third argument; none = the default window).
+#       at the window part a accepted (pass its flags as the third argument; none = the default window). Start
+#       them fresh: do not carry session 14's folders of these rows (another window) under .devsrc/row/.
 # Usage (in ~/src, after the wheels and the Warp cache): bash job_next.sh END_EPOCH [a|b] ["WINDOW FLAGS"]
 END=$1
 PART=${2:-a}
