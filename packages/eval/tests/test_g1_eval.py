@@ -24,6 +24,7 @@ from gmloco.eval.g1_eval import (
     summarize,
 )
 from gmloco.eval.mpm.g1_scene import LOG_FIELDS
+from gmloco.eval.mpm.window import SandWindowCfg
 from gmloco.eval.tables_mpm import table_speeds, table_terrains
 
 
@@ -94,6 +95,30 @@ def test_a_sole_outside_the_sand_window_flags_the_episode() -> None:
     row = score_episode(EpisodeSpec("dry_sand", "straight", 1.0, 0), cfg, log)
     assert math.isclose(row["window_exit_s"], (n - 10) * dt) and not row["window_exit_early"]
     assert (row["sole_behind_m"], row["sole_ahead_m"], row["sole_side_m"]) == (0.45, 0.15, 0.25)
+
+
+def test_a_run_reports_the_soles_reach_against_its_window(capsys: pytest.CaptureFixture[str]) -> None:
+    """The largest reach over the episodes against the window's extent; a warning names the earliest exit."""
+    from gmloco.eval.g1_eval import _report_window
+
+    rows = [
+        {
+            "key": f"k{i}",
+            "sole_behind_m": b,
+            "sole_ahead_m": 0.15,
+            "sole_side_m": 0.2,
+            "window_exit_s": e,
+            "window_exit_early": e is not None,
+        }
+        for i, (b, e) in enumerate([(0.3, None), (0.62, 0.8), (0.55, 0.5)])
+    ]
+    _report_window(rows, SandWindowCfg(length=1.0, width=0.5, lead=0.1))
+    err = capsys.readouterr().err
+    assert "0.62 m behind the pelvis, 0.15 m ahead and 0.20 m sideways" in err
+    assert "spans 0.40 m behind, 0.60 m ahead and 0.25 m sideways" in err
+    assert "in 2 of 3 episodes" in err and "first at 0.50 s, k2" in err
+    _report_window(rows[:1], SandWindowCfg(length=1.0, width=0.5, lead=0.1))
+    assert "warning" not in capsys.readouterr().err
 
 
 def test_a_circle_gets_a_square_moving_window() -> None:

@@ -617,24 +617,31 @@ def run(cfg: G1EvalCfg) -> tuple[dict[str, float], bool]:
     summary["throughput/episodes_this_call"] = float(len(rows) - len(done))
     summary["throughput/episodes_per_minute"] = 60.0 * (len(rows) - len(done)) / max(wall, 1e-9)
     _write_outputs(out, cfg, rows, summary, complete)
-    _warn_window_exits(rows)
+    _report_window(rows, cfg.window)
     return summary, complete
 
 
-def _warn_window_exits(rows: list[dict[str, Any]]) -> None:
-    """Say on stderr how many episodes had a sole outside its sand window before the episode's last moments."""
+def _report_window(rows: list[dict[str, Any]], window: SandWindowCfg) -> None:
+    """Say on stderr how far the soles reached against the window, and warn about episodes that left it early."""
     import sys
 
+    reach = [max((r.get(k, math.nan) for r in rows if math.isfinite(r.get(k, math.nan))), default=math.nan)
+             for k in ("sole_behind_m", "sole_ahead_m", "sole_side_m")]  # fmt: skip
+    if not all(math.isfinite(x) for x in reach):
+        return
+    if window.moving:
+        print(f"sand window: the soles reached {reach[0]:.2f} m behind the pelvis, {reach[1]:.2f} m ahead and "
+              f"{reach[2]:.2f} m sideways (largest over {len(rows)} episodes); the window spans "
+              f"{0.5 * window.length - window.lead:.2f} m behind, {0.5 * window.length + window.lead:.2f} m ahead and "
+              f"{0.5 * window.width:.2f} m sideways (along the grid's axes; on circles a square of the larger side)",
+              file=sys.stderr, flush=True)  # fmt: skip
     early = [r for r in rows if r.get("window_exit_early")]
     if early:
         worst = min(early, key=lambda r: r["window_exit_s"])
-        reach = [max((r.get(k, math.nan) for r in rows if math.isfinite(r.get(k, math.nan))), default=math.nan)
-                 for k in ("sole_behind_m", "sole_ahead_m", "sole_side_m")]  # fmt: skip
         print(f"warning: in {len(early)} of {len(rows)} episodes a sole that needed sand stood outside its sand window "
               f"more than {WINDOW_EXIT_GRACE_S} s before the episode ended (first at {worst['window_exit_s']:.2f} s, "
-              f"{worst['key']}): those walks lost their support to the window, not to the sand. The soles reached "
-              f"{reach[0]:.2f} m behind the pelvis, {reach[1]:.2f} m ahead and {reach[2]:.2f} m sideways: lengthen "
-              "the window or move it back (--window-length, --window-lead, --window-width)",
+              f"{worst['key']}): those walks lost their support to the window, not to the sand. Lengthen the window "
+              "or move it back (--window-length, --window-lead, --window-width)",
               file=sys.stderr, flush=True)  # fmt: skip
 
 
