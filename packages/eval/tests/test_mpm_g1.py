@@ -9,7 +9,14 @@ import numpy as np
 import pytest
 
 from gmloco.eval.mpm.box_scene import MpmSolverCfg, frame_dt_problem
-from gmloco.eval.mpm.g1_scene import G1MpmScene, G1MpmSceneCfg, MjlabOnnxPolicy, sole_reach, soles_outside
+from gmloco.eval.mpm.g1_scene import (
+    G1MpmScene,
+    G1MpmSceneCfg,
+    MjlabOnnxPolicy,
+    needs_sand,
+    sole_reach,
+    soles_outside,
+)
 from gmloco.eval.mpm.window import SandWindowCfg
 
 POLICY = Path(__file__).resolve().parents[3] / "artifacts" / "ppo_rft3d" / "policy.onnx"
@@ -33,11 +40,11 @@ def test_soles_outside_counts_low_corners_beyond_the_window() -> None:
     corners[0, 0, :, 0] = 0.5  # left sole inside
     corners[0, 1, :, 0] = np.linspace(-0.2, 0.15, 8)  # right sole straddles the rear edge: 5 corners behind it
     surface = np.zeros((1, 2, 8))
-    assert soles_outside(corners, surface, bounds).tolist() == [5]
+    assert soles_outside(corners, needs_sand(corners, surface), bounds).tolist() == [5]
     corners[0, 1, :, 2] = 0.05  # the right sole 5 cm up in its swing: no sand needed
-    assert soles_outside(corners, surface, bounds).tolist() == [0]
+    assert soles_outside(corners, needs_sand(corners, surface), bounds).tolist() == [0]
     corners[0, 1, :, 2], corners[0, 1, :, 0], corners[0, 1, :, 1] = -0.03, 0.5, 0.6  # sunk, beside the window
-    assert soles_outside(corners, surface, bounds).tolist() == [8]
+    assert soles_outside(corners, needs_sand(corners, surface), bounds).tolist() == [8]
 
 
 def test_sole_reach_is_measured_in_the_pelvis_yaw_frame() -> None:
@@ -48,11 +55,11 @@ def test_sole_reach_is_measured_in_the_pelvis_yaw_frame() -> None:
     corners[..., 0], corners[..., 1] = 1.0, 2.0
     corners[0, 0, 0, 1], corners[0, 0, 1, 1], corners[0, 1, 2, 0] = 2.5, 1.8, 0.7
     corners[1, ..., 2] = 0.1  # robot 1: both soles 10 cm up
-    reach = sole_reach(corners, np.zeros((2, 2, 8)), base_q)
+    reach = sole_reach(corners, needs_sand(corners, np.zeros((2, 2, 8))), base_q)
     np.testing.assert_allclose(reach[0], [0.2, 0.5, 0.3], atol=1e-12)
     assert np.isnan(reach[1]).all()
     corners[..., 2] = 0.1  # every sole in the air
-    assert np.isnan(sole_reach(corners, np.zeros((2, 2, 8)), base_q)).all()
+    assert np.isnan(sole_reach(corners, needs_sand(corners, np.zeros((2, 2, 8))), base_q)).all()
 
 
 def test_policy_metadata_layout() -> None:

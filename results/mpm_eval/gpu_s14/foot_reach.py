@@ -35,6 +35,7 @@ def reach(path: Path, near: float) -> dict:
     import mujoco
 
     from gmloco.deploy.logs.reader import read_log
+    from gmloco.eval.metrics.locomotion import quat_wxyz_to_roll_pitch_yaw
     from gmloco.eval.mpm.g1_scene import SoleCfg, g1_mjcf_path, sole_box_corners
 
     log = read_log(path)
@@ -55,8 +56,7 @@ def reach(path: Path, near: float) -> dict:
         corners = np.concatenate([data.xpos[b] + local @ data.xmat[b].reshape(3, 3).T for b in feet])
         if corners[:, 2].min() > near:
             continue
-        w, x, y, z = quat[i]
-        yaw = np.arctan2(2 * (w * z + x * y), 1 - 2 * (y * y + z * z))
+        yaw = quat_wxyz_to_roll_pitch_yaw(quat[i])[2]
         c, s = np.cos(yaw), np.sin(yaw)
         d = corners[corners[:, 2] <= near][:, :2] - pos[i][:2]
         rel.append(np.stack([c * d[:, 0] + s * d[:, 1], -s * d[:, 0] + c * d[:, 1]], axis=1))

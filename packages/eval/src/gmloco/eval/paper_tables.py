@@ -104,14 +104,12 @@ def combine(
         speeds += [[label, *r] for r in table_speeds(rows, all_speeds)[1]]
         transition += [[label, *r] for r in table_transition(rows)]
     out_dir.mkdir(parents=True, exist_ok=True)
-    write_table(out_dir / "table_terrains", (*TERRAIN_COLUMNS, "complete"), terrains)
-    write_table(out_dir / "table_speeds", ["policy", *table_speeds([], all_speeds)[0]], speeds)
+    note = _mixed_note(first, mixed)
+    write_table(out_dir / "table_terrains", (*TERRAIN_COLUMNS, "complete"), terrains, note)
+    write_table(out_dir / "table_speeds", ["policy", *table_speeds([], all_speeds)[0]], speeds, note)
     if transition:
-        write_table(out_dir / "table_transition", ("policy", *TRANSITION_COLUMNS), transition)
+        write_table(out_dir / "table_transition", ("policy", *TRANSITION_COLUMNS), transition, note)
     figures = _figures_by_cell(loaded, out_dir)
-    if mixed:
-        names = ("table_terrains", "table_speeds", *(("table_transition",) if transition else ()))
-        _footnote_mixed([out_dir / f"{n}.md" for n in names], first, mixed)
     summary = {
         "runs": {label: {"dir": str(d), "policy": summaries[label].get("policy")} for label, d in runs},
         "setting": settings[first],
@@ -143,12 +141,16 @@ def _figures_by_cell(loaded: list[tuple[str, list[dict[str, Any]]]], out_dir: Pa
     return paths
 
 
-def _footnote_mixed(tables: list[Path], first: str, mixed: dict[str, list[str]]) -> None:
-    """Append to each markdown table which rows were scored at another setting than ``first``'s, and how."""
+def _mixed_note(first: str, mixed: dict[str, list[str]]) -> str:
+    """Markdown note naming the rows scored at another setting than ``first``'s, and how ("" when none)."""
+    if not mixed:
+        return ""
     lines = [f"- `{label}`: {', '.join(diff)}" for label, diff in mixed.items()]
-    note = f"\nScored at settings other than `{first}`'s (tabulated with `--allow-mixed-settings`):\n\n"
-    for md in tables:
-        md.write_text(md.read_text() + note + "\n".join(lines) + "\n")
+    return (
+        f"\nScored at settings other than `{first}`'s (tabulated with `--allow-mixed-settings`):\n\n"
+        + "\n".join(lines)
+        + "\n"
+    )
 
 
 def _run_arg(text: str) -> tuple[str, Path]:

@@ -117,15 +117,17 @@ def _fmt(x: Any) -> str:
     return str(x)
 
 
-def write_table(path: Path, header: list[str] | tuple[str, ...], body: list[list[Any]]) -> list[Path]:
-    """Write ``<path>.csv`` and ``<path>.md``."""
+def write_table(
+    path: Path, header: list[str] | tuple[str, ...], body: list[list[Any]], md_footer: str = ""
+) -> list[Path]:
+    """Write ``<path>.csv`` and ``<path>.md`` (``md_footer``: text after the markdown table, e.g. a note)."""
     with path.with_suffix(".csv").open("w", newline="") as f:
         w = csv.writer(f)
         w.writerow(header)
         w.writerows(body)
     lines = ["| " + " | ".join(header) + " |", "|" + "---|" * len(header)]
     lines += ["| " + " | ".join(_fmt(x) for x in row) + " |" for row in body]
-    path.with_suffix(".md").write_text("\n".join(lines) + "\n")
+    path.with_suffix(".md").write_text("\n".join(lines) + "\n" + md_footer)
     return [path.with_suffix(".md"), path.with_suffix(".csv")]
 
 

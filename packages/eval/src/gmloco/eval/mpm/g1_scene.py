@@ -39,6 +39,7 @@ from typing import Any
 import numpy as np
 
 from gmloco.eval.g1_eval_policy import MjlabOnnxPolicy, PolicySpec, StudentOnnxPolicy
+from gmloco.eval.metrics.locomotion import quat_wxyz_to_roll_pitch_yaw
 from gmloco.eval.mpm.box_scene import MpmSolverCfg, frame_dt_problem, model_gravity
 from gmloco.eval.mpm.coupled_setup import make_coupled_states, make_mpm_solver
 from gmloco.eval.mpm.window import SandWindow, SandWindowCfg
@@ -54,6 +55,7 @@ __all__ = [
     "SoleCfg",
     "StudentOnnxPolicy",
     "g1_mjcf_path",
+    "needs_sand",
     "quat_rotate_inv",
     "sole_box_corners",
     "sole_reach",
@@ -66,19 +68,21 @@ LOG_FIELDS = ("base_q", "base_qd", "foot_force", "sinkage", "foot_sinkage", "joi
 
 
 SOLE_NEAR_M = 0.02
-"""A sole corner this close above the local sand surface, or below it, needs sand under it [m] (``soles_outside``)."""
+"""A sole corner this close above the local sand surface, or below it, needs sand under it [m] (``needs_sand``)."""
 
 
-def soles_outside(
-    corners: np.ndarray, surface: np.ndarray, bounds: np.ndarray, near: float = SOLE_NEAR_M
-) -> np.ndarray:
+def needs_sand(corners: np.ndarray, surface: np.ndarray, near: float = SOLE_NEAR_M) -> np.ndarray:
+    """Which sole corners [R, 2, 8, 3] are within ``near`` of the sand surface [R, 2, 8] or below it, [R, 2, 8]."""
+    return corners[..., 2] - surface <= near
+
+
+def soles_outside(corners: np.ndarray, low: np.ndarray, bounds: np.ndarray) -> np.ndarray:
     """Sole corners that need sand under them but lie outside their robot's sand window, per robot.
 
     Args:
         corners: World sole corners [m], [R, 2, 8, 3].
-        surface: Sand surface height under each corner [m], [R, 2, 8].
+        low: The corners that need sand (``needs_sand``), [R, 2, 8].
         bounds: Window boxes [m], [R, 2, 2]: (lower, upper) xy corners (``SandWindow.bounds``).
-        near: Height above the surface below which a corner counts [m].
 
     Returns:
         Number of such corners per robot, [R] (0 when the soles are over sand or in the air).
@@ -86,7 +90,6 @@ def soles_outside(
     x, y = corners[..., 0], corners[..., 1]
     lo, hi = bounds[:, None, None, 0, :], bounds[:, None, None, 1, :]
     out = (x < lo[..., 0]) | (x > hi[..., 0]) | (y < lo[..., 1]) | (y > hi[..., 1])
-    low = corners[..., 2] - surface <= near
     return (out & low).reshape(len(corners), -1).sum(axis=1)
 
 
@@ -96,25 +99,22 @@ def sole_box_corners(sole: SoleCfg) -> np.ndarray:
     return np.array(sole.center) + signs * np.array(sole.half_extents)
 
 
-def sole_reach(corners: np.ndarray, surface: np.ndarray, base_q: np.ndarray, near: float = SOLE_NEAR_M) -> np.ndarray:
+def sole_reach(corners: np.ndarray, low: np.ndarray, base_q: np.ndarray) -> np.ndarray:
     """How far the sole corners that need sand lie from the pelvis, in its yaw frame (x forward), per robot.
 
     Args:
         corners: World sole corners [m], [R, 2, 8, 3].
-        surface: Sand surface height under each corner [m], [R, 2, 8].
+        low: The corners that need sand (``needs_sand``), [R, 2, 8].
         base_q: Pelvis poses (position, quaternion x y z w), [R, 7].
-        near: Height above the surface below which a corner counts [m].
 
     Returns:
-        [R, 3]: reach behind the pelvis, ahead of it, and sideways (largest |y|) [m]; NaN for a robot whose soles are
-        all higher than ``near`` above the sand.
+        [R, 3]: reach behind the pelvis, ahead of it, and sideways (largest |y|) [m]; NaN for a robot whose soles
+        all are in the air.
     """
-    x, y, z, w = (base_q[:, k] for k in (3, 4, 5, 6))
-    yaw = np.arctan2(2.0 * (w * z + x * y), 1.0 - 2.0 * (y * y + z * z))
+    yaw = quat_wxyz_to_roll_pitch_yaw(base_q[:, [6, 3, 4, 5]])[:, 2]
     c, s = np.cos(yaw)[:, None, None], np.sin(yaw)[:, None, None]
     dx, dy = corners[..., 0] - base_q[:, None, None, 0], corners[..., 1] - base_q[:, None, None, 1]
     fwd, side = c * dx + s * dy, -s * dx + c * dy
-    low = corners[..., 2] - surface <= near
     out = np.full((len(corners), 3), np.nan)
     some = low.reshape(len(corners), -1).any(axis=1)
     if not some.any():
@@ -248,9 +248,9 @@ class G1MpmScene:
         self.action: list[np.ndarray] = []
         self.eta: list[np.ndarray] = []
         self.sole_out: list[np.ndarray] = []
+        """Per sample: sole corners per robot that need sand but lie outside the window (``soles_outside``)."""
         self.sole_reach: list[np.ndarray] = []
         """Per sample: reach of the soles that need sand behind / ahead of / beside the pelvis (``sole_reach``)."""
-        """Per sample: sole corners per robot that need sand but lie outside the window (``soles_outside``)."""
 
     @property
     def particle_count(self) -> int:
@@ -464,8 +464,9 @@ class G1MpmScene:
         self.target.append(target)
         self.action.append(self.last_action.copy())
         self.eta.append(self._decoded_eta())
-        self.sole_out.append(soles_outside(corners, surf, self.window.bounds()))
-        self.sole_reach.append(sole_reach(corners, surf, st["base_q"]))
+        low = needs_sand(corners, surf)
+        self.sole_out.append(soles_outside(corners, low, self.window.bounds()))
+        self.sole_reach.append(sole_reach(corners, low, st["base_q"]))
 
     def _decoded_eta(self) -> np.ndarray:
         """The student's decoded terrain stiffness after its last step, [R] (NaN for policies without one)."""
