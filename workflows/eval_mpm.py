@@ -13,19 +13,24 @@ Run alone (time-boxed and resumable; works with plain ``python`` and ``PYTHONPAT
 
     python workflows/eval_mpm.py +exp=gm_loco run_dir=runs/gm_loco/<name> max_minutes=9
 
-Throughput and the voxel-size convergence check: ``scripts/gpu/bench_mpm_eval.py``.
+The GPU machine's command line without Hydra: ``python -m gmloco.eval.g1_eval_cli``; whether a cheaper MPM setting
+walks as the accepted one does: ``python -m gmloco.eval.convergence`` (``docs/mpm_eval.md``).
 """
 
 from __future__ import annotations
 
 from dataclasses import replace
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 from omegaconf import DictConfig
 
 from stage_registry import StageIncompleteError
 
-__all__ = ["main", "run"]
+if TYPE_CHECKING:
+    from gmloco.eval.g1_eval import G1EvalCfg
+
+__all__ = ["eval_cfg", "main", "run"]
 
 
 def _device(device: str) -> str | None:
@@ -33,16 +38,15 @@ def _device(device: str) -> str | None:
     return None if device == "auto" else device
 
 
-def run(cfg: DictConfig) -> dict[str, float]:
-    """Evaluate ``<policy_dir>/<policy_file>`` on MPM sand; raise ``StageIncompleteError`` at the time box."""
+def eval_cfg(cfg: DictConfig) -> G1EvalCfg:
+    """The ``G1EvalCfg`` of the pipeline's ``eval_mpm`` section (every field the section sets carried over)."""
     from gmloco.eval.g1_eval import G1EvalCfg
-    from gmloco.eval.g1_eval import run as run_eval
     from gmloco.eval.mpm.box_scene import MpmSolverCfg
     from gmloco.eval.mpm.window import SandWindowCfg
 
     s = cfg.eval_mpm
     base = G1EvalCfg()
-    eval_cfg = replace(
+    out = replace(
         base,
         policy_path=str(Path(str(s.policy_dir)) / str(s.policy_file)),
         out_dir=str(s.out_dir),
@@ -54,7 +58,12 @@ def run(cfg: DictConfig) -> dict[str, float]:
         circle_radius=float(s.circle_radius),
         course_slack=float(s.course_slack),
         bed_depth=float(s.bed_depth),
-        window=SandWindowCfg(moving=bool(s.moving_window), length=float(s.window_length), width=float(s.window_width)),
+        window=SandWindowCfg(
+            moving=bool(s.moving_window),
+            length=float(s.window_length),
+            width=float(s.window_width),
+            lead=float(s.window_lead),
+        ),
         robots_per_batch=int(s.robots_per_batch),
         cell_capacity_factor=float(s.cell_capacity_factor),
         record_mcap=bool(s.record_mcap),
@@ -70,8 +79,15 @@ def run(cfg: DictConfig) -> dict[str, float]:
         max_minutes=None if s.max_minutes is None else float(s.max_minutes),
         resume=bool(s.resume),
     )
-    assert isinstance(eval_cfg.solver, MpmSolverCfg)
-    metrics, complete = run_eval(eval_cfg)
+    assert isinstance(out.solver, MpmSolverCfg)
+    return out
+
+
+def run(cfg: DictConfig) -> dict[str, float]:
+    """Evaluate ``<policy_dir>/<policy_file>`` on MPM sand; raise ``StageIncompleteError`` at the time box."""
+    from gmloco.eval.g1_eval import run as run_eval
+
+    metrics, complete = run_eval(eval_cfg(cfg))
     if not complete:
         raise StageIncompleteError(
             f"time box reached after {int(metrics.get('all/num_episodes', 0))} episodes; episodes.jsonl kept"

@@ -305,6 +305,9 @@ class EvalMpmCfg(StageCfg):
     """Moving window size along x [m] (centred 0.2 m ahead of the pelvis; 1.4 m walks as 1.8 m does: session 12)."""
     window_width: float = 0.6
     """Moving window size along y [m] (0.6 m walks as 1.0 m does and costs 40 % less: session 11)."""
+    window_lead: float = 0.2
+    """Window centre ahead of the pelvis [m] (negative: behind it). The soles lead the pelvis by <= 0.2 m and trail
+    it by ~0.3 m walking, 0.5-0.75 m in falls (``results/mpm_eval/gpu_s14/foot_reach.json``)."""
     robots_per_batch: int = 32
     """Robots sharing one MPM solver (one lane each)."""
     cell_capacity_factor: float = 1.5

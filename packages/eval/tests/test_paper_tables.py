@@ -104,3 +104,24 @@ def test_a_figure_per_cell_puts_the_policies_side_by_side(tmp_path: Path) -> Non
     summary = combine([("x", a), ("y", b)], tmp_path / "out")
     assert summary["figures"] == ["fig_speeds_dry_sand_straight.png"]
     assert (tmp_path / "out" / "fig_speeds_dry_sand_straight.png").stat().st_size > 10_000
+
+
+def test_rows_whose_soles_left_the_window_are_named(tmp_path: Path) -> None:
+    """3 of 10 early window exits: the row is listed in tables.json and under the markdown table; 0 of 10 is not."""
+    a, b = _run(tmp_path, "a", 5, 10), _run(tmp_path, "b", 5, 10)
+    for d, exits in ((a, 3), (b, 0)):
+        rows = [json.loads(line) for line in (d / "episodes.jsonl").read_text().splitlines()]
+        for k, r in enumerate(rows):
+            r["window_exit_early"] = k < exits
+        (d / "episodes.jsonl").write_text("".join(json.dumps(r) + "\n" for r in rows))
+    summary = combine([("rigid", a), ("td", b)], tmp_path / "out")
+    assert summary["window_exit_rows"] == {"rigid/dry_sand/straight": 30.0}
+    md = (tmp_path / "out" / "table_terrains.md").read_text()
+    assert "`rigid/dry_sand/straight`: 30 % of episodes" in md and "`td/dry_sand" not in md
+
+
+def test_runs_older_than_the_window_check_are_not_named(tmp_path: Path) -> None:
+    """Episodes without ``window_exit_early`` (NaN column) add no note."""
+    summary = combine([("td", _run(tmp_path, "a", 5, 10))], tmp_path / "out")
+    assert summary["window_exit_rows"] == {}
+    assert "left the sand window" not in (tmp_path / "out" / "table_terrains.md").read_text()

@@ -58,9 +58,12 @@ class Verdict:
     decision: Decision
     reasons: tuple[str, ...]
     episodes: tuple[int, int]
+    """Episodes of the candidate and of the reference (every pair below is in this order)."""
     alive_median_s: tuple[float, float]
+    """Median time alive, candidate and reference [s]."""
     alive_p: float
     success: tuple[int, int]
+    """Successful episodes, candidate and reference."""
     success_p: float
     vel_error_median: tuple[float, float]
     """Median velocity tracking error, candidate and reference [m/s]."""
@@ -69,7 +72,9 @@ class Verdict:
     """Median yaw tracking error, candidate and reference [rad] (rad/s for circle commands)."""
     yaw_error_p: float
     sinkage_mean_m: tuple[float, float]
+    """Mean sinkage of the lowest sole point, candidate and reference [m]."""
     sinkage_rel_diff: float
+    """|candidate - reference| / reference of the mean sinkage."""
 
 
 def load_episodes(path: str | Path) -> list[dict[str, Any]]:

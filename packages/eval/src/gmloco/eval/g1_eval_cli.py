@@ -59,9 +59,7 @@ def _parse(argv: list[str] | None) -> argparse.Namespace:
     p.add_argument("--static-bed", action="store_true", help="naive baseline: a bed covering the course")
     p.add_argument("--window-length", type=float, default=_WINDOW.length)
     p.add_argument("--window-width", type=float, default=_WINDOW.width)
-    p.add_argument(
-        "--window-lead", type=float, default=SandWindowCfg.lead, help="window centre ahead of the pelvis [m]"
-    )
+    p.add_argument("--window-lead", type=float, default=_WINDOW.lead, help="window centre ahead of the pelvis [m]")
     p.add_argument(
         "--particles-per-voxel", type=int, default=SandWindowCfg.particles_per_voxel, help="particles per voxel edge"
     )

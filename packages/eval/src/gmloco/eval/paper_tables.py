@@ -30,10 +30,13 @@ import json
 from pathlib import Path
 from typing import Any
 
-__all__ = ["SETTING_KEYS", "combine", "main", "setting_of"]
+__all__ = ["SETTING_KEYS", "WINDOW_EXIT_NOTE_PCT", "combine", "main", "setting_of"]
 
 SETTING_KEYS = ("solver", "window", "bed_depth", "episode_s", "failure", "course_slack", "circle_radius")
 """Fields of a run's ``summary.json`` ``cfg`` that define the experiment; runs in one table must agree on them."""
+
+WINDOW_EXIT_NOTE_PCT = 5.0
+"""Rows with more than this % of early sand-window exits are named under the tables [%]."""
 
 
 def _summary(run_dir: Path) -> dict[str, Any]:
@@ -104,7 +107,8 @@ def combine(
         speeds += [[label, *r] for r in table_speeds(rows, all_speeds)[1]]
         transition += [[label, *r] for r in table_transition(rows)]
     out_dir.mkdir(parents=True, exist_ok=True)
-    note = _mixed_note(first, mixed)
+    exits = _window_exit_rows(terrains)
+    note = _mixed_note(first, mixed) + _window_exit_note(exits)
     write_table(out_dir / "table_terrains", (*TERRAIN_COLUMNS, "complete"), terrains, note)
     write_table(out_dir / "table_speeds", ["policy", *table_speeds([], all_speeds)[0]], speeds, note)
     if transition:
@@ -116,6 +120,7 @@ def combine(
         "mixed_settings": mixed,
         "episodes_expected": episodes,
         "partial_rows": partial,
+        "window_exit_rows": exits,
         "figures": [p.name for p in figures],
         "rows": [dict(zip((*TERRAIN_COLUMNS, "complete"), row, strict=True)) for row in terrains],
         "speed_rows": [dict(zip(["policy", *table_speeds([], all_speeds)[0]], row, strict=True)) for row in speeds],
@@ -148,6 +153,31 @@ def _mixed_note(first: str, mixed: dict[str, list[str]]) -> str:
     lines = [f"- `{label}`: {', '.join(diff)}" for label, diff in mixed.items()]
     return (
         f"\nScored at settings other than `{first}`'s (tabulated with `--allow-mixed-settings`):\n\n"
+        + "\n".join(lines)
+        + "\n"
+    )
+
+
+def _window_exit_rows(rows: list[list[Any]]) -> dict[str, float]:
+    """``policy/terrain/scenario`` -> % of episodes whose soles left their sand window early, above the threshold.
+
+    Rows above ``WINDOW_EXIT_NOTE_PCT`` only; NaN (runs older than the check) is never listed.
+    """
+    from gmloco.eval.tables_mpm import TERRAIN_COLUMNS
+
+    k = TERRAIN_COLUMNS.index("window_exit_pct")
+    return {f"{r[0]}/{r[1]}/{r[2]}": round(float(r[k]), 1) for r in rows if float(r[k]) > WINDOW_EXIT_NOTE_PCT}
+
+
+def _window_exit_note(exits: dict[str, float]) -> str:
+    """Markdown note naming the rows whose soles left the sand early ("" when none)."""
+    if not exits:
+        return ""
+    lines = [f"- `{key}`: {pct:.0f} % of episodes" for key, pct in exits.items()]
+    return (
+        "\nSoles left the sand window more than 0.25 s before the episode ended (the robot stepped where no sand "
+        "was simulated), so these rows' times alive and falls may depend on the window; rerun them with a window "
+        "that covers the reach printed by the run (`--window-length`, `--window-width`, `--window-lead`):\n\n"
         + "\n".join(lines)
         + "\n"
     )

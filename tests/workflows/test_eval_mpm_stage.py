@@ -1,0 +1,39 @@
+# SPDX-License-Identifier: Apache-2.0
+"""The ``eval_mpm`` stage hands every setting of its config section to ``G1EvalCfg``."""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+
+from omegaconf import DictConfig
+
+import eval_mpm
+
+
+def test_section_settings_reach_the_eval_cfg(compose: Callable[..., DictConfig]) -> None:
+    """Window (size and lead), bed, lanes and numerics set in the section are the ones the evaluation runs with."""
+    cfg = compose(
+        "+exp=gm_loco",
+        "+scale=full",
+        "eval_mpm.window_length=0.8",
+        "eval_mpm.window_width=0.5",
+        "eval_mpm.window_lead=-0.1",
+        "eval_mpm.bed_depth=0.25",
+        "eval_mpm.robots_per_batch=50",
+        "eval_mpm.max_iterations=400",
+    )
+    out = eval_mpm.eval_cfg(cfg)
+    assert (out.window.length, out.window.width, out.window.lead, out.window.moving) == (0.8, 0.5, -0.1, True)
+    assert (out.bed_depth, out.robots_per_batch, out.solver.max_iterations) == (0.25, 50, 400)
+    assert out.policy_path.endswith("policy.onnx")
+
+
+def test_default_section_matches_the_eval_defaults(compose: Callable[..., DictConfig]) -> None:
+    """Without overrides the pipeline scores at ``G1EvalCfg``'s defaults (one accepted setting, not two)."""
+    from gmloco.eval.g1_eval import G1EvalCfg
+
+    out = eval_mpm.eval_cfg(compose("+exp=gm_loco", "+scale=full"))
+    base = G1EvalCfg()
+    assert out.window == base.window
+    assert (out.bed_depth, out.cell_capacity_factor) == (base.bed_depth, base.cell_capacity_factor)
+    assert out.solver == base.solver
