@@ -1,0 +1,74 @@
+#!/usr/bin/env bash
+# Prepared in session 15 for the next GPU session (issue 9); NOT yet run. One machine, ~22 min after the wheels.
+# Runs one after the other: session 15 ran its checks side by side on one H100 and the GPU did less in all
+# (~112 robot-frames/s summed against ~150 for one process).
+#   (1) Power for the 1.0 x 0.5 m window (lead -0.1) at 1.5 m/s: session 15 accepted it on 16 episodes, but with
+#       11 vs 14 successes and +10 % sinkage. 16 more episodes of each window with seed 1; the verdict pools both
+#       seeds (32 vs 32) and decides the window of the td rows.
+#   (2) Does a stumbling policy need a wider window? ppo_rigid's soles reached 0.64 m ahead / behind and 0.58 m
+#       sideways of the pelvis in session 15's row (55 % early window exits). 16 robots x 5 s at 1.0 m/s:
+#       1.4 x 1.3 m lead 0 (covers that reach) against 1.0 x 0.5 m lead -0.1. Accepted -> the small window is
+#       enough to score it (the falls are not caused by the missing sand); rejected -> its row is rerun wide.
+#   (3) Rows (100 episodes, straight, 1.0-2.5 m/s, 50 lanes, time-boxed, resumable): ppo_rigid (resume session
+#       15's 92 episodes: carry results/mpm_eval/gpu_s15/runs/table_ppo_rigid_dry_sand as
+#       .devsrc/row/table_ppo_rigid_dry_sand, only if (2) keeps the small window), clr50 on dry sand, td on
+#       poppy seed.
+# Usage (in ~/src, after the wheels and the Warp cache): bash job_next.sh END_EPOCH
+END=$1
+cd ~/src && source scripts/gpu/env.sh && mkdir -p ~/chunks/g1_eval ~/chunks/verdicts
+[ -d ~/src/.devsrc/row ] && cp -r ~/src/.devsrc/row/* ~/chunks/g1_eval/
+log() { echo "$* at $(date +%T)" >> ~/chunks/job.log; }
+left() { python3 -c "import time;print(round(($END-time.time())/60 - $1,2))"; }
+S15=results/mpm_eval/gpu_s15/runs
+SMALL="--window-length 1.0 --window-width 0.5 --window-lead -0.1"
+log "start"
+check() {  # check NAME POLICY SPEED SEED WINDOW_FLAGS...
+  N=$1 POL=$2 V=$3 SEED=$4; shift 4
+  timeout 480 python3 -m gmloco.eval.g1_eval_cli --policy $POL --terrains dry_sand --speeds $V --no-mcap --fresh \
+    --episode-s 5 --num-episodes 16 --robots-per-batch 16 --seed $SEED "$@" --out $HOME/chunks/g1_eval/$N \
+    > ~/chunks/g1_eval/$N.log 2>&1
+  log "check $N rc=$?"
+}
+verdict() {  # verdict NAME "REF_DIRS" "CANDIDATE_DIRS"
+  python3 -m gmloco.eval.convergence --reference $2 --candidate $3 --out ~/chunks/verdicts/$1.json \
+    > ~/chunks/verdicts/$1.log 2>&1
+  D=$(python3 -c "import json; print(json.load(open('$HOME/chunks/verdicts/$1.json'))['decision'])" 2>/dev/null)
+  log "verdict $1: $D"; echo $D
+}
+TD=artifacts/gm_loco_student_td/policy.onnx
+RIGID=artifacts/ppo_rigid/policy.onnx
+check td_l1.4_w0.6_lead0.2_r16_5s_v1.5_seed1 $TD 1.5 1 --window-length 1.4 --window-width 0.6 --window-lead 0.2
+check td_l1.0_w0.5_lead-0.1_r16_5s_v1.5_seed1 $TD 1.5 1 $SMALL
+G=~/chunks/g1_eval
+TDWIN=$(verdict td_v1.5_l1.0_w0.5_pooled \
+  "$S15/td_v0.03_it500_d0.3_l1.4_w0.6_lead0.2_r16_5s_v1.5 $G/td_l1.4_w0.6_lead0.2_r16_5s_v1.5_seed1" \
+  "$S15/td_v0.03_it500_d0.3_l1.0_w0.5_lead-0.1_r16_5s_v1.5 $G/td_l1.0_w0.5_lead-0.1_r16_5s_v1.5_seed1")
+check rigid_l1.4_w1.3_lead0_r16_5s_v1.0 $RIGID 1.0 0 --window-length 1.4 --window-width 1.3 --window-lead 0.0
+check rigid_l1.0_w0.5_lead-0.1_r16_5s_v1.0 $RIGID 1.0 0 $SMALL
+RIGIDWIN=$(verdict rigid_v1.0_l1.0_w0.5_vs_l1.4_w1.3 $G/rigid_l1.4_w1.3_lead0_r16_5s_v1.0 \
+  $G/rigid_l1.0_w0.5_lead-0.1_r16_5s_v1.0)
+row() {  # row NAME POLICY TERRAIN WINDOW_FLAGS...: 100 episodes, straight, 1.0-2.5 m/s
+  N=$1 POL=$2 T=$3; shift 3
+  M=$(left 0.7)
+  if python3 -c "import sys; sys.exit(0 if $M > 1.0 else 1)"; then
+    timeout $(python3 -c "print(int(max(30,$M*60+20)))") python3 -m gmloco.eval.g1_eval_cli --policy $POL \
+      --terrains $T --scenarios straight --speeds 1.0 1.5 2.0 2.5 --num-episodes 100 --robots-per-batch 50 \
+      "$@" --max-minutes $M --out $G/$N >> $G/$N.log 2>&1
+    log "row $N rc=$?"
+  else
+    log "row $N skipped: $M min left"
+  fi
+}
+if [ "$RIGIDWIN" = accepted ]; then
+  row table_ppo_rigid_dry_sand $RIGID dry_sand $SMALL
+else
+  rm -rf $G/table_ppo_rigid_dry_sand
+  row table_ppo_rigid_wide_dry_sand $RIGID dry_sand --window-length 1.4 --window-width 1.3 --window-lead 0.0
+fi
+row table_clr50_dry_sand artifacts/gm_loco_student_clr50/policy.onnx dry_sand $SMALL
+if [ "$TDWIN" = accepted ]; then
+  row table_td_poppy_seed $TD poppy_seed $SMALL
+else
+  row table_td_poppy_seed_l1.4 $TD poppy_seed
+fi
+touch ~/chunks/DONE
