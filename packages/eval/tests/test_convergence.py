@@ -115,3 +115,41 @@ def test_a_run_cut_short_by_its_time_box_is_undecided(tmp_path: Path) -> None:
     assert len(v.reasons) == 1 and "ref is incomplete (10 of 16 episodes)" in v.reasons[0]
     complete = compare_runs(_rows(alive, 0.08, 0.2), _rows(alive, 0.08, 0.2))
     assert complete.decision == "accepted"  # the same episodes without the flag
+
+
+def _with_floor(rows: list[dict], hits: int) -> list[dict]:
+    """The first ``hits`` episodes had a sole reach the bed's rigid floor."""
+    return [r | {"floor_reached": k < hits} for k, r in enumerate(rows)]
+
+
+def test_soles_reaching_the_floor_more_often_are_rejected() -> None:
+    """Same walks, but a sole reached the floor in 14 of 16 episodes against 2 of 16: rejected on the floor."""
+    alive = np.full(16, 10.0)
+    v = compare_runs(_with_floor(_rows(alive, 0.08, 0.5), 2), _with_floor(_rows(alive, 0.08, 0.5), 14))
+    assert v.decision == "rejected" and v.floor_reached == (14, 2)
+    assert [r for r in v.reasons if "floor" in r] == [r for r in v.reasons]  # the floor is the only reason
+    same = compare_runs(_with_floor(_rows(alive, 0.08, 0.5), 3), _with_floor(_rows(alive, 0.08, 0.5), 4))
+    assert same.decision == "accepted" and same.floor_p > 0.05
+
+
+def test_runs_without_floor_records_skip_the_floor_test() -> None:
+    """Older runs (no ``floor_reached``): the test is skipped, p = 1, nothing counted."""
+    alive = np.full(10, 10.0)
+    v = compare_runs(_rows(alive, 0.08, 0.5), _with_floor(_rows(alive, 0.08, 0.5), 10))
+    assert v.floor_p == 1.0 and v.decision == "accepted"
+
+
+def test_sinkage_interval_brackets_the_difference_and_narrows_with_episodes() -> None:
+    """Candidate 10 % deeper on average: the 95 % interval holds +10 % and is narrower with 4x the episodes."""
+    rng = np.random.default_rng(3)
+
+    def run(n: int, mean: float) -> list[dict]:
+        rows = _rows(np.full(n, 10.0), 0.0, 0.5)
+        return [r | {"mean_sinkage": float(s)} for r, s in zip(rows, rng.normal(mean, 0.01, n), strict=True)]
+
+    small = compare_runs(run(16, 0.07), run(16, 0.077))
+    large = compare_runs(run(64, 0.07), run(64, 0.077))
+    for v in (small, large):
+        lo, hi = v.sinkage_rel_ci95
+        assert lo < 0.10 < hi
+    assert np.diff(large.sinkage_rel_ci95)[0] < np.diff(small.sinkage_rel_ci95)[0]

@@ -1,7 +1,7 @@
 # SPDX-License-Identifier: Apache-2.0
 """Session 15's cost table and figure from the runs' episodes (robot-frames/s = frames/s x lanes, median).
 
-    python results/mpm_eval/gpu_s15/cost_fig.py   # writes cost.json and fig_cost.png beside this file
+python results/mpm_eval/gpu_s15/cost_fig.py   # writes cost.json and fig_cost.png beside this file
 """
 
 from __future__ import annotations
@@ -9,11 +9,6 @@ from __future__ import annotations
 import json
 import statistics
 from pathlib import Path
-
-import matplotlib
-
-matplotlib.use("Agg")
-import matplotlib.pyplot as plt
 
 HERE = Path(__file__).parent
 TARGET_RF_S = 100 * 10.0 / 0.005 / 600.0
@@ -28,6 +23,12 @@ CASES = {
 
 
 def main() -> None:
+    """Write ``cost.json`` and ``fig_cost.png`` beside this file."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
     out = {}
     for rel, label in CASES.items():
         rows = [json.loads(line) for line in (HERE / rel / "episodes.jsonl").read_text().splitlines()]
