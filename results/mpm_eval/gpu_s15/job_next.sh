@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Prepared in session 15 for the next GPU session (issue 9); NOT yet run. One machine, ~22 min after the wheels.
+# Prepared in session 15 for the next GPU session (issue 9); NOT yet run. One machine, ~24 min after the wheels.
 # Runs one after the other: session 15 ran its checks side by side on one H100 and the GPU did less in all
 # (~112 robot-frames/s summed against ~150 for one process).
 #   (1) Power for the 1.0 x 0.5 m window (lead -0.1) at 1.5 m/s: session 15 accepted it on 16 episodes, but with
@@ -9,7 +9,8 @@
 #       sideways of the pelvis in session 15's row (55 % early window exits). 16 robots x 5 s at 1.0 m/s:
 #       1.4 x 1.3 m lead 0 (covers that reach) against 1.0 x 0.5 m lead -0.1. Accepted -> the small window is
 #       enough to score it (the falls are not caused by the missing sand); rejected -> its row is rerun wide.
-#   (3) Rows (100 episodes, straight, 1.0-2.5 m/s, 50 lanes, time-boxed, resumable): ppo_rigid (resume session
+#   (2b) Lanes: 32, 50 and 100 robots per solver, side by side (cost only).
+#   (3) Rows (100 episodes, straight, 1.0-2.5 m/s, 50 or 100 lanes by (2b), time-boxed, resumable): ppo_rigid (resume session
 #       15's 92 episodes: carry results/mpm_eval/gpu_s15/runs/table_ppo_rigid_dry_sand as
 #       .devsrc/row/table_ppo_rigid_dry_sand, only if (2) keeps the small window), clr50 on dry sand, td on
 #       poppy seed.
@@ -47,12 +48,30 @@ check rigid_l1.4_w1.3_lead0_r16_5s_v1.0 $RIGID 1.0 0 --window-length 1.4 --windo
 check rigid_l1.0_w0.5_lead-0.1_r16_5s_v1.0 $RIGID 1.0 0 $SMALL
 RIGIDWIN=$(verdict rigid_v1.0_l1.0_w0.5_vs_l1.4_w1.3 $G/rigid_l1.4_w1.3_lead0_r16_5s_v1.0 \
   $G/rigid_l1.0_w0.5_lead-0.1_r16_5s_v1.0)
+# (2b) Lanes, side by side on the idle GPU (cost only, 0.3 s episodes, 1.0 x 0.5 m window): 32, 50 and 100 robots
+#      per solver. 100 episodes take 100 lane-episodes at 50 or 100 lanes, so the rows take the faster of the two.
+cost() {  # cost ROBOTS
+  timeout 240 python3 -m gmloco.eval.g1_eval_cli --policy $TD --terrains dry_sand --speeds 1.0 --no-mcap --fresh \
+    --episode-s 0.3 --num-episodes $1 --robots-per-batch $1 $SMALL --out $HOME/chunks/cost/r$1 \
+    > ~/chunks/cost/r$1.log 2>&1
+  log "cost r$1 rc=$?"
+}
+mkdir -p ~/chunks/cost
+for R in 32 50 100; do cost $R; done
+rf() { python3 -c "import json,statistics as s; r=[json.loads(l) for l in open('$HOME/chunks/cost/r$1/episodes.jsonl')]; print(s.median(x['frames_per_s']*x['batch_size'] for x in r))" 2>/dev/null || echo 0; }
+RF50=$(rf 50) RF100=$(rf 100)
+log "robot-frames/s at 32 / 50 / 100 lanes: $(rf 32) / $RF50 / $RF100"
+lanes() {  # lanes MINUTES_LEFT: 100 only if faster AND a whole walking row (one wave) fits the time box, since a
+           # time box drops every running episode and 100 lanes run all 100 at once
+  python3 -c "print(100 if $RF100 > $RF50 and $1 > 200000 / max($RF100, 1) / 60 + 1.5 else 50)"
+}
 row() {  # row NAME POLICY TERRAIN WINDOW_FLAGS...: 100 episodes, straight, 1.0-2.5 m/s
   N=$1 POL=$2 T=$3; shift 3
   M=$(left 0.7)
   if python3 -c "import sys; sys.exit(0 if $M > 1.0 else 1)"; then
+    LANES=$(lanes $M); log "row $N: $LANES lanes, $M min"
     timeout $(python3 -c "print(int(max(30,$M*60+20)))") python3 -m gmloco.eval.g1_eval_cli --policy $POL \
-      --terrains $T --scenarios straight --speeds 1.0 1.5 2.0 2.5 --num-episodes 100 --robots-per-batch 50 \
+      --terrains $T --scenarios straight --speeds 1.0 1.5 2.0 2.5 --num-episodes 100 --robots-per-batch $LANES \
       "$@" --max-minutes $M --out $G/$N >> $G/$N.log 2>&1
     log "row $N rc=$?"
   else
