@@ -74,3 +74,12 @@ def test_cell_capacity_factor_below_one_is_refused(capsys: pytest.CaptureFixture
         _parse(["--out", "x", "--cell-capacity-factor", "0.5"])
     assert "--cell-capacity-factor 0.5" in capsys.readouterr().err
     assert _parse(["--out", "x", "--cell-capacity-factor", "1.5"]).cell_capacity_factor == 1.5
+
+
+def test_window_defaults_are_the_evaluation_defaults() -> None:
+    """Without window flags the command line scores at ``G1EvalCfg``'s window (size and lead) and bed."""
+    from gmloco.eval.g1_eval import G1EvalCfg
+
+    a, base = _parse(["--out", "x"]), G1EvalCfg()
+    assert (a.window_length, a.window_width, a.window_lead) == (base.window.length, base.window.width, base.window.lead)
+    assert a.bed_depth == base.bed_depth
