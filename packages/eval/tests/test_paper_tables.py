@@ -125,3 +125,13 @@ def test_runs_older_than_the_window_check_are_not_named(tmp_path: Path) -> None:
     summary = combine([("td", _run(tmp_path, "a", 5, 10))], tmp_path / "out")
     assert summary["window_exit_rows"] == {}
     assert "left the sand window" not in (tmp_path / "out" / "table_terrains.md").read_text()
+
+
+def test_the_paper_layouts_are_written(tmp_path: Path) -> None:
+    """``table_ablation`` and ``table_per_terrain`` (markdown + CSV) come with the combined tables."""
+    combine([("td", _run(tmp_path, "a", 5, 10)), ("rigid", _run(tmp_path, "b", 0, 10))], tmp_path / "out")
+    ablation = list(csv.DictReader((tmp_path / "out" / "table_ablation.csv").open()))
+    assert [(r["policy"], r["straight_success_pct"]) for r in ablation] == [("td", "50.0"), ("rigid", "0.0")]
+    per_terrain = list(csv.DictReader((tmp_path / "out" / "table_per_terrain.csv").open()))
+    assert per_terrain[0]["terrain"] == "dry_sand" and per_terrain[0]["rigid: success %"] == "0.0"
+    assert (tmp_path / "out" / "table_per_terrain.md").is_file()

@@ -11,6 +11,9 @@ tool labels each run's episodes with the policy's name and writes the combined t
   interval, tracking errors, DTW path error, sinkage and swing (``gmloco.eval.tables_mpm``);
 * ``table_speeds.{md,csv}``: success rate per commanded speed, one row per (policy, terrain, scenario);
 * ``table_transition.{md,csv}`` when a run walked the layered course;
+* ``table_ablation.{md,csv}`` (the contact-model ablation's layout: per terrain and policy, the straight walk's
+  success beside the circular walk's success and DTW path error) and ``table_per_terrain.{md,csv}`` (one row per
+  terrain, each policy's success rate and velocity / yaw tracking errors on the straight walk);
 * ``fig_speeds_<terrain>_<scenario>.png``: per cell, the policies' success rate (95 % interval) and median time alive
   against the commanded speed;
 * ``tables.json``: the runs, their common MPM setting, which rows are partial, and the rows as records
@@ -76,8 +79,11 @@ def combine(
     """
     from gmloco.eval.convergence import load_episodes
     from gmloco.eval.tables_mpm import (
+        ABLATION_COLUMNS,
         TERRAIN_COLUMNS,
         TRANSITION_COLUMNS,
+        table_ablation,
+        table_per_terrain,
         table_speeds,
         table_terrains,
         table_transition,
@@ -113,6 +119,8 @@ def combine(
     write_table(out_dir / "table_speeds", ["policy", *table_speeds([], all_speeds)[0]], speeds, note)
     if transition:
         write_table(out_dir / "table_transition", ("policy", *TRANSITION_COLUMNS), transition, note)
+    write_table(out_dir / "table_ablation", ABLATION_COLUMNS, table_ablation(terrains), note)
+    write_table(out_dir / "table_per_terrain", *table_per_terrain(terrains), note)
     figures = _figures_by_cell(loaded, out_dir)
     summary = {
         "runs": {label: {"dir": str(d), "policy": summaries[label].get("policy")} for label, d in runs},

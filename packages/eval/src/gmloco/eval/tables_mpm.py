@@ -6,6 +6,9 @@
   ``window_exit_pct``: episodes whose soles left the sand window early, a validity check, NaN for older runs;
   several policies' ``episodes.jsonl`` concatenated give the ablation rows).
 * ``table_speeds``: success rate per commanded forward speed (rows terrain x scenario).
+* ``table_ablation`` and ``table_per_terrain``: the same numbers in the paper's two layouts, built from several
+  policies' ``table_terrains`` rows (``gmloco.eval.paper_tables``): per (terrain, policy) the straight and circular
+  walks side by side (success, DTW path error), and per terrain each policy's success and tracking errors.
 * ``table_transition``: on the layered ``transition`` course, per (scenario, medium): episodes that reached the
   medium, the student's mean decoded stiffness eta and the swing apex / lift there (GM-Loco's terrain-transition
   analysis); written only when the rows hold transition episodes.
@@ -21,7 +24,12 @@ from typing import Any
 import numpy as np
 
 __all__ = [
+    "ABLATION_COLUMNS",
+    "PER_TERRAIN_METRICS",
+    "TERRAIN_COLUMNS",
     "TRANSITION_COLUMNS",
+    "table_ablation",
+    "table_per_terrain",
     "table_speeds",
     "table_terrains",
     "table_transition",
@@ -92,6 +100,59 @@ def table_speeds(rows: list[dict[str, Any]], speeds: list[float] | None = None) 
         body.append(
             [terrain, scenario, *[100.0 * _mean([r for r in rs if r["speed"] == v], "success") for v in speeds]]
         )
+    return header, body
+
+
+ABLATION_COLUMNS = ("terrain", "policy", "straight_episodes", "straight_success_pct", "circle_episodes",
+                    "circle_success_pct", "circle_path_error_m")  # fmt: skip
+"""Columns of ``table_ablation``."""
+
+_COL = {c: i for i, c in enumerate(TERRAIN_COLUMNS)}
+
+
+def table_ablation(terrain_rows: list[list[Any]]) -> list[list[Any]]:
+    """GM-Loco's contact-model ablation layout: straight and circular walks side by side per (terrain, policy).
+
+    Columns ``ABLATION_COLUMNS``: the straight walk's success rate beside the circular walk's success rate and DTW
+    path error (a scenario not run: 0 episodes, NaN). ``terrain_rows``: rows of ``table_terrains`` (``TERRAIN_COLUMNS``, extra trailing columns ignored), several
+    policies concatenated; the output keeps their first-seen order.
+    """
+    cells: dict[tuple[str, str], dict[str, list[Any]]] = {}
+    for r in terrain_rows:
+        cells.setdefault((r[_COL["terrain"]], r[_COL["policy"]]), {})[r[_COL["scenario"]]] = r
+    nan = float("nan")
+    out = []
+    for (terrain, policy), by in sorted(cells.items(), key=lambda kv: _first_seen(cells, kv[0][0])):
+        s, c = by.get("straight"), by.get("circle")
+        out.append([terrain, policy,
+                    s[_COL["episodes"]] if s else 0, s[_COL["success_rate_pct"]] if s else nan,
+                    c[_COL["episodes"]] if c else 0, c[_COL["success_rate_pct"]] if c else nan,
+                    c[_COL["path_error_m"]] if c else nan])  # fmt: skip
+    return out
+
+
+def _first_seen(cells: dict[tuple[str, str], Any], terrain: str) -> int:
+    """Rank of ``terrain`` by first appearance among ``cells``' keys (a stable sort key that groups terrains)."""
+    return [t for t, _ in cells].index(terrain)
+
+
+PER_TERRAIN_METRICS = (("success_rate_pct", "success %"), ("vel_error_mps", "vel error [m/s]"),
+                       ("yaw_error_radps", "yaw error [rad/s]"))  # fmt: skip
+"""The per-terrain table's metrics (``table_terrains`` column, header label)."""
+
+
+def table_per_terrain(terrain_rows: list[list[Any]], scenario: str = "straight") -> tuple[list[str], list[list[Any]]]:
+    """GM-Loco's per-terrain layout: one row per terrain, each policy's success and tracking errors side by side.
+
+    For each policy: its success rate and velocity and yaw tracking errors on ``scenario`` (NaN where the policy
+    did not walk that terrain). Returns (header, rows).
+    """
+    policies = list(dict.fromkeys(r[_COL["policy"]] for r in terrain_rows))
+    terrains = list(dict.fromkeys(r[_COL["terrain"]] for r in terrain_rows if r[_COL["scenario"]] == scenario))
+    at = {(r[_COL["terrain"]], r[_COL["policy"]]): r for r in terrain_rows if r[_COL["scenario"]] == scenario}
+    header = ["terrain", *[f"{p}: {label}" for p in policies for _, label in PER_TERRAIN_METRICS]]
+    body = [[t, *[at[(t, p)][_COL[key]] if (t, p) in at else float("nan") for p in policies
+                  for key, _ in PER_TERRAIN_METRICS]] for t in terrains]  # fmt: skip
     return header, body
 
 
