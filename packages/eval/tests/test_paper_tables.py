@@ -74,10 +74,10 @@ def test_seeds_and_time_boxes_may_differ(tmp_path: Path) -> None:
 
 
 def test_command_line_errors_say_what_to_pass(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
-    """A --run without LABEL=, a folder without summary.json and a repeated label are usage errors."""
-    run = _run(tmp_path, "a", 1, 2)
+    """A --run without LABEL=, a folder without summary.json and one label on two policies are usage errors."""
+    run, other = _run(tmp_path, "a", 1, 2), _run(tmp_path, "b", 1, 2)
     for argv, msg in ((["--run", str(run)], "LABEL=RUN_DIR"), (["--run", f"x={tmp_path}"], "no summary.json"),
-                      (["--run", f"x={run}", "--run", f"x={run}"], "labels repeat")):  # fmt: skip
+                      (["--run", f"x={run}", "--run", f"x={other}"], "different policies")):  # fmt: skip
         with pytest.raises(SystemExit):
             main([*argv, "--out", str(tmp_path / "out")])
         assert msg in capsys.readouterr().err
@@ -135,3 +135,13 @@ def test_the_paper_layouts_are_written(tmp_path: Path) -> None:
     per_terrain = list(csv.DictReader((tmp_path / "out" / "table_per_terrain.csv").open()))
     assert per_terrain[0]["terrain"] == "dry_sand" and per_terrain[0]["rigid: success %"] == "0.0"
     assert (tmp_path / "out" / "table_per_terrain.md").is_file()
+
+
+def test_folders_with_one_label_are_pooled(tmp_path: Path) -> None:
+    """One policy scored in two folders (two GPUs): one row of 20 episodes, both folders in the provenance."""
+    a, b = _run(tmp_path, "a", 5, 10), _run(tmp_path, "b", 3, 10)
+    doc = json.loads((b / "summary.json").read_text())
+    (b / "summary.json").write_text(json.dumps(doc | {"policy": "artifacts/a/policy.onnx"}))
+    summary = combine([("td", a), ("td", b)], tmp_path / "out", episodes=20)
+    assert [(r["policy"], r["episodes"], r["success_rate_pct"]) for r in summary["rows"]] == [("td", 20, 40.0)]
+    assert summary["runs"]["td"]["dirs"] == [str(a), str(b)] and summary["partial_rows"] == []

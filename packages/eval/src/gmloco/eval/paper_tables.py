@@ -73,6 +73,9 @@ def combine(
 ) -> dict[str, Any]:
     """Write the combined tables of ``runs`` (label, run folder) under ``out_dir``; return ``tables.json``'s content.
 
+    Folders given the same label are pooled (one policy's cells scored in several folders, e.g. one per GPU by
+    ``gmloco.eval.g1_eval_queue``); they must hold the same policy.
+
     Raises:
         ValueError: Two runs differ in their MPM setting (and ``allow_mixed`` is False), a label repeats, or a run
             holds no episodes.
@@ -90,18 +93,27 @@ def combine(
         write_table,
     )
 
-    labels = [label for label, _ in runs]
-    if len(set(labels)) != len(labels):
-        raise ValueError(f"policy labels repeat ({labels}); give each run its own LABEL=DIR")
-    summaries = {label: _summary(d) for label, d in runs}
-    settings = {label: setting_of(sm) for label, sm in summaries.items()}
+    grouped: dict[str, list[Path]] = {}
+    for label, d in runs:
+        grouped.setdefault(label, []).append(Path(d))
+    labels = list(grouped)
+    summaries = {label: [_summary(d) for d in ds] for label, ds in grouped.items()}
+    for label, sms in summaries.items():
+        if len({sm.get("policy") for sm in sms}) > 1:
+            raise ValueError(f"the runs labelled {label!r} scored different policies "
+                             f"({sorted({str(sm.get('policy')) for sm in sms})}); give each policy its own label")  # fmt: skip
     first = labels[0]
-    mixed = {label: diff for label in labels[1:] if (diff := _differences(settings[first], settings[label]))}
+    base = setting_of(summaries[first][0])
+    mixed = {}
+    for label, ds in grouped.items():
+        for i, (d, sm) in enumerate(zip(ds, summaries[label], strict=True)):
+            if diff := _differences(base, setting_of(sm)):
+                mixed[label if i == 0 else f"{label} ({d})"] = diff
     if mixed and not allow_mixed:
         lines = "; ".join(f"{label}: {', '.join(diff)}" for label, diff in mixed.items())
         raise ValueError(f"runs were scored at different MPM settings than {first!r} ({lines}); rerun them at one "
                          "setting, or pass --allow-mixed-settings to tabulate them anyway")  # fmt: skip
-    loaded = [(label, load_episodes(d)) for label, d in runs]
+    loaded = [(label, [r for d in ds for r in load_episodes(d)]) for label, ds in grouped.items()]
     all_speeds = sorted({float(r["speed"]) for _, rows in loaded for r in rows})
     terrains, speeds, transition, partial = [], [], [], []
     for label, rows in loaded:
@@ -123,8 +135,11 @@ def combine(
     write_table(out_dir / "table_per_terrain", *table_per_terrain(terrains), note)
     figures = _figures_by_cell(loaded, out_dir)
     summary = {
-        "runs": {label: {"dir": str(d), "policy": summaries[label].get("policy")} for label, d in runs},
-        "setting": settings[first],
+        "runs": {
+            label: {"dirs": [str(d) for d in ds], "policy": summaries[label][0].get("policy")}
+            for label, ds in grouped.items()
+        },
+        "setting": base,
         "mixed_settings": mixed,
         "episodes_expected": episodes,
         "partial_rows": partial,
@@ -202,7 +217,13 @@ def _run_arg(text: str) -> tuple[str, Path]:
 def main(argv: list[str] | None = None) -> dict[str, Any]:
     """Command line: combine runs into the paper's tables."""
     p = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    p.add_argument("--run", type=_run_arg, action="append", required=True, help="LABEL=RUN_DIR (repeat per policy)")
+    p.add_argument(
+        "--run",
+        type=_run_arg,
+        action="append",
+        required=True,
+        help="LABEL=RUN_DIR (repeat per policy; folders with the same label are pooled)",
+    )
     p.add_argument("--out", type=Path, required=True, help="folder for the tables")
     p.add_argument("--episodes", type=int, default=100, help="episodes a complete row has (the paper: 100)")
     p.add_argument("--allow-mixed-settings", action="store_true", help="tabulate runs scored at different settings")

@@ -1,0 +1,166 @@
+# SPDX-License-Identifier: Apache-2.0
+"""Several GPUs, one evaluation each: the MPM evaluation's cells spread over a machine's GPUs (issue 9).
+
+One ``g1_eval_cli`` process drives one GPU; running several on one GPU does not pay (session 15: seven side by side
+on an H100 summed ~112 robot-frames/s against ~150 for one alone). On a machine with N GPUs this tool splits the
+evaluation into one task per (terrain, scenario) cell, each with its own run folder ``OUT/<terrain>__<scenario>``,
+and keeps every GPU busy from a shared queue (a GPU takes the next task when its last one ends). Each task is
+time-boxed to what is left of ``--max-minutes`` and resumable like any ``g1_eval`` run (same ``--out``); a task that
+would get less than a minute is not started. Afterwards, combine the folders with ``gmloco.eval.paper_tables``
+(the queue prints the command: the folders share one label, so they are pooled into one policy's rows).
+
+    python -m gmloco.eval.g1_eval_queue --gpus 0 1 2 3 --out results/mpm_eval/td
+        --terrains basalt dry_sand poppy_seed --scenarios straight circle --max-minutes 25
+        -- --policy artifacts/gm_loco_student_td/policy.onnx
+
+Everything after ``--`` goes to every ``g1_eval_cli`` call (policy, window, numerics, episodes). Writes
+``OUT/queue.json`` (per task: GPU, return code, minutes, log file).
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import subprocess
+import sys
+import time
+from collections.abc import Callable
+from dataclasses import asdict, dataclass
+from pathlib import Path
+from typing import Any
+
+__all__ = ["Launch", "QueueTask", "TaskResult", "cell_tasks", "main", "run_queue"]
+
+MIN_TASK_MINUTES = 1.0
+"""A task that would get less than this is not started [min] (it would only build its solver)."""
+
+
+@dataclass(frozen=True)
+class QueueTask:
+    """One ``g1_eval_cli`` call: a run folder name and its arguments (without ``--out`` and ``--max-minutes``)."""
+
+    name: str
+    argv: tuple[str, ...]
+
+
+@dataclass
+class TaskResult:
+    """What became of a task."""
+
+    name: str
+    gpu: str | None = None
+    """The GPU (``CUDA_VISIBLE_DEVICES`` value) it ran on; None if it was not started."""
+    returncode: int | None = None
+    minutes: float = 0.0
+    log: str = ""
+
+
+def cell_tasks(terrains: list[str], scenarios: list[str], argv: list[str]) -> list[QueueTask]:
+    """One task per (terrain, scenario), in that order (give the most wanted first)."""
+    for flag in ("--out", "--max-minutes", "--terrains", "--scenarios", "--device"):
+        if flag in argv:
+            raise ValueError(f"{flag} is set by the queue per task; remove it from the arguments after --")
+    return [QueueTask(f"{t}__{s}", (*argv, "--terrains", t, "--scenarios", s)) for t in terrains for s in scenarios]
+
+
+Launch = Callable[[list[str], dict[str, str], Path], subprocess.Popen[bytes]]
+"""Starts one task's command with its environment, output to its log file (tests pass a stand-in)."""
+
+
+def _launch(cmd: list[str], env: dict[str, str], log: Path) -> subprocess.Popen[bytes]:
+    """Start ``cmd`` with ``env``, its output appended to ``log``."""
+    with log.open("ab") as f:
+        return subprocess.Popen(cmd, env=env, stdout=f, stderr=subprocess.STDOUT)
+
+
+def _command(task: QueueTask, out_root: Path, minutes: float | None) -> list[str]:
+    cmd = [sys.executable, "-m", "gmloco.eval.g1_eval_cli", *task.argv, "--out", str(out_root / task.name)]
+    return cmd if minutes is None else [*cmd, "--max-minutes", f"{minutes:.2f}"]
+
+
+def run_queue(
+    tasks: list[QueueTask],
+    gpus: list[str],
+    out_root: Path,
+    max_minutes: float | None = None,
+    launch: Launch = _launch,
+    poll_s: float = 2.0,
+) -> list[TaskResult]:
+    """Run ``tasks`` over ``gpus``, one at a time per GPU, in order; return one result per task.
+
+    Raises:
+        ValueError: No GPU, or a GPU named twice.
+    """
+    if not gpus or len(set(gpus)) != len(gpus):
+        raise ValueError(f"--gpus {gpus}: name each GPU once (CUDA_VISIBLE_DEVICES values, e.g. 0 1 2 3)")
+    out_root.mkdir(parents=True, exist_ok=True)
+    t0 = time.monotonic()
+    left = (lambda: None) if max_minutes is None else (lambda: max_minutes - (time.monotonic() - t0) / 60.0)
+    results = {t.name: TaskResult(t.name, log=str(out_root / f"{t.name}.log")) for t in tasks}
+    queue, running = list(tasks), {}  # gpu -> (task, process, start)
+    while queue or running:
+        for gpu in [g for g in gpus if g not in running]:
+            minutes = left()
+            if not queue or (minutes is not None and minutes < MIN_TASK_MINUTES):
+                break
+            task = queue.pop(0)
+            env = {**os.environ, "CUDA_VISIBLE_DEVICES": gpu}
+            running[gpu] = (task, launch(_command(task, out_root, minutes), env, out_root / f"{task.name}.log"),
+                            time.monotonic())  # fmt: skip
+            results[task.name].gpu = gpu
+            print(f"[queue] {task.name} started on GPU {gpu}" + (f" ({minutes:.1f} min left)" if minutes else ""))
+        if queue and not running:  # nothing runs and nothing may start: the time is up
+            break
+        for gpu, (task, proc, start) in list(running.items()):
+            if (rc := proc.poll()) is not None:
+                res = results[task.name]
+                res.returncode, res.minutes = rc, round((time.monotonic() - start) / 60.0, 2)
+                print(f"[queue] {task.name} on GPU {gpu}: rc={rc} after {res.minutes:.1f} min")
+                del running[gpu]
+        if running:
+            time.sleep(poll_s)
+    return [results[t.name] for t in tasks]
+
+
+def _policy_label(argv: list[str]) -> str:
+    """The folder name of ``--policy`` among ``g1_eval_cli`` arguments (``policy`` when none is given)."""
+    if "--policy" not in argv or argv.index("--policy") + 1 >= len(argv):
+        return "policy"
+    return Path(argv[argv.index("--policy") + 1]).parent.name or "policy"
+
+
+def main(argv: list[str] | None = None) -> list[TaskResult]:
+    """Command line (see the module docstring)."""
+    argv = sys.argv[1:] if argv is None else argv
+    own, passthrough = (argv[: argv.index("--")], argv[argv.index("--") + 1 :]) if "--" in argv else (argv, [])
+    p = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    p.add_argument("--gpus", nargs="+", required=True, help="CUDA_VISIBLE_DEVICES values, one task at a time each")
+    p.add_argument("--out", type=Path, required=True, help="folder of the run folders (one per cell)")
+    p.add_argument("--terrains", nargs="+", required=True)
+    p.add_argument("--scenarios", nargs="+", default=["straight"])
+    p.add_argument("--max-minutes", type=float, default=None, help="time box of the whole queue [min]")
+    p.add_argument("--label", default=None, help="policy label in the combined tables (default: the policy's folder)")
+    a = p.parse_args(own)
+    try:
+        tasks = cell_tasks(a.terrains, a.scenarios, passthrough)
+        results = run_queue(tasks, a.gpus, a.out, a.max_minutes)
+    except ValueError as exc:
+        p.error(str(exc))
+    doc: dict[str, Any] = {"gpus": a.gpus, "max_minutes": a.max_minutes, "argv": passthrough,
+                           "tasks": [asdict(r) for r in results]}  # fmt: skip
+    (a.out / "queue.json").write_text(json.dumps(doc, indent=1) + "\n")
+    failed = [r.name for r in results if r.returncode not in (0, None)]
+    skipped = [r.name for r in results if r.gpu is None]
+    if skipped:
+        print(f"[queue] not started (time box): {', '.join(skipped)}; rerun the same command to go on")
+    if failed:
+        print(f"[queue] failed: {', '.join(failed)}; see their logs in {a.out}")
+    label = a.label or _policy_label(passthrough)
+    runs = " ".join(f"--run {label}={a.out / r.name}" for r in results if r.gpu is not None)
+    print(f"[queue] combine: python -m gmloco.eval.paper_tables {runs} --out {a.out / 'tables'}")
+    return results
+
+
+if __name__ == "__main__":
+    main()

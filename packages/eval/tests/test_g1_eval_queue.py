@@ -1,0 +1,72 @@
+# SPDX-License-Identifier: Apache-2.0
+"""The several-GPU queue: every task runs once, one at a time per GPU, within the time box; failures are reported."""
+
+from __future__ import annotations
+
+import itertools
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+from gmloco.eval.g1_eval_queue import Launch, QueueTask, cell_tasks, main, run_queue
+
+
+def _fake_launch(record: Path, fail: str = "") -> Launch:
+    """A launcher that runs a short Python process instead of g1_eval_cli, logging (task, GPU, start, end)."""
+
+    def launch(cmd: list[str], env: dict[str, str], log: Path) -> subprocess.Popen[bytes]:
+        name = Path(cmd[cmd.index("--out") + 1]).name
+        code = 3 if name == fail else 0
+        script = ("import sys, time; t0 = time.time(); time.sleep(0.3); "
+                  f"open({str(record)!r}, 'a').write(f'{name} {env['CUDA_VISIBLE_DEVICES']} {{t0}} {{time.time()}}\\n'); "
+                  f"sys.exit({code})")  # fmt: skip
+        return subprocess.Popen([sys.executable, "-c", script])
+
+    return launch
+
+
+def test_cells_become_tasks_and_queue_owned_flags_are_refused() -> None:
+    """One task per (terrain, scenario) with the shared arguments; --out after -- is an error."""
+    tasks = cell_tasks(["basalt", "dry_sand"], ["straight", "circle"], ["--policy", "p.onnx"])
+    assert [t.name for t in tasks] == ["basalt__straight", "basalt__circle", "dry_sand__straight", "dry_sand__circle"]
+    assert tasks[1].argv == ("--policy", "p.onnx", "--terrains", "basalt", "--scenarios", "circle")
+    with pytest.raises(ValueError, match="--out is set by the queue"):
+        cell_tasks(["basalt"], ["straight"], ["--out", "x"])
+
+
+def test_every_task_runs_once_and_a_gpu_runs_one_at_a_time(tmp_path: Path) -> None:
+    """Five tasks on two GPUs: all run, none twice, and no two overlap on one GPU."""
+    record = tmp_path / "record.txt"
+    tasks = [QueueTask(f"t{k}", ()) for k in range(5)]
+    results = run_queue(tasks, ["0", "1"], tmp_path / "out", launch=_fake_launch(record), poll_s=0.05)
+    assert [r.returncode for r in results] == [0] * 5 and {r.gpu for r in results} == {"0", "1"}
+    lines = [line.split() for line in record.read_text().splitlines()]
+    assert sorted(line[0] for line in lines) == [f"t{k}" for k in range(5)]
+    for gpu in ("0", "1"):
+        spans = sorted((float(a), float(b)) for _, g, a, b in lines if g == gpu)
+        assert all(end <= nxt_start for (_, end), (nxt_start, _) in itertools.pairwise(spans))
+
+
+def test_a_failed_task_is_reported_and_the_rest_go_on(tmp_path: Path) -> None:
+    """Task t1 exits 3: its result says so, t0 and t2 still run."""
+    tasks = [QueueTask(f"t{k}", ()) for k in range(3)]
+    launch = _fake_launch(tmp_path / "record.txt", fail="t1")
+    results = run_queue(tasks, ["0"], tmp_path / "out", launch=launch, poll_s=0.05)
+    assert [r.returncode for r in results] == [0, 3, 0]
+
+
+def test_nothing_starts_when_the_time_box_is_too_short(tmp_path: Path) -> None:
+    """Half a minute left: no task is started (it would only build its solver); none has a GPU."""
+    launch = _fake_launch(tmp_path / "record.txt")
+    results = run_queue([QueueTask("t0", ())], ["0"], tmp_path / "out", max_minutes=0.5, launch=launch)
+    assert results[0].gpu is None and results[0].returncode is None
+    assert not (tmp_path / "record.txt").exists()
+
+
+def test_command_line_refuses_a_gpu_named_twice(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    """--gpus 0 0 is a usage error that says how to name them."""
+    with pytest.raises(SystemExit):
+        main(["--gpus", "0", "0", "--out", str(tmp_path), "--terrains", "basalt", "--", "--policy", "p.onnx"])
+    assert "name each GPU once" in capsys.readouterr().err
