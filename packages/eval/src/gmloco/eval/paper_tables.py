@@ -77,8 +77,8 @@ def combine(
     ``gmloco.eval.g1_eval_queue``); they must hold the same policy.
 
     Raises:
-        ValueError: Two runs differ in their MPM setting (and ``allow_mixed`` is False), a label repeats, or a run
-            holds no episodes.
+        ValueError: Two runs differ in their MPM setting (and ``allow_mixed`` is False), one label names runs of
+            different policies, or a run holds no episodes.
     """
     from gmloco.eval.convergence import load_episodes
     from gmloco.eval.tables_mpm import (
