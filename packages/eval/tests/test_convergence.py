@@ -153,3 +153,12 @@ def test_sinkage_interval_brackets_the_difference_and_narrows_with_episodes() ->
         lo, hi = v.sinkage_rel_ci95
         assert lo < 0.10 < hi
     assert np.diff(large.sinkage_rel_ci95)[0] < np.diff(small.sinkage_rel_ci95)[0]
+
+
+def test_sinkage_interval_skips_episodes_without_a_sinkage() -> None:
+    """A NaN sinkage (no sole near the sand) is left out of the interval, as out of the means."""
+    alive = np.full(12, 10.0)
+    cand = _rows(alive, 0.08, 0.5)
+    cand[0]["mean_sinkage"] = float("nan")
+    lo, hi = compare_runs(_rows(alive, 0.08, 0.5), cand).sinkage_rel_ci95
+    assert np.isfinite(lo) and np.isfinite(hi) and lo <= 0.0 <= hi

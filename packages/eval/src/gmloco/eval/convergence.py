@@ -138,6 +138,7 @@ def _mw_p(cand: np.ndarray, ref: np.ndarray) -> float:
 
 def _sinkage_ci(cand: np.ndarray, ref: np.ndarray, n_boot: int = 2000, seed: int = 0) -> tuple[float, float]:
     """95 % percentile-bootstrap interval of (mean(cand) - mean(ref)) / mean(ref), episodes resampled per run."""
+    cand, ref = cand[np.isfinite(cand)], ref[np.isfinite(ref)]  # as the means of the check (nanmean)
     if len(cand) == 0 or len(ref) == 0:
         return (math.nan, math.nan)
     rng = np.random.default_rng(seed)
