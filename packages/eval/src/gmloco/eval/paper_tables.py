@@ -99,9 +99,10 @@ def combine(
     labels = list(grouped)
     summaries = {label: [_summary(d) for d in ds] for label, ds in grouped.items()}
     for label, sms in summaries.items():
-        if len({sm.get("policy") for sm in sms}) > 1:
-            raise ValueError(f"the runs labelled {label!r} scored different policies "
-                             f"({sorted({str(sm.get('policy')) for sm in sms})}); give each policy its own label")  # fmt: skip
+        policies = sorted({str(sm.get("policy")) for sm in sms})
+        if len(policies) > 1:
+            raise ValueError(f"the runs labelled {label!r} scored different policies ({policies}); give each "
+                             "policy its own label")  # fmt: skip
     first = labels[0]
     base = setting_of(summaries[first][0])
     mixed = {}

@@ -2,7 +2,8 @@
 """The MPM evaluation's paper-shaped tables (markdown + CSV) from the per-episode rows of ``episodes.jsonl``.
 
 * ``table_terrains``: one row per (policy, terrain, scenario): episodes, success rate with its 95 % Wilson
-  interval, velocity and yaw tracking error, DTW path error, mean sinkage, swing apex and lift (GM-Loco's per-terrain and contact-model tables;
+  interval, velocity and yaw tracking error, DTW path error, mean sinkage, swing apex and lift (GM-Loco's
+  per-terrain and contact-model tables;
   ``window_exit_pct``: episodes whose soles left the sand window early, a validity check, NaN for older runs;
   several policies' ``episodes.jsonl`` concatenated give the ablation rows).
 * ``table_speeds``: success rate per commanded forward speed (rows terrain x scenario).
@@ -114,26 +115,23 @@ def table_ablation(terrain_rows: list[list[Any]]) -> list[list[Any]]:
     """GM-Loco's contact-model ablation layout: straight and circular walks side by side per (terrain, policy).
 
     Columns ``ABLATION_COLUMNS``: the straight walk's success rate beside the circular walk's success rate and DTW
-    path error (a scenario not run: 0 episodes, NaN). ``terrain_rows``: rows of ``table_terrains`` (``TERRAIN_COLUMNS``, extra trailing columns ignored), several
-    policies concatenated; the output keeps their first-seen order.
+    path error (a scenario not run: 0 episodes, NaN). ``terrain_rows``: rows of ``table_terrains``
+    (``TERRAIN_COLUMNS``, extra trailing columns ignored), several policies concatenated; terrains and policies
+    keep their first-seen order, the rows grouped by terrain.
     """
-    cells: dict[tuple[str, str], dict[str, list[Any]]] = {}
+    cells: dict[str, dict[str, dict[str, list[Any]]]] = {}  # terrain -> policy -> scenario -> row
     for r in terrain_rows:
-        cells.setdefault((r[_COL["terrain"]], r[_COL["policy"]]), {})[r[_COL["scenario"]]] = r
+        cells.setdefault(r[_COL["terrain"]], {}).setdefault(r[_COL["policy"]], {})[r[_COL["scenario"]]] = r
     nan = float("nan")
     out = []
-    for (terrain, policy), by in sorted(cells.items(), key=lambda kv: _first_seen(cells, kv[0][0])):
-        s, c = by.get("straight"), by.get("circle")
-        out.append([terrain, policy,
-                    s[_COL["episodes"]] if s else 0, s[_COL["success_rate_pct"]] if s else nan,
-                    c[_COL["episodes"]] if c else 0, c[_COL["success_rate_pct"]] if c else nan,
-                    c[_COL["path_error_m"]] if c else nan])  # fmt: skip
+    for terrain, policies in cells.items():
+        for policy, by in policies.items():
+            s, c = by.get("straight"), by.get("circle")
+            out.append([terrain, policy,
+                        s[_COL["episodes"]] if s else 0, s[_COL["success_rate_pct"]] if s else nan,
+                        c[_COL["episodes"]] if c else 0, c[_COL["success_rate_pct"]] if c else nan,
+                        c[_COL["path_error_m"]] if c else nan])  # fmt: skip
     return out
-
-
-def _first_seen(cells: dict[tuple[str, str], Any], terrain: str) -> int:
-    """Rank of ``terrain`` by first appearance among ``cells``' keys (a stable sort key that groups terrains)."""
-    return [t for t, _ in cells].index(terrain)
 
 
 PER_TERRAIN_METRICS = (("success_rate_pct", "success %"), ("vel_error_mps", "vel error [m/s]"),
