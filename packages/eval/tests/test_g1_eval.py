@@ -117,6 +117,10 @@ def test_a_run_reports_the_soles_reach_against_its_window(capsys: pytest.Capture
     assert "0.62 m behind the pelvis, 0.15 m ahead and 0.20 m sideways" in err
     assert "spans 0.40 m behind, 0.60 m ahead and 0.25 m sideways" in err
     assert "in 2 of 3 episodes" in err and "first at 0.50 s, k2" in err
+    assert "turned" not in err  # rows without the cause (older runs) blame nothing on a turn
+    rows[1]["window_exit_turn"] = True
+    _report_window(rows, SandWindowCfg(length=1.0, width=0.5, lead=0.1))
+    assert "in 1 of them the robot had turned" in capsys.readouterr().err
     _report_window(rows[:1], SandWindowCfg(length=1.0, width=0.5, lead=0.1))
     assert "warning" not in capsys.readouterr().err
 
@@ -450,3 +454,45 @@ def test_grid_capacity_pads_without_changing_the_walk() -> None:
         final[factor] = (np.array(scene.base_q[-1]), solver.max_active_cell_count)
     assert final[1.5][1] < 0.55 * final[3.0][1]
     np.testing.assert_allclose(final[1.5][0], final[3.0][0], atol=1e-6)
+
+
+def test_a_window_exit_is_blamed_on_a_turn_or_on_the_reach() -> None:
+    """Soles within the window's extent along the heading: the robot turned; beyond it: the window is too small.
+
+    Hand-made walk: the heading turns steadily to 60 degrees; a sole leaves the (1.4 x 0.6 m, lead 0.2) window at
+    step 30. With the soles 0.4 m behind and 0.2 m beside the pelvis (inside 0.5 / 0.3 m) the cause is the turn;
+    0.6 m behind (beyond 0.5 m) it is the reach; a static bed never turns.
+    """
+    cfg = replace(G1EvalCfg(), episode_s=2.0)
+    dt, n = 0.02, 100
+    t = (np.arange(n) + 1) * dt
+    log = _log(np.stack([t, 0 * t], 1), np.tile([1.0, 0.0], (n, 1)), np.full(n, 0.7), dt)
+    yaw = np.radians(np.linspace(0.0, 60.0, n))
+    log["base_q"][:, 5], log["base_q"][:, 6] = np.sin(0.5 * yaw), np.cos(0.5 * yaw)
+    log["sole_out"] = np.zeros(n)
+    log["sole_out"][30:] = 1
+    log["sole_reach"] = np.tile([0.4, 0.2, 0.2], (n, 1))
+    spec = EpisodeSpec("dry_sand", "straight", 1.0, 0)
+    row = score_episode(spec, cfg, log)
+    assert math.isclose(row["heading_turn_deg"], 60.0, rel_tol=1e-6)
+    assert row["window_exit_cause"] == "turn" and row["window_exit_turn"] and row["window_exit_early"]
+    log["sole_reach"][30] = [0.6, 0.2, 0.2]
+    row = score_episode(spec, cfg, log)
+    assert row["window_exit_cause"] == "reach" and not row["window_exit_turn"]
+    log["sole_reach"][30] = [0.4, 0.2, 0.29]  # within the 2 cm margin of the side: counted as beyond
+    assert score_episode(spec, cfg, log)["window_exit_cause"] == "reach"
+    log["sole_reach"][30] = [0.4, 0.2, 0.2]
+    static = replace(cfg, window=replace(cfg.window, moving=False))
+    assert score_episode(spec, static, log)["window_exit_cause"] == "reach"
+    del log["sole_out"]
+    row = score_episode(spec, cfg, log)
+    assert row["window_exit_cause"] is None and not row["window_exit_turn"]
+
+
+def test_heading_turn_wraps_around() -> None:
+    """A heading going from 170 to -170 degrees turned 20 degrees, not 340; only alive samples count."""
+    from gmloco.eval.g1_eval import heading_turn_deg
+
+    yaw = np.radians([170.0, 180.0, -170.0, 90.0])
+    assert math.isclose(heading_turn_deg(yaw, 3), 20.0, rel_tol=1e-9)
+    assert math.isclose(heading_turn_deg(yaw, 4), 80.0, rel_tol=1e-9)

@@ -21,6 +21,9 @@ with :mod:`gmloco.eval.metrics.locomotion`:
 * window check: ``window_exit_s``, the first time a sole corner within 2 cm of the surface lay outside its robot's
   sand window (no particles there), and ``window_exit_early`` when that was more than ``WINDOW_EXIT_GRACE_S`` before
   the episode ended; its rate is in the summary and the terrain table, and a run warns about it.
+  ``window_exit_cause`` says why: ``"turn"`` when the soles were within the window's extent along the robot's
+  heading (the window, a box of the grid's axes, did not turn with it; ``window_exit_turn`` flags such early exits),
+  ``"reach"`` when they stepped beyond it; ``heading_turn_deg`` is the heading's largest turn from its start.
 * decoded stiffness: the student's mean decoded eta over the alive steps; on the layered ``transition`` course
   also per medium, with the swings there (``layer_stats``; ``table_transition``, ``fig_mpm_transition.png``).
 
@@ -57,6 +60,7 @@ from gmloco.eval.mpm.window import SandWindowCfg
 
 __all__ = [
     "WINDOW_EXIT_GRACE_S",
+    "WINDOW_EXIT_MARGIN_M",
     "EpisodeSpec",
     "G1EvalCfg",
     "build_cell_scene",
@@ -64,6 +68,7 @@ __all__ = [
     "check_grid_capacity",
     "episode_batches",
     "episode_specs",
+    "heading_turn_deg",
     "lane_failed",
     "load_policy",
     "read_episodes",
@@ -71,6 +76,7 @@ __all__ = [
     "run_cell",
     "score_episode",
     "sole_reach_max",
+    "window_exit_cause",
     "window_exit_time",
 ]  # fmt: skip
 
@@ -405,6 +411,8 @@ def score_episode(spec: EpisodeSpec, cfg: G1EvalCfg, log: dict[str, Any]) -> dic
     eta = np.asarray(log.get("eta", np.full(len(q), np.nan)), dtype=float)[:alive]
     exit_s = window_exit_time(log.get("sole_out"), dt, alive)
     behind, ahead, side = sole_reach_max(log.get("sole_reach"), alive)
+    cause = window_exit_cause(log.get("sole_reach"), exit_s, dt, _window_and_lanes([spec], cfg)[0])
+    early = exit_s is not None and exit_s < out.alive_steps * dt - WINDOW_EXIT_GRACE_S
     return {
         "key": spec.key, "terrain": spec.terrain, "scenario": spec.scenario, "speed": spec.speed,
         "success": out.success, "reason": out.reason, "alive_s": out.alive_steps * dt,
@@ -419,8 +427,9 @@ def score_episode(spec: EpisodeSpec, cfg: G1EvalCfg, log: dict[str, Any]) -> dic
         "eta_mean": float(np.mean(eta)) if np.isfinite(eta).any() else float("nan"),
         "layers": layer_stats(log, alive),
         # a sole that needed sand stood outside its sand window (no particles there): the window was too small
-        "window_exit_s": exit_s,
-        "window_exit_early": exit_s is not None and exit_s < out.alive_steps * dt - WINDOW_EXIT_GRACE_S,
+        "window_exit_s": exit_s, "window_exit_early": early, "window_exit_cause": cause,
+        # the window is a box of the grid's axes: a robot that turned can step out of it within its reach
+        "window_exit_turn": early and cause == "turn", "heading_turn_deg": heading_turn_deg(yaw, alive),
         # how much window the soles needed: their reach from the pelvis (yaw frame) while near or in the sand
         "sole_behind_m": behind, "sole_ahead_m": ahead, "sole_side_m": side,
         # a sole reached the rigid floor under the sand (the soles stand on it): the bed was too shallow there
@@ -444,6 +453,39 @@ def window_exit_time(sole_out: Any, dt: float, alive: int) -> float | None:
     counts = np.asarray(sole_out, dtype=float).reshape(len(sole_out), -1).sum(axis=1)[:alive]
     hit = np.flatnonzero(counts > 0)
     return float(hit[0] * dt) if len(hit) else None
+
+
+WINDOW_EXIT_MARGIN_M = 0.02
+"""Reach this close to the window's edge counts as beyond it (the window moves in whole particle columns) [m]."""
+
+
+def window_exit_cause(reach: Any, exit_s: float | None, dt: float, window: SandWindowCfg) -> str | None:
+    """Why the soles first left the sand window, from their reach at that sample (``sole_reach``, pelvis yaw frame).
+
+    ``"turn"``: they lay within the window's extent measured along the robot's heading (behind, ahead, beside the
+    pelvis, less ``WINDOW_EXIT_MARGIN_M``), so the exit came from the robot turning: the window is a box of the
+    grid's axes and does not turn with it. ``"reach"``: they reached beyond that extent (the window is too short or
+    narrow, or a static bed). None without an exit or without a reach log (older runs).
+    """
+    arr = None if reach is None or exit_s is None else np.asarray(reach, dtype=float)
+    if arr is None or arr.ndim != 2 or arr.shape[1] != 3 or not len(arr):
+        return None
+    k = min(round(exit_s / dt), len(arr) - 1)  # type: ignore[operator]
+    if not np.isfinite(arr[k]).all():
+        return None
+    b, a, s = arr[k] + WINDOW_EXIT_MARGIN_M
+    half = 0.5 * window.length
+    fits = b <= half - window.lead and a <= half + window.lead and s <= 0.5 * window.width
+    return "turn" if window.moving and fits else "reach"
+
+
+def heading_turn_deg(yaw: np.ndarray, alive: int) -> float:
+    """Largest turn of the heading away from its start over the alive samples [deg] (yaw [rad], wrapped)."""
+    yaw = np.asarray(yaw, dtype=float)[: max(alive, 1)]
+    if not len(yaw):
+        return math.nan
+    turn = np.angle(np.exp(1j * (yaw - yaw[0])))
+    return float(np.degrees(np.max(np.abs(turn))))
 
 
 def sole_reach_max(reach: Any, alive: int) -> tuple[float, float, float]:
@@ -502,7 +544,8 @@ def _runs(mask: np.ndarray) -> list[tuple[int, int]]:
 
 METRIC_KEYS = (
     "success", "vel_error", "yaw_error", "path_error", "support_ratio", "max_sinkage", "mean_sinkage", "floor_reached",
-    "swing_apex", "swing_lift", "eta_mean", "window_exit_early", "sole_behind_m", "sole_ahead_m", "sole_side_m",
+    "swing_apex", "swing_lift", "eta_mean", "window_exit_early", "window_exit_turn", "heading_turn_deg",
+    "sole_behind_m", "sole_ahead_m", "sole_side_m",
 )  # fmt: skip
 
 
@@ -638,10 +681,14 @@ def _report_window(rows: list[dict[str, Any]], window: SandWindowCfg) -> None:
     early = [r for r in rows if r.get("window_exit_early")]
     if early:
         worst = min(early, key=lambda r: r["window_exit_s"])
+        turned = sum(bool(r.get("window_exit_turn")) for r in early)
+        why = (f"; in {turned} of them the robot had turned and the soles were within the window's reach along its "
+               "heading: the window is a box of the grid's axes and does not turn, so a walk whose heading drifts "
+               "needs a square window (--window-width equal to --window-length)") if turned else ""  # fmt: skip
         print(f"warning: in {len(early)} of {len(rows)} episodes a sole that needed sand stood outside its sand window "
               f"more than {WINDOW_EXIT_GRACE_S} s before the episode ended (first at {worst['window_exit_s']:.2f} s, "
               f"{worst['key']}): those walks lost their support to the window, not to the sand. Lengthen the window "
-              "or move it back (--window-length, --window-lead, --window-width)",
+              f"or move it back (--window-length, --window-lead, --window-width){why}",
               file=sys.stderr, flush=True)  # fmt: skip
 
 
