@@ -83,3 +83,26 @@ def test_window_defaults_are_the_evaluation_defaults() -> None:
     a, base = _parse(["--out", "x"]), G1EvalCfg()
     assert (a.window_length, a.window_width, a.window_lead) == (base.window.length, base.window.width, base.window.lead)
     assert a.bed_depth == base.bed_depth
+
+
+def test_shard_reaches_the_config_and_bad_shards_are_refused(
+    monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """--shard 1/4 scores a quarter of each cell: with four speeds, the 25 episodes at 1.5 m/s."""
+    import gmloco.eval.g1_eval_cli as cli
+    from gmloco.eval.g1_eval import episode_specs
+
+    seen = {}
+
+    def fake_run(cfg):  # noqa: ANN001, ANN202
+        seen["cfg"] = cfg
+        return {}, True
+
+    monkeypatch.setattr(cli, "run", fake_run)
+    cli.main(["--out", "x", "--shard", "1/4"])
+    specs = episode_specs(seen["cfg"])
+    assert len(specs) == 25 and {s.speed for s in specs} == {1.5} and specs[0].index == 1
+    for bad in ("4/4", "1-4", "x/2"):
+        with pytest.raises(SystemExit):
+            _parse(["--out", "x", "--shard", bad])
+        assert "--shard" in capsys.readouterr().err

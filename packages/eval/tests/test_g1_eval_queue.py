@@ -70,3 +70,15 @@ def test_command_line_refuses_a_gpu_named_twice(tmp_path: Path, capsys: pytest.C
     with pytest.raises(SystemExit):
         main(["--gpus", "0", "0", "--out", str(tmp_path), "--terrains", "basalt", "--", "--policy", "p.onnx"])
     assert "name each GPU once" in capsys.readouterr().err
+
+
+def test_shards_split_each_cell_into_shares() -> None:
+    """--shards 4: four tasks per cell, cell after cell, each passing its --shard; --shard after -- is an error."""
+    tasks = cell_tasks(["basalt", "poppy_seed"], ["straight"], ["--policy", "p.onnx"], shards=4)
+    assert [t.name for t in tasks[:4]] == [f"basalt__straight__share{i}of4" for i in range(4)]
+    assert tasks[4].name == "poppy_seed__straight__share0of4"
+    assert tasks[2].argv[-2:] == ("--shard", "2/4")
+    with pytest.raises(ValueError, match="--shard is set by the queue"):
+        cell_tasks(["basalt"], ["straight"], ["--shard", "0/2"], shards=2)
+    with pytest.raises(ValueError, match="at least 1"):
+        cell_tasks(["basalt"], ["straight"], [], shards=0)

@@ -33,6 +33,12 @@ def _parse(argv: list[str] | None) -> argparse.Namespace:
     p.add_argument("--scenarios", nargs="+", default=["straight"], choices=["straight", "circle"])
     p.add_argument("--speeds", type=float, nargs="+", default=[1.0, 1.5, 2.0, 2.5])
     p.add_argument("--num-episodes", type=int, default=100)
+    p.add_argument(
+        "--shard",
+        default="0/1",
+        help="I/N: score the share I (0 .. N-1) of each cell's episodes, those with index k %% N == I "
+        "(several GPUs split one row; paper_tables pools the folders)",
+    )
     p.add_argument("--episode-s", type=float, default=10.0)
     p.add_argument("--voxel", type=float, default=_SOLVER.voxel_size, help="MPM voxel size [m]")
     p.add_argument("--iters", type=int, default=_SOLVER.max_iterations, help="rheology iterations")
@@ -77,6 +83,12 @@ def _parse(argv: list[str] | None) -> argparse.Namespace:
     a = p.parse_args(argv)
     if (problem := frame_dt_problem(a.frame_dt)) is not None:
         p.error(f"--frame-dt: {problem}")
+    try:
+        a.shard, a.shards = (int(x) for x in a.shard.split("/"))
+    except ValueError:
+        p.error(f"--shard {a.shard!r}: write I/N, e.g. 2/4 for the third of four shares")
+    if not 0 <= a.shard < a.shards:
+        p.error(f"--shard {a.shard}/{a.shards}: the share I must be 0 .. N-1")
     if a.particles_per_voxel < 1:
         p.error(f"--particles-per-voxel {a.particles_per_voxel} must be >= 1")
     if not a.tolerance > 0.0:
@@ -100,6 +112,8 @@ def main(argv: list[str] | None = None) -> None:
         scenarios=tuple(a.scenarios),
         speeds=tuple(a.speeds),
         num_episodes=a.num_episodes,
+        shard=a.shard,
+        shards=a.shards,
         episode_s=a.episode_s,
         window=SandWindowCfg(
             moving=not a.static_bed,

@@ -3,7 +3,9 @@
 
 One ``g1_eval_cli`` process drives one GPU; running several on one GPU does not pay (session 15: seven side by side
 on an H100 summed ~112 robot-frames/s against ~150 for one alone). On a machine with N GPUs this tool splits the
-evaluation into one task per (terrain, scenario) cell, each with its own run folder ``OUT/<terrain>__<scenario>``,
+evaluation into one task per (terrain, scenario) cell, each with its own run folder ``OUT/<terrain>__<scenario>``
+(with ``--shards N``: N tasks per cell, ``OUT/<terrain>__<scenario>__share<I>ofN``, each scoring the episodes whose
+index k has k % N == I, so a long row runs on N GPUs at once and its first row is done first),
 and keeps every GPU busy from a shared queue (a GPU takes the next task when its last one ends). Each task is
 time-boxed to what is left of ``--max-minutes`` and resumable like any ``g1_eval`` run (same ``--out``); a task that
 would get less than a minute is not started. Afterwards, combine the folders with ``gmloco.eval.paper_tables``
@@ -56,12 +58,30 @@ class TaskResult:
     log: str = ""
 
 
-def cell_tasks(terrains: list[str], scenarios: list[str], argv: list[str]) -> list[QueueTask]:
-    """One task per (terrain, scenario), in that order (give the most wanted first)."""
-    for flag in ("--out", "--max-minutes", "--terrains", "--scenarios", "--device"):
+def cell_tasks(terrains: list[str], scenarios: list[str], argv: list[str], shards: int = 1) -> list[QueueTask]:
+    """One task per (terrain, scenario), in that order (give the most wanted first).
+
+    With ``shards`` > 1, that many per cell, each scoring one share of its episodes (``--shard I/N``), so several
+    GPUs walk one row at once.
+
+    Raises:
+        ValueError: An argument the queue sets per task is among ``argv``, or ``shards`` < 1.
+    """
+    for flag in ("--out", "--max-minutes", "--terrains", "--scenarios", "--device", "--shard"):
         if flag in argv:
             raise ValueError(f"{flag} is set by the queue per task; remove it from the arguments after --")
-    return [QueueTask(f"{t}__{s}", (*argv, "--terrains", t, "--scenarios", s)) for t in terrains for s in scenarios]
+    if shards < 1:
+        raise ValueError(f"--shards {shards}: split each cell into at least 1 share")
+    tasks = []
+    for t in terrains:
+        for s in scenarios:
+            cell = (*argv, "--terrains", t, "--scenarios", s)
+            if shards == 1:
+                tasks.append(QueueTask(f"{t}__{s}", cell))
+            else:
+                tasks += [QueueTask(f"{t}__{s}__share{i}of{shards}", (*cell, "--shard", f"{i}/{shards}"))
+                          for i in range(shards)]  # fmt: skip
+    return tasks
 
 
 Launch = Callable[[list[str], dict[str, str], Path], subprocess.Popen[bytes]]
@@ -140,10 +160,12 @@ def main(argv: list[str] | None = None) -> list[TaskResult]:
     p.add_argument("--terrains", nargs="+", required=True)
     p.add_argument("--scenarios", nargs="+", default=["straight"])
     p.add_argument("--max-minutes", type=float, default=None, help="time box of the whole queue [min]")
+    p.add_argument("--shards", type=int, default=1,
+                   help="split each cell's episodes into this many tasks (e.g. the GPU count: one row on all GPUs)")  # fmt: skip
     p.add_argument("--label", default=None, help="policy label in the combined tables (default: the policy's folder)")
     a = p.parse_args(own)
     try:
-        tasks = cell_tasks(a.terrains, a.scenarios, passthrough)
+        tasks = cell_tasks(a.terrains, a.scenarios, passthrough, a.shards)
         results = run_queue(tasks, a.gpus, a.out, a.max_minutes)
     except ValueError as exc:
         p.error(str(exc))
