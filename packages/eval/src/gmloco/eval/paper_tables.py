@@ -30,6 +30,7 @@ from __future__ import annotations
 
 import argparse
 import json
+import math
 from pathlib import Path
 from typing import Any
 
@@ -127,7 +128,8 @@ def combine(
         transition += [[label, *r] for r in table_transition(rows)]
     out_dir.mkdir(parents=True, exist_ok=True)
     exits = _window_exit_rows(terrains)
-    note = _mixed_note(first, mixed) + _window_exit_note(exits)
+    turns = _window_turn_rows(terrains, exits)
+    note = _mixed_note(first, mixed) + _window_exit_note(exits, turns)
     write_table(out_dir / "table_terrains", (*TERRAIN_COLUMNS, "complete"), terrains, note)
     write_table(out_dir / "table_speeds", ["policy", *table_speeds([], all_speeds)[0]], speeds, note)
     if transition:
@@ -145,6 +147,7 @@ def combine(
         "episodes_expected": episodes,
         "partial_rows": partial,
         "window_exit_rows": exits,
+        "window_exit_turn_rows": turns,
         "figures": [p.name for p in figures],
         "rows": [dict(zip((*TERRAIN_COLUMNS, "complete"), row, strict=True)) for row in terrains],
         "speed_rows": [dict(zip(["policy", *table_speeds([], all_speeds)[0]], row, strict=True)) for row in speeds],
@@ -193,15 +196,35 @@ def _window_exit_rows(rows: list[list[Any]]) -> dict[str, float]:
     return {f"{r[0]}/{r[1]}/{r[2]}": round(float(r[k]), 1) for r in rows if float(r[k]) > WINDOW_EXIT_NOTE_PCT}
 
 
-def _window_exit_note(exits: dict[str, float]) -> str:
-    """Markdown note naming the rows whose soles left the sand early ("" when none)."""
+def _window_turn_rows(rows: list[list[Any]], exits: dict[str, float]) -> dict[str, float]:
+    """Key -> % of episodes that left the window early because the robot turned.
+
+    Only ``exits`` rows that recorded why (runs from session 16 on).
+    """
+    from gmloco.eval.tables_mpm import TERRAIN_COLUMNS
+
+    k = TERRAIN_COLUMNS.index("window_exit_turn_pct")
+    return {key: round(float(r[k]), 1) for r in rows
+            if (key := f"{r[0]}/{r[1]}/{r[2]}") in exits and math.isfinite(float(r[k]))}  # fmt: skip
+
+
+def _window_exit_note(exits: dict[str, float], turns: dict[str, float] | None = None) -> str:
+    """Markdown note naming the rows whose soles left the sand early ("" when none), with the share by turns."""
     if not exits:
         return ""
-    lines = [f"- `{key}`: {pct:.0f} % of episodes" for key, pct in exits.items()]
+    turns = turns or {}
+
+    def why(key: str) -> str:
+        if key not in turns:
+            return ""
+        return f" ({turns[key]:.0f} % by the robot's turn: give it a square window)" if turns[key] > 0 else " (reach)"
+
+    lines = [f"- `{key}`: {pct:.0f} % of episodes{why(key)}" for key, pct in exits.items()]
     return (
         "\nSoles left the sand window more than 0.25 s before the episode ended (the robot stepped where no sand "
         "was simulated), so these rows' times alive and falls may depend on the window; rerun them with a window "
-        "that covers the reach printed by the run (`--window-length`, `--window-width`, `--window-lead`):\n\n"
+        "that covers the reach printed by the run (`--window-length`, `--window-width`, `--window-lead`), or, where "
+        "the robot turned out of it (the window does not turn), with a square one (length = width):\n\n"
         + "\n".join(lines)
         + "\n"
     )

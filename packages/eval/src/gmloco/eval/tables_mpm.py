@@ -5,6 +5,8 @@
   interval, velocity and yaw tracking error, DTW path error, mean sinkage, swing apex and lift (GM-Loco's
   per-terrain and contact-model tables;
   ``window_exit_pct``: episodes whose soles left the sand window early, a validity check, NaN for older runs;
+  ``window_exit_turn_pct``: those of them that left it because the robot turned (the window does not turn), NaN for
+  runs before session 16;
   several policies' ``episodes.jsonl`` concatenated give the ablation rows).
 * ``table_speeds``: success rate per commanded forward speed (rows terrain x scenario).
 * ``table_ablation`` and ``table_per_terrain``: the same numbers in the paper's two layouts, built from several
@@ -42,7 +44,7 @@ __all__ = [
 TERRAIN_COLUMNS = ("policy", "terrain", "scenario", "episodes", "success_rate_pct", "success_lo95_pct",
                    "success_hi95_pct", "vel_error_mps",
                    "yaw_error_radps", "path_error_m", "mean_sinkage_cm", "swing_apex_cm", "swing_lift_cm",
-                   "window_exit_pct")  # fmt: skip
+                   "window_exit_pct", "window_exit_turn_pct")  # fmt: skip
 """Columns of ``table_terrains``."""
 
 
@@ -85,7 +87,7 @@ def table_terrains(rows: list[dict[str, Any]], policy: str) -> list[list[Any]]:
                     _mean(rs, "vel_error"),
                     _mean(rs, "yaw_error"), _mean(rs, "path_error"), 100.0 * _mean(rs, "mean_sinkage"),
                     100.0 * _mean(rs, "swing_apex"), 100.0 * _mean(rs, "swing_lift"),
-                    100.0 * _mean(rs, "window_exit_early")])  # fmt: skip
+                    100.0 * _mean(rs, "window_exit_early"), 100.0 * _mean(rs, "window_exit_turn")])  # fmt: skip
     return out
 
 
