@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Prepared in session 15 for the next GPU session (issue 9); NOT yet run. One machine, ~24 min after the wheels.
+# Prepared in session 15 (issue 9); never run: superseded by gpu_s16/job_next.sh. One machine, ~24 min after the wheels.
 # Runs one after the other: session 15 ran its checks side by side on one H100 and the GPU did less in all
 # (~112 robot-frames/s summed against ~150 for one process).
 #   (1) Power for the 1.0 x 0.5 m window (lead -0.1) at 1.5 m/s: session 15 accepted it on 16 episodes, but with
