@@ -115,6 +115,11 @@ def test_a_run_cut_short_by_its_time_box_is_undecided(tmp_path: Path) -> None:
     assert len(v.reasons) == 1 and "ref is incomplete (10 of 16 episodes)" in v.reasons[0]
     complete = compare_runs(_rows(alive, 0.08, 0.2), _rows(alive, 0.08, 0.2))
     assert complete.decision == "accepted"  # the same episodes without the flag
+    # a share of a two-terrain run (--shard 1/4 of 32 per cell) asks for 2 x 8 episodes
+    cfg = {"num_episodes": 32, "shard": 1, "shards": 4, "terrains": ["basalt", "dry_sand"], "scenarios": ["straight"]}
+    (tmp_path / "ref" / "summary.json").write_text(json.dumps({"complete": False, "cfg": cfg}))
+    v = main(["--reference", str(tmp_path / "ref"), "--candidate", str(tmp_path / "cand")])
+    assert "ref is incomplete (10 of 16 episodes)" in v.reasons[0]
 
 
 def _with_floor(rows: list[dict], hits: int) -> list[dict]:

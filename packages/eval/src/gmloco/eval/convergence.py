@@ -102,6 +102,15 @@ def load_episodes(path: str | Path) -> list[dict[str, Any]]:
     return rows
 
 
+def _episodes_wanted(cfg: dict[str, Any]) -> int | str:
+    """Episodes a run's config asks for: its share (``shard`` of ``shards``) of every (terrain, scenario) cell."""
+    n = cfg.get("num_episodes")
+    if not isinstance(n, int):
+        return "?"
+    cells = len(cfg.get("terrains") or [None]) * len(cfg.get("scenarios") or [None])
+    return cells * len(range(int(cfg.get("shard", 0)), n, int(cfg.get("shards", 1))))
+
+
 def incomplete_runs(paths: list[str | Path]) -> list[str]:
     """Why each run folder among ``paths`` whose ``summary.json`` says ``complete: false`` is a biased sample."""
     out = []
@@ -111,7 +120,7 @@ def incomplete_runs(paths: list[str | Path]) -> list[str]:
             doc = json.loads(summary.read_text())
             if doc.get("complete") is False:
                 kept = len(load_episodes(path))
-                wanted = doc.get("cfg", {}).get("num_episodes", "?")
+                wanted = _episodes_wanted(doc.get("cfg", {}))
                 out.append(f"{path} is incomplete ({kept} of {wanted} episodes): its time box dropped the episodes "
                            "still running, the longest-lived, so its sample leans to early falls; resume it (same "
                            "--out) and compare again")  # fmt: skip
