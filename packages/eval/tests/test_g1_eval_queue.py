@@ -10,7 +10,7 @@ from pathlib import Path
 
 import pytest
 
-from gmloco.eval.g1_eval_queue import Launch, QueueTask, cell_tasks, main, run_queue
+from gmloco.eval.g1_eval_queue import Launch, QueueTask, cell_tasks, file_tasks, main, run_queue
 
 
 def _fake_launch(record: Path, fail: str = "") -> Launch:
@@ -82,3 +82,44 @@ def test_shards_split_each_cell_into_shares() -> None:
         cell_tasks(["basalt"], ["straight"], ["--shard", "0/2"], shards=2)
     with pytest.raises(ValueError, match="at least 1"):
         cell_tasks(["basalt"], ["straight"], [], shards=0)
+
+
+def test_a_task_file_gives_one_task_per_line(tmp_path: Path) -> None:
+    """Names, quoted arguments and comments; the shared arguments after -- are appended; bad files say why."""
+    f = tmp_path / "tasks.txt"
+    f.write_text("# rows\nrow_a --policy a.onnx --terrains basalt --shard 0/4\n\n"
+                 "row_b --policy 'my dir/b.onnx' --window-width 1.3  # wide\n")  # fmt: skip
+    tasks = file_tasks(f, ["--no-mcap"])
+    assert [t.name for t in tasks] == ["row_a", "row_b"]
+    assert tasks[0].argv == ("--policy", "a.onnx", "--terrains", "basalt", "--shard", "0/4", "--no-mcap")
+    assert tasks[1].argv == ("--policy", "my dir/b.onnx", "--window-width", "1.3", "--no-mcap")
+    for text, why in (("a --out x\n", "--out is set by the queue"), ("a\na\n", "used twice"),
+                      ("../a --policy p\n", "must be a folder name"), ("# nothing\n", "no task in it")):  # fmt: skip
+        f.write_text(text)
+        with pytest.raises(ValueError, match=why):
+            file_tasks(f, [])
+    with pytest.raises(ValueError, match="no such file"):
+        file_tasks(tmp_path / "missing.txt", [])
+
+
+def test_the_command_line_runs_a_task_file_and_names_each_policy(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """--tasks runs every line; the printed combine command labels each run by its own policy's folder."""
+    import gmloco.eval.g1_eval_queue as q
+
+    record = tmp_path / "record.txt"
+    real = q.run_queue
+    monkeypatch.setattr(q, "run_queue", lambda tasks, gpus, out, minutes: real(tasks, gpus, out, minutes,
+                                                                                launch=_fake_launch(record),
+                                                                                poll_s=0.05))  # fmt: skip
+    f = tmp_path / "tasks.txt"
+    f.write_text("r1 --policy artifacts/td/policy.onnx\nr2 --policy artifacts/rigid/policy.onnx\n")
+    results = main(["--gpus", "0", "1", "--out", str(tmp_path / "out"), "--tasks", str(f)])
+    assert [r.returncode for r in results] == [0, 0]
+    out = capsys.readouterr().out
+    assert f"--run td={tmp_path / 'out' / 'r1'}" in out and f"--run rigid={tmp_path / 'out' / 'r2'}" in out
+    for extra in (["--terrains", "basalt"], ["--shards", "2"]):
+        with pytest.raises(SystemExit):
+            main(["--gpus", "0", "--out", str(tmp_path / "out"), "--tasks", str(f), *extra])
+        assert "--terrains" in capsys.readouterr().err

@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Prepared in session 15 for a machine of several GPUs (issue 9); ran in session 16 (gpu_s16/jobs/job_multi.sh). Device time counts the machine's
+# Prepared in session 15 for a machine of several GPUs (issue 9); ran in session 16 (results: gpu_s16/). Device time counts the machine's
 # held time whatever its GPU count, so on nvidia-h100-x4 (or x8) each GPU runs one evaluation at a time from a
 # shared queue, in priority order: 4-8 times the rows of a one-GPU session. Every row uses the tables' accepted
 # setting (1.4 x 0.6 m window, the default), except ppo_rigid, whose soles reach 0.64 m ahead / behind and 0.58 m

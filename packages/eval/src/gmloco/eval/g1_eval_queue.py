@@ -17,6 +17,13 @@ would get less than a minute is not started. Afterwards, combine the folders wit
 
 Everything after ``--`` goes to every ``g1_eval_cli`` call (policy, window, numerics, episodes). Writes
 ``OUT/queue.json`` (per task: GPU, return code, minutes, log file).
+
+Rows of several policies, windows or checks in one queue: ``--tasks FILE`` instead of ``--terrains``, one task per
+line, ``NAME g1_eval_cli-arguments...`` (shell quoting; blank lines and ``#`` comments skipped), run in file order,
+each in ``OUT/NAME`` (an existing folder resumes):
+
+    table_td_basalt_share0of4 --policy artifacts/gm_loco_student_td/policy.onnx --terrains basalt --shard 0/4
+    table_ppo_rigid --policy artifacts/ppo_rigid/policy.onnx --terrains dry_sand --window-width 1.3
 """
 
 from __future__ import annotations
@@ -24,6 +31,8 @@ from __future__ import annotations
 import argparse
 import json
 import os
+import re
+import shlex
 import subprocess
 import sys
 import time
@@ -32,7 +41,7 @@ from dataclasses import asdict, dataclass
 from pathlib import Path
 from typing import Any
 
-__all__ = ["Launch", "QueueTask", "TaskResult", "cell_tasks", "main", "run_queue"]
+__all__ = ["Launch", "QueueTask", "TaskResult", "cell_tasks", "file_tasks", "main", "run_queue"]
 
 MIN_TASK_MINUTES = 1.0
 """A task that would get less than this is not started [min] (it would only build its solver)."""
@@ -81,6 +90,38 @@ def cell_tasks(terrains: list[str], scenarios: list[str], argv: list[str], shard
             else:
                 tasks += [QueueTask(f"{t}__{s}__share{i}of{shards}", (*cell, "--shard", f"{i}/{shards}"))
                           for i in range(shards)]  # fmt: skip
+    return tasks
+
+
+_QUEUE_FLAGS = ("--out", "--max-minutes", "--device")
+"""``g1_eval_cli`` arguments the queue sets per task."""
+
+
+def file_tasks(path: Path, argv: list[str]) -> list[QueueTask]:
+    """The tasks of a task file (see the module docstring), each with ``argv`` appended; in file order.
+
+    Raises:
+        ValueError: The file is missing or holds no task, a name repeats or is not a plain folder name, or a line
+            sets an argument the queue sets per task.
+    """
+    if not path.is_file():
+        raise ValueError(f"--tasks {path}: no such file; write one task per line: NAME g1_eval_cli-arguments")
+    tasks: list[QueueTask] = []
+    for n, line in enumerate(path.read_text().splitlines(), start=1):
+        words = shlex.split(line, comments=True)
+        if not words:
+            continue
+        name, args = words[0], [*words[1:], *argv]
+        where = f"--tasks {path}, line {n}"
+        if not re.fullmatch(r"[A-Za-z0-9_.+=-]+", name):
+            raise ValueError(f"{where}: the task name {name!r} must be a folder name (letters, digits, _ . + = -)")
+        if any(t.name == name for t in tasks):
+            raise ValueError(f"{where}: the task name {name!r} is used twice (each task has its own run folder)")
+        if bad := [f for f in _QUEUE_FLAGS if f in args]:
+            raise ValueError(f"{where}: {', '.join(bad)} is set by the queue per task; remove it")
+        tasks.append(QueueTask(name, tuple(args)))
+    if not tasks:
+        raise ValueError(f"--tasks {path}: no task in it (one per line: NAME g1_eval_cli-arguments)")
     return tasks
 
 
@@ -156,16 +197,24 @@ def main(argv: list[str] | None = None) -> list[TaskResult]:
     own, passthrough = (argv[: argv.index("--")], argv[argv.index("--") + 1 :]) if "--" in argv else (argv, [])
     p = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     p.add_argument("--gpus", nargs="+", required=True, help="CUDA_VISIBLE_DEVICES values, one task at a time each")
-    p.add_argument("--out", type=Path, required=True, help="folder of the run folders (one per cell)")
-    p.add_argument("--terrains", nargs="+", required=True)
+    p.add_argument("--out", type=Path, required=True, help="folder of the run folders (one per task)")
+    p.add_argument("--terrains", nargs="+", help="one task per (terrain, scenario) cell")
+    p.add_argument("--tasks", type=Path, help="task file instead of --terrains: one task per line (see above)")
     p.add_argument("--scenarios", nargs="+", default=["straight"])
     p.add_argument("--max-minutes", type=float, default=None, help="time box of the whole queue [min]")
     p.add_argument("--shards", type=int, default=1,
                    help="split each cell's episodes into this many tasks (e.g. the GPU count: one row on all GPUs)")  # fmt: skip
     p.add_argument("--label", default=None, help="policy label in the combined tables (default: the policy's folder)")
     a = p.parse_args(own)
+    if (a.terrains is None) == (a.tasks is None):
+        p.error("give either --terrains (one task per cell) or --tasks FILE (one task per line)")
+    if a.tasks is not None and a.shards != 1:
+        p.error("--shards splits --terrains cells; in a task file write the shares as lines with --shard I/N")
     try:
-        tasks = cell_tasks(a.terrains, a.scenarios, passthrough, a.shards)
+        if a.tasks is not None:
+            tasks = file_tasks(a.tasks, passthrough)
+        else:
+            tasks = cell_tasks(a.terrains, a.scenarios, passthrough, a.shards)
         results = run_queue(tasks, a.gpus, a.out, a.max_minutes)
     except ValueError as exc:
         p.error(str(exc))
@@ -178,9 +227,11 @@ def main(argv: list[str] | None = None) -> list[TaskResult]:
         print(f"[queue] not started (time box): {', '.join(skipped)}; rerun the same command to go on")
     if failed:
         print(f"[queue] failed: {', '.join(failed)}; see their logs in {a.out}")
-    label = a.label or _policy_label(passthrough)
-    runs = " ".join(f"--run {label}={a.out / r.name}" for r in results if r.gpu is not None)
-    print(f"[queue] combine: python -m gmloco.eval.paper_tables {runs} --out {a.out / 'tables'}")
+    argv_of = {t.name: list(t.argv) for t in tasks}
+    runs = " ".join(f"--run {a.label or _policy_label(argv_of[r.name])}={a.out / r.name}"
+                    for r in results if r.gpu is not None)  # fmt: skip
+    print(f"[queue] combine: python -m gmloco.eval.paper_tables {runs} --out {a.out / 'tables'}"
+          + (" (keep the table rows; leave out cost or check runs)" if a.tasks is not None else ""))  # fmt: skip
     return results
 
 
