@@ -480,10 +480,12 @@ def window_exit_cause(reach: Any, exit_s: float | None, dt: float, window: SandW
     grid's axes and does not turn with it. ``"reach"``: they reached beyond that extent (the window is too short or
     narrow, or a static bed). None without an exit or without a reach log (older runs).
     """
-    arr = None if reach is None or exit_s is None else np.asarray(reach, dtype=float)
-    if arr is None or arr.ndim != 2 or arr.shape[1] != 3 or not len(arr):
+    if reach is None or exit_s is None:
         return None
-    k = min(round(exit_s / dt), len(arr) - 1)  # type: ignore[operator]
+    arr = np.asarray(reach, dtype=float)
+    if arr.ndim != 2 or arr.shape[1] != 3 or not len(arr):
+        return None
+    k = min(round(exit_s / dt), len(arr) - 1)
     if not np.isfinite(arr[k]).all():
         return None
     b, a, s = arr[k] + WINDOW_EXIT_MARGIN_M

@@ -67,6 +67,10 @@ class TaskResult:
     log: str = ""
 
 
+_QUEUE_FLAGS = ("--out", "--max-minutes", "--device")
+"""``g1_eval_cli`` arguments the queue sets per task."""
+
+
 def cell_tasks(terrains: list[str], scenarios: list[str], argv: list[str], shards: int = 1) -> list[QueueTask]:
     """One task per (terrain, scenario), in that order (give the most wanted first).
 
@@ -76,7 +80,7 @@ def cell_tasks(terrains: list[str], scenarios: list[str], argv: list[str], shard
     Raises:
         ValueError: An argument the queue sets per task is among ``argv``, or ``shards`` < 1.
     """
-    for flag in ("--out", "--max-minutes", "--terrains", "--scenarios", "--device", "--shard"):
+    for flag in (*_QUEUE_FLAGS, "--terrains", "--scenarios", "--shard"):
         if flag in argv:
             raise ValueError(f"{flag} is set by the queue per task; remove it from the arguments after --")
     if shards < 1:
@@ -91,10 +95,6 @@ def cell_tasks(terrains: list[str], scenarios: list[str], argv: list[str], shard
                 tasks += [QueueTask(f"{t}__{s}__share{i}of{shards}", (*cell, "--shard", f"{i}/{shards}"))
                           for i in range(shards)]  # fmt: skip
     return tasks
-
-
-_QUEUE_FLAGS = ("--out", "--max-minutes", "--device")
-"""``g1_eval_cli`` arguments the queue sets per task."""
 
 
 def file_tasks(path: Path, argv: list[str]) -> list[QueueTask]:
