@@ -10,7 +10,8 @@
 #      throughput lever not measured on one machine), with the ppo_rigid wide row's last 16 episodes (resumed);
 #   3. the rough row (resumed), the transition course (square window: it starts on basalt, where the student turns);
 #   4. the td student on dry sand at the square window (does session 13's 22 % row, scored before exits were
-#      recorded, hold?); then the circles (their window is square by construction).
+#      recorded, hold?); then the circles of the four ablation policies (their window is square by construction;
+#      the policies that fall within ~2 s get one task each).
 #   Before: mkdir -p .devsrc/row && cp -r results/mpm_eval/gpu_s16/runs/table_ppo_rigid_wide_dry_sand \
 #           results/mpm_eval/gpu_s16/runs/table_td_dry_sand_rough .devsrc/row/   (the two resumed rows)
 #   Usage (in ~/src, after the wheels and the Warp cache): bash job_next.sh END_EPOCH
@@ -42,6 +43,8 @@ shares() {  # shares NAME ARGS...: the row as four task lines, one per share
   shares table_td_dry_sand_sq --policy $TD --terrains dry_sand $ROW $SQ
   shares table_td_dry_sand_circle --policy $TD --terrains dry_sand --scenarios circle $ROW
   shares table_ppo_rft3d_dry_sand_circle --policy $RFT --terrains dry_sand --scenarios circle $ROW
+  echo "table_clr50_dry_sand_circle --policy artifacts/gm_loco_student_clr50/policy.onnx --terrains dry_sand --scenarios circle $ROW"
+  echo "table_ppo_rigid_dry_sand_circle --policy $RIGID --terrains dry_sand --scenarios circle $ROW $WIDE"
 } > ~/chunks/tasks.txt
 if [ -n "${DRY:-}" ]; then  # every line must parse as the queue and g1_eval_cli read it
   python3 - <<'PY'
