@@ -9,7 +9,7 @@ from typing import Any
 
 import numpy as np
 
-__all__ = ["fig_mpm_speed_sweep", "fig_mpm_transition", "fig_policies_by_speed", "write_figures"]
+__all__ = ["fig_mpm_speed_sweep", "fig_mpm_transition", "fig_per_terrain", "fig_policies_by_speed", "write_figures"]
 
 
 def _by_speed(rs: list[dict[str, Any]], key: str) -> tuple[np.ndarray, np.ndarray]:
@@ -102,6 +102,47 @@ def fig_policies_by_speed(runs: list[tuple[str, list[dict[str, Any]]]], path: st
     ax1.set(xlabel="commanded speed [m/s]", ylabel="median time alive [s]", ylim=(0, None))
     ax0.legend(fontsize=7)
     fig.suptitle(f"MPM sand, {cell}: policies side by side", fontsize=9)
+    fig.savefig(path, dpi=120)
+    plt.close(fig)
+    return Path(path)
+
+
+def fig_per_terrain(runs: list[tuple[str, list[dict[str, Any]]]], path: str | Path, scenario: str = "straight") -> Path:
+    """The per-terrain table as bars: per terrain, each policy's success rate and mean sinkage on ``scenario``.
+
+    Left: success rate [%] with its 95 % Wilson interval, the episode count on each bar (a row short of the paper's
+    100 shows it); right: mean sinkage of the lowest sole point [cm]. ``runs``: (policy label, its episodes).
+    """
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    from gmloco.eval.tables_mpm import wilson_interval
+
+    terrains = list(dict.fromkeys(r["terrain"] for _, rs in runs for r in rs if r["scenario"] == scenario))
+    fig, (ax0, ax1) = plt.subplots(1, 2, figsize=(10, 3.6), constrained_layout=True)
+    width = 0.8 / max(len(runs), 1)
+    x = np.arange(len(terrains))
+    for k, (label, rs) in enumerate(runs):
+        cells = [[r for r in rs if r["terrain"] == t and r["scenario"] == scenario] for t in terrains]
+        n = np.array([len(c) for c in cells])
+        wins = np.array([sum(bool(r["success"]) for r in c) for c in cells])
+        rate = np.where(n > 0, 100.0 * wins / np.maximum(n, 1), np.nan)
+        ci = np.array([wilson_interval(int(w), int(m)) for w, m in zip(wins, n, strict=True)]) * 100.0
+        sink = [100.0 * float(np.nanmean([r["mean_sinkage"] for r in c])) if c else np.nan for c in cells]
+        xk = x + (k - 0.5 * (len(runs) - 1)) * width
+        ax0.bar(xk, rate, width, yerr=np.vstack([rate - ci[:, 0], ci[:, 1] - rate]), capsize=2, label=label)
+        ax1.bar(xk, sink, width, label=label)
+        for xi, ri, ni in zip(xk, rate, n, strict=True):
+            if ni:
+                ax0.text(xi, min(float(np.nan_to_num(ri)) + 3.0, 100.0), str(int(ni)), ha="center", fontsize=6)
+    for ax in (ax0, ax1):
+        ax.set_xticks(x, [t.replace("_", " ") for t in terrains], fontsize=8, rotation=20)
+    ax0.set(ylabel="success rate [%] (95 % interval)", ylim=(0, 105))
+    ax1.set(ylabel="mean sinkage [cm]")
+    ax0.legend(fontsize=7)
+    fig.suptitle(f"MPM sand, {scenario} walks: per terrain (episodes on each bar)", fontsize=9)
     fig.savefig(path, dpi=120)
     plt.close(fig)
     return Path(path)

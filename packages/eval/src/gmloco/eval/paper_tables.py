@@ -14,6 +14,8 @@ tool labels each run's episodes with the policy's name and writes the combined t
 * ``table_ablation.{md,csv}`` (the contact-model ablation's layout: per terrain and policy, the straight walk's
   success beside the circular walk's success and DTW path error) and ``table_per_terrain.{md,csv}`` (one row per
   terrain, each policy's success rate and velocity / yaw tracking errors on the straight walk);
+* ``fig_per_terrain.png``: the per-terrain table as bars (success rate with its interval and episode count, mean
+  sinkage; straight walks);
 * ``fig_speeds_<terrain>_<scenario>.png``: per cell, the policies' success rate (95 % interval) and median time alive
   against the commanded speed;
 * ``tables.json``: the runs, their common MPM setting, which rows are partial, and the rows as records
@@ -137,6 +139,10 @@ def combine(
     write_table(out_dir / "table_ablation", ABLATION_COLUMNS, table_ablation(terrains), note)
     write_table(out_dir / "table_per_terrain", *table_per_terrain(terrains), note)
     figures = _figures_by_cell(loaded, out_dir)
+    if any(r["scenario"] == "straight" for _, rows in loaded for r in rows):
+        from gmloco.eval.figures_mpm import fig_per_terrain
+
+        figures.append(fig_per_terrain(loaded, out_dir / "fig_per_terrain.png"))
     summary = {
         "runs": {
             label: {"dirs": [str(d) for d in ds], "policy": summaries[label][0].get("policy")}
