@@ -30,6 +30,7 @@ def main() -> None:
     from tensordict import TensorDict
 
     from gmloco.contact import MATERIAL_PRESETS
+    from gmloco.eval.metrics.locomotion import quat_wxyz_to_roll_pitch_yaw
     from gmloco.train.evaluation_ts import TsEvalCfg, _build_runner, _pin_materials, _policy_step, _start
 
     p = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
@@ -51,16 +52,15 @@ def main() -> None:
     obs = _start(runner, commands)
     robot = env.scene["robot"]
     alive = torch.ones(len(cells), dtype=torch.bool, device=env.device)
-    yaws, alives = [], []
+    quats, alives = [], []
     for _ in range(round(a.duration / env.step_dt)):
-        q = robot.data.root_link_quat_w  # w x y z
-        yaws.append(torch.atan2(2 * (q[:, 0] * q[:, 3] + q[:, 1] * q[:, 2]), 1 - 2 * (q[:, 2] ** 2 + q[:, 3] ** 2)))
+        quats.append(robot.data.root_link_quat_w.clone())  # w x y z
         alives.append(alive.clone())
         out = _policy_step(runner, obs)
         obs_dict, _, terminated, _, _ = env.step(out["actions"])
         obs = TensorDict(obs_dict, batch_size=[len(cells)])
         alive &= ~terminated
-    yaw = np.unwrap(torch.stack(yaws).cpu().numpy(), axis=0)
+    yaw = np.unwrap(quat_wxyz_to_roll_pitch_yaw(torch.stack(quats).cpu().numpy())[..., 2], axis=0)
     live = torch.stack(alives).cpu().numpy()
     rows = []
     for w, (m, v) in enumerate(cells):

@@ -20,6 +20,7 @@ import numpy as np
 
 from gmloco.deploy.logs.reader import read_log
 from gmloco.eval.g1_eval import WINDOW_EXIT_MARGIN_M
+from gmloco.eval.metrics.locomotion import quat_wxyz_to_roll_pitch_yaw
 
 HERE = Path(__file__).resolve().parent
 ROWS = {  # row folder -> (length, width, lead) of its window [m]
@@ -64,8 +65,7 @@ def headings(folder: Path) -> dict[str, np.ndarray]:
         with warnings.catch_warnings():
             warnings.simplefilter("ignore")
             q = np.asarray(read_log(f).channels["/odometry"].fields["orientation"], dtype=float)  # w x y z
-        w, x, y, z = q.T
-        yaw = np.unwrap(np.arctan2(2.0 * (w * z + x * y), 1.0 - 2.0 * (y * y + z * z)))
+        yaw = np.unwrap(quat_wxyz_to_roll_pitch_yaw(q)[:, 2])
         out[f.stem] = np.degrees(yaw - yaw[0])
     return out
 

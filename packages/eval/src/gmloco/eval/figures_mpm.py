@@ -22,6 +22,17 @@ def _by_speed(rs: list[dict[str, Any]], key: str) -> tuple[np.ndarray, np.ndarra
     return speeds, np.array(vals)
 
 
+def _success_with_interval(groups: list[list[dict[str, Any]]]) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Per group of episodes: (count, success rate [%] (NaN for none), [G, 2] 95 % Wilson interval [%])."""
+    from gmloco.eval.tables_mpm import wilson_interval
+
+    n = np.array([len(g) for g in groups])
+    wins = np.array([sum(bool(r["success"]) for r in g) for g in groups])
+    rate = np.where(n > 0, 100.0 * wins / np.maximum(n, 1), np.nan)
+    ci = np.array([wilson_interval(int(w), int(m)) for w, m in zip(wins, n, strict=True)]).reshape(-1, 2) * 100.0
+    return n, rate, ci
+
+
 def fig_mpm_speed_sweep(rows: list[dict[str, Any]], path: str | Path, policy: str) -> Path:
     """Success rate [%] and velocity tracking error [m/s] vs commanded speed, one line per (terrain, scenario)."""
     import matplotlib
@@ -85,17 +96,13 @@ def fig_policies_by_speed(runs: list[tuple[str, list[dict[str, Any]]]], path: st
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
-    from gmloco.eval.tables_mpm import wilson_interval
-
     fig, (ax0, ax1) = plt.subplots(1, 2, figsize=(9, 3.4), constrained_layout=True)
     for k, (label, rs) in enumerate(runs):
         speeds = sorted({float(r["speed"]) for r in rs})
         at = [[r for r in rs if float(r["speed"]) == v] for v in speeds]
-        wins = [sum(bool(r["success"]) for r in group) for group in at]
-        rate = [100.0 * w / len(g) for w, g in zip(wins, at, strict=True)]
-        lo_hi = np.array([wilson_interval(w, len(g)) for w, g in zip(wins, at, strict=True)]) * 100.0
+        _, rate, lo_hi = _success_with_interval(at)
         x = np.array(speeds) + 0.02 * (k - 0.5 * (len(runs) - 1))  # a small dodge so the intervals stay apart
-        err = np.vstack([np.array(rate) - lo_hi[:, 0], lo_hi[:, 1] - np.array(rate)])
+        err = np.vstack([rate - lo_hi[:, 0], lo_hi[:, 1] - rate])
         ax0.errorbar(x, rate, yerr=err, fmt="o-", capsize=3, label=f"{label} ({len(rs)} ep.)")
         ax1.plot(x, [float(np.median([r["alive_s"] for r in g])) for g in at], "o-", label=label)
     ax0.set(xlabel="commanded speed [m/s]", ylabel="success rate [%] (95 % interval)", ylim=(-5, 105))
@@ -118,18 +125,13 @@ def fig_per_terrain(runs: list[tuple[str, list[dict[str, Any]]]], path: str | Pa
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
-    from gmloco.eval.tables_mpm import wilson_interval
-
     terrains = list(dict.fromkeys(r["terrain"] for _, rs in runs for r in rs if r["scenario"] == scenario))
     fig, (ax0, ax1) = plt.subplots(1, 2, figsize=(10, 3.6), constrained_layout=True)
     width = 0.8 / max(len(runs), 1)
     x = np.arange(len(terrains))
     for k, (label, rs) in enumerate(runs):
         cells = [[r for r in rs if r["terrain"] == t and r["scenario"] == scenario] for t in terrains]
-        n = np.array([len(c) for c in cells])
-        wins = np.array([sum(bool(r["success"]) for r in c) for c in cells])
-        rate = np.where(n > 0, 100.0 * wins / np.maximum(n, 1), np.nan)
-        ci = np.array([wilson_interval(int(w), int(m)) for w, m in zip(wins, n, strict=True)]) * 100.0
+        n, rate, ci = _success_with_interval(cells)
         sink = [100.0 * float(np.nanmean([r["mean_sinkage"] for r in c])) if c else np.nan for c in cells]
         xk = x + (k - 0.5 * (len(runs) - 1)) * width
         ax0.bar(xk, rate, width, yerr=np.vstack([rate - ci[:, 0], ci[:, 1] - rate]), capsize=2, label=label)
