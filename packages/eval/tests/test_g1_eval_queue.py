@@ -10,7 +10,7 @@ from pathlib import Path
 
 import pytest
 
-from gmloco.eval.g1_eval_queue import Launch, QueueTask, cell_tasks, file_tasks, main, run_queue
+from gmloco.eval.g1_eval_queue import Launch, QueueTask, cell_tasks, file_tasks, main, row_spans, run_queue
 
 
 def _fake_launch(record: Path, fail: str = "") -> Launch:
@@ -123,3 +123,17 @@ def test_the_command_line_runs_a_task_file_and_names_each_policy(
         with pytest.raises(SystemExit):
             main(["--gpus", "0", "--out", str(tmp_path / "out"), "--tasks", str(f), *extra])
         assert "--terrains" in capsys.readouterr().err
+
+
+def test_a_row_in_shares_gets_its_wall_clock(tmp_path: Path) -> None:
+    """Four shares of one row on two GPUs: the row spans the first start to the last end; an unfinished row is left out."""
+    tasks = [QueueTask(f"row_share{i}of4", ()) for i in range(4)] + [QueueTask("cell__share0of2", ())]
+    results = run_queue(tasks, ["0", "1"], tmp_path / "out", launch=_fake_launch(tmp_path / "r.txt"), poll_s=0.05)
+    assert all(r.started_min is not None for r in results)
+    rows = row_spans(results)
+    assert list(rows) == ["row"]  # cell__share1of2 was never a task: that row is not whole
+    span = rows["row"]
+    assert span["shares"] == 4 and span["gpus"] == ["0", "1"] and span["returncodes"] == [0] * 4
+    ends = [(r.started_min or 0.0) + r.minutes for r in results[:4]]
+    assert span["wall_minutes"] == pytest.approx(max(ends) - min(r.started_min or 0.0 for r in results[:4]), abs=0.011)
+    assert span["wall_minutes"] >= max(r.minutes for r in results[:4])

@@ -16,7 +16,8 @@ would get less than a minute is not started. Afterwards, combine the folders wit
         -- --policy artifacts/gm_loco_student_td/policy.onnx
 
 Everything after ``--`` goes to every ``g1_eval_cli`` call (policy, window, numerics, episodes). Writes
-``OUT/queue.json`` (per task: GPU, return code, minutes, log file).
+``OUT/queue.json`` (per task: GPU, return code, start and minutes, log file; per row split into shares: its
+wall-clock from the first share's start to the last one's end, ``row_spans``).
 
 Rows of several policies, windows or checks in one queue: ``--tasks FILE`` instead of ``--terrains``, one task per
 line, ``NAME g1_eval_cli-arguments...`` (shell quoting; blank lines and ``#`` comments skipped), run in file order,
@@ -41,7 +42,7 @@ from dataclasses import asdict, dataclass
 from pathlib import Path
 from typing import Any
 
-__all__ = ["Launch", "QueueTask", "TaskResult", "cell_tasks", "file_tasks", "main", "run_queue"]
+__all__ = ["Launch", "QueueTask", "TaskResult", "cell_tasks", "file_tasks", "main", "row_spans", "run_queue"]
 
 MIN_TASK_MINUTES = 1.0
 """A task that would get less than this is not started [min] (it would only build its solver)."""
@@ -63,7 +64,10 @@ class TaskResult:
     gpu: str | None = None
     """The GPU (``CUDA_VISIBLE_DEVICES`` value) it ran on; None if it was not started."""
     returncode: int | None = None
+    started_min: float | None = None
+    """When it started, in minutes after the queue started (None if it was not started)."""
     minutes: float = 0.0
+    """How long it ran [min]."""
     log: str = ""
 
 
@@ -170,6 +174,7 @@ def run_queue(
             running[gpu] = (task, launch(_command(task, out_root, minutes), env, out_root / f"{task.name}.log"),
                             time.monotonic())  # fmt: skip
             results[task.name].gpu = gpu
+            results[task.name].started_min = round((time.monotonic() - t0) / 60.0, 2)
             print(f"[queue] {task.name} started on GPU {gpu}" + (f" ({minutes:.1f} min left)" if minutes else ""))
         if queue and not running:  # nothing runs and nothing may start: the time is up
             break
@@ -182,6 +187,34 @@ def run_queue(
         if running:
             time.sleep(poll_s)
     return [results[t.name] for t in tasks]
+
+
+_SHARE = re.compile(r"^(?P<row>.+?)_{1,2}share(?P<i>\d+)of(?P<n>\d+)$")
+"""A share's task name: ``ROW_shareIofN`` (task files) or ``CELL__shareIofN`` (``--shards``)."""
+
+
+def row_spans(results: list[TaskResult]) -> dict[str, dict[str, Any]]:
+    """Wall-clock of each row split into shares, from its shares' start and end times.
+
+    A row is listed once all its N shares started: ``wall_minutes`` runs from the first share's start to the last
+    one's end (the time one row took on the machine), ``gpus`` the GPUs its shares ran on. Whether every share also
+    finished all its episodes is in each run folder's ``summary.json`` (``complete``).
+    """
+    groups: dict[str, list[tuple[int, int, TaskResult]]] = {}
+    for r in results:
+        if (m := _SHARE.match(r.name)) is not None:
+            groups.setdefault(m["row"], []).append((int(m["i"]), int(m["n"]), r))
+    rows = {}
+    for row, shares in groups.items():
+        n = shares[0][1]
+        started = [r for _, _, r in shares if r.started_min is not None]
+        if {i for i, _, _ in shares} != set(range(n)) or len(started) != n:
+            continue
+        first = min(r.started_min for r in started if r.started_min is not None)
+        last = max((r.started_min or 0.0) + r.minutes for r in started)
+        rows[row] = {"shares": n, "gpus": sorted({r.gpu for r in started if r.gpu is not None}),
+                     "wall_minutes": round(last - first, 2), "returncodes": [r.returncode for r in started]}  # fmt: skip
+    return rows
 
 
 def _policy_label(argv: list[str]) -> str:
@@ -218,9 +251,13 @@ def main(argv: list[str] | None = None) -> list[TaskResult]:
         results = run_queue(tasks, a.gpus, a.out, a.max_minutes)
     except ValueError as exc:
         p.error(str(exc))
+    rows = row_spans(results)
     doc: dict[str, Any] = {"gpus": a.gpus, "max_minutes": a.max_minutes, "argv": passthrough,
-                           "tasks": [asdict(r) for r in results]}  # fmt: skip
+                           "tasks": [asdict(r) for r in results], "rows": rows}  # fmt: skip
     (a.out / "queue.json").write_text(json.dumps(doc, indent=1) + "\n")
+    for row, span in rows.items():
+        print(f"[queue] row {row}: {span['shares']} shares on GPUs {' '.join(span['gpus'])}, "
+              f"{span['wall_minutes']:.1f} min from the first share's start to the last one's end")  # fmt: skip
     failed = [r.name for r in results if r.returncode not in (0, None)]
     skipped = [r.name for r in results if r.gpu is None]
     if skipped:
