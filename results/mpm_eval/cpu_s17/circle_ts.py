@@ -1,0 +1,106 @@
+# SPDX-License-Identifier: Apache-2.0
+"""Whether the td student walks the commanded circle in the training simulator (issue 9, session 17).
+
+On MPM dry sand the student finished none of 75 circle episodes (``../gpu_s17/README.md``). This walks the same
+student (its ``StudentPPO`` checkpoint, whose ONNX export the MPM evaluation runs) in the granular training simulator
+(3D-RFT on the whole foot box, as it was trained) with the MPM evaluation's circle command, (v, 0, v / R) with
+R = 2 m held for 10 s, v = 1.0 / 1.5 / 2.0 / 2.5 m/s, on dry sand and basalt, ``--repeats`` envs per cell, and
+scores each walk with the MPM evaluation's rules (:func:`gmloco.eval.g1_eval.score_episode`'s progress rule and
+:mod:`gmloco.eval.metrics.locomotion`): course finished, DTW path error, mean yaw-rate error, the heading's turn.
+Writes ``circle_ts.json`` beside this script.
+
+    python results/mpm_eval/cpu_s17/circle_ts.py [--repeats 2] [--device cpu]
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import time
+from pathlib import Path
+
+import numpy as np
+import torch
+
+HERE = Path(__file__).resolve().parent
+SPEEDS = (1.0, 1.5, 2.0, 2.5)
+MATERIALS = ("dry_sand", "basalt")
+RADIUS_M = 2.0
+COURSE_SLACK = 0.2
+
+
+def _finished_at(xy: np.ndarray, cmd_xy: np.ndarray, dt: float) -> float | None:
+    """Time the base passed 1 - COURSE_SLACK of the commanded path (nearest sample, searched forwards) [s]."""
+    idx, window = 0, max(1, round(0.5 / dt))
+    for t, p in enumerate(xy):
+        idx += int(np.argmin(np.linalg.norm(cmd_xy[idx : idx + window] - p, axis=1)))
+        if idx >= (1.0 - COURSE_SLACK) * (len(cmd_xy) - 1):
+            return (t + 1) * dt
+    return None
+
+
+def main() -> None:
+    """Build the play env, pin materials and commands, walk 10 s, score each env's circle."""
+    from tensordict import TensorDict
+
+    from gmloco.contact import MATERIAL_PRESETS
+    from gmloco.eval.metrics.locomotion import circular_path, metric_path_error, quat_wxyz_to_roll_pitch_yaw
+    from gmloco.train.evaluation_ts import TsEvalCfg, _build_runner, _pin_materials, _policy_step, _start
+
+    p = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    p.add_argument("--repeats", type=int, default=2)
+    p.add_argument("--device", default="cpu")
+    p.add_argument("--duration", type=float, default=10.0)
+    a = p.parse_args()
+    cfg = TsEvalCfg(student_checkpoint="artifacts/gm_loco_student_td/checkpoint.pt",
+                    teacher_checkpoint="artifacts/gm_loco_teacher_td/checkpoint.pt", foot_faces="box",
+                    baseline_policy=None, device=a.device)  # fmt: skip
+    cells = [(m, v) for m in MATERIALS for v in SPEEDS for _ in range(a.repeats)]
+    t0 = time.perf_counter()
+    runner = _build_runner(cfg, len(cells), a.duration)
+    env = runner.env.unwrapped
+    mats = [MATERIAL_PRESETS[m] for m, _ in cells]
+    _pin_materials(env, [x.rho_c for x in mats], [x.mu_int for x in mats], [x.mu_surf for x in mats])
+    commands = torch.tensor([[v, 0.0, v / RADIUS_M] for _, v in cells], dtype=torch.float32, device=env.device)
+    runner.alg.eval_mode()
+    obs = _start(runner, commands)
+    robot = env.scene["robot"]
+    alive = torch.ones(len(cells), dtype=torch.bool, device=env.device)
+    quats, xys, wzs, alives = [], [], [], []
+    for _ in range(round(a.duration / env.step_dt)):
+        quats.append(robot.data.root_link_quat_w.clone())  # w x y z
+        xys.append(robot.data.root_link_pos_w[:, :2].clone())
+        wzs.append(robot.data.root_link_ang_vel_w[:, 2].clone())
+        alives.append(alive.clone())
+        out = _policy_step(runner, obs)
+        obs_dict, _, terminated, _, _ = env.step(out["actions"])
+        obs = TensorDict(obs_dict, batch_size=[len(cells)])
+        alive &= ~terminated
+    dt = env.step_dt
+    yaw = np.unwrap(quat_wxyz_to_roll_pitch_yaw(torch.stack(quats).cpu().numpy())[..., 2], axis=0)
+    xy, wz = torch.stack(xys).cpu().numpy(), torch.stack(wzs).cpu().numpy()
+    live = torch.stack(alives).cpu().numpy()
+    rows = []
+    for w, (m, v) in enumerate(cells):
+        n = int(live[:, w].sum())
+        cmd_xy, _ = circular_path(v, v / RADIUS_M, a.duration, dt, start_xy=tuple(xy[0, w]), start_yaw=yaw[0, w])
+        fin = _finished_at(xy[:n, w], cmd_xy, dt)
+        rows.append({"material": m, "speed": v, "alive_s": n * dt, "finished_at_s": fin,
+                     "success": bool(n == len(xy) and fin is not None) or (fin is not None and fin <= n * dt),
+                     "path_error_m": metric_path_error(xy[:n, w], cmd_xy) if n else float("nan"),
+                     "yaw_rate_cmd": v / RADIUS_M, "yaw_rate_mean": float(np.mean(wz[:n, w])) if n else float("nan"),
+                     "yaw_error": float(np.mean(np.abs(wz[:n, w] - v / RADIUS_M))) if n else float("nan"),
+                     "heading_turn_end_deg": float(np.degrees(yaw[n - 1, w] - yaw[0, w])) if n else float("nan"),
+                     "heading_turn_cmd_deg": float(np.degrees(v / RADIUS_M * n * dt))})  # fmt: skip
+    doc = {"policy": cfg.student_checkpoint, "simulator": "granular training simulator (3D-RFT, whole foot box)",
+           "command": f"(v, 0, v / {RADIUS_M}) for {a.duration} s", "device": a.device, "duration_s": a.duration,
+           "wall_s": round(time.perf_counter() - t0, 1), "rows": rows}  # fmt: skip
+    (HERE / "circle_ts.json").write_text(json.dumps(doc, indent=1) + "\n")
+    for r in rows:
+        print(f"{r['material']:9s} v={r['speed']:.1f}: alive {r['alive_s']:.1f} s, finished {r['finished_at_s']}, "
+              f"path error {r['path_error_m']:.2f} m, yaw rate {r['yaw_rate_mean']:.2f} of {r['yaw_rate_cmd']:.2f} "
+              f"rad/s, turned {r['heading_turn_end_deg']:.0f} of {r['heading_turn_cmd_deg']:.0f} deg")  # fmt: skip
+
+
+if __name__ == "__main__":
+    main()
