@@ -715,7 +715,7 @@ def _write_outputs(out: Path, cfg: G1EvalCfg, rows: list[dict[str, Any]], summar
     policy = Path(cfg.policy_path).parent.name or Path(cfg.policy_path).stem
     tables = write_tables(rows, out, policy)
     try:  # the GPU image may lack matplotlib: the numbers must not be lost for a figure
-        figures, note = (write_figures(rows, out, policy) if rows else []), ""
+        figures, note = (write_figures(rows, out, policy, cfg.episode_s) if rows else []), ""
     except ImportError as exc:
         figures, note = [], f"figures skipped: {exc}"
     doc = {"complete": complete, "policy": cfg.policy_path, "cfg": _jsonable(asdict(cfg)), "metrics": summary,

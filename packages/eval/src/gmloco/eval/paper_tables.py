@@ -138,7 +138,7 @@ def combine(
         write_table(out_dir / "table_transition", ("policy", *TRANSITION_COLUMNS), transition, note)
     write_table(out_dir / "table_ablation", ABLATION_COLUMNS, table_ablation(terrains), note)
     write_table(out_dir / "table_per_terrain", *table_per_terrain(terrains), note)
-    figures = _figures_by_cell(loaded, out_dir)
+    figures = _figures_by_cell(loaded, out_dir) + _path_figures(grouped, summaries, out_dir)
     if any(r["scenario"] == "straight" for _, rows in loaded for r in rows):
         from gmloco.eval.figures_mpm import fig_per_terrain
 
@@ -177,6 +177,25 @@ def _figures_by_cell(loaded: list[tuple[str, list[dict[str, Any]]]], out_dir: Pa
             fig_policies_by_speed(runs, out_dir / f"fig_speeds_{terrain}_{scenario}.png", f"{terrain} / {scenario}")
         )
     return paths
+
+
+def _path_figures(
+    grouped: dict[str, list[Path]], summaries: dict[str, list[dict[str, Any]]], out_dir: Path
+) -> list[Path]:
+    """``fig_paths_<terrain>_<scenario>.png``: each policy's recorded walks of a cell against the commanded paths.
+
+    A policy's panel holds one recording per speed (its runs' first episodes; the first run that recorded a speed).
+    """
+    from gmloco.eval.figures_paths import fig_paths, recordings_by_cell
+
+    cells: dict[tuple[str, str], list[tuple[str, list[Path]]]] = {}
+    for label, dirs in grouped.items():
+        for cell, recs in recordings_by_cell(list(dirs)).items():
+            by_speed = {r.stem.rsplit("__v", 1)[-1]: r for r in reversed(recs)}
+            cells.setdefault(cell, []).append((label, [by_speed[k] for k in sorted(by_speed, key=float)]))
+    episode_s = float(summaries[next(iter(summaries))][0].get("cfg", {}).get("episode_s", 10.0))
+    return [fig_paths(panels, out_dir / f"fig_paths_{terrain}_{scenario}.png", episode_s, f"{terrain} / {scenario}")
+            for (terrain, scenario), panels in cells.items()]  # fmt: skip
 
 
 def _mixed_note(first: str, mixed: dict[str, list[str]]) -> str:
