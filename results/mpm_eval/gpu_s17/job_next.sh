@@ -10,8 +10,9 @@
 #      shares each (the circle's window is square by construction);
 #   3. the transition course (square window: it starts on basalt, where the student turns);
 #   4. basalt at the square 1.4 x 1.4 m window (lead 0.2; session 16's basalt row left the window in 94 % of its
-#      episodes because the student turns 35-69 degrees in 10 s and the window does not turn), then rough sand's
-#      1.0 m/s cell at the square window (13 of its 24 walks turned out of the tables' window in session 17).
+#      episodes because the student turns 35-69 degrees in 10 s and the window does not turn), then the rough row at
+#      the square window (13 of its 24 walks at 1.0 m/s turned out of the tables' window in session 17; the whole
+#      row, so the tables can take it in place of the old one; the shares above 1.0 m/s fall within ~3 s).
 #   What the time box leaves undone resumes from the fetched folders (copy them to .devsrc/row/).
 #   Usage (in ~/src, after the wheels and the Warp cache): bash job_next.sh END_EPOCH
 #   Fetch: cd ~/chunks && tar czf - g1_eval job.log job.out tasks.txt | split -b 15M - $OUT/s18.tgz.part
@@ -39,7 +40,7 @@ shares() {  # shares NAME ARGS...: the row as four task lines, one per share
   shares table_ppo_rigid_dry_sand_circle --policy $RIGID --terrains dry_sand --scenarios circle $ROW $WIDE
   shares table_td_transition_sq --policy $TD --terrains transition $ROW $SQ
   shares table_td_basalt_sq --policy $TD --terrains basalt $ROW $SQ
-  echo "table_td_dry_sand_rough_sq_v1.0 --policy $TD --terrains dry_sand_rough --speeds 1.0 --num-episodes 25 --robots-per-batch 25 $SQ"
+  shares table_td_dry_sand_rough_sq --policy $TD --terrains dry_sand_rough $ROW $SQ
 } > ~/chunks/tasks.txt
 if [ -n "${DRY:-}" ]; then  # every line must parse as the queue and g1_eval_cli read it
   python3 - <<'PY'
