@@ -73,3 +73,20 @@ def test_figures_are_drawn_per_run_and_per_cell(tmp_path: Path) -> None:
     (tmp_path / "tables").mkdir()
     out = _path_figures({"p": [run]}, summaries, tmp_path / "tables")
     assert [f.name for f in out] == ["fig_paths_dry_sand_circle.png"] and out[0].stat().st_size > 0
+
+
+def test_a_damaged_recording_costs_the_figure_not_the_run(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    """A recording without odometry (not an episode): the speed figure is still written, the paths one is skipped."""
+    from gmloco.eval.figures_mpm import write_figures
+    from gmloco.eval.figures_paths import recorded_path
+
+    run = tmp_path / "run"
+    ep = _circle_episode(1.0, 0.5, 0.0, (0.0, 0.0), 30, 0.02)
+    rec = _record(run, "dry_sand__circle__v1", ep)
+    rec.write_bytes(rec.read_bytes()[:200])  # cut inside the header: nothing decodable
+    with pytest.raises((KeyError, ValueError, OSError)):
+        recorded_path(rec)
+    row = {"terrain": "dry_sand", "scenario": "circle", "speed": 1.0, "success": False, "vel_error": 0.1}
+    paths = write_figures([row], run, "p", episode_s=1.0)
+    assert [p.name for p in paths] == ["fig_mpm_speed_sweep.png"]
+    assert "fig_mpm_paths.png skipped" in capsys.readouterr().err

@@ -4,6 +4,7 @@
 from __future__ import annotations
 
 import math
+import sys
 from pathlib import Path
 from typing import Any
 
@@ -163,5 +164,9 @@ def write_figures(rows: list[dict[str, Any]], out_dir: str | Path, policy: str, 
 
     if cells := recordings_by_cell([out_dir]):
         panels = [(f"{terrain} / {scenario}", recs) for (terrain, scenario), recs in cells.items()]
-        paths.append(fig_paths(panels, Path(out_dir) / "fig_mpm_paths.png", episode_s, policy))
+        try:  # a recording that cannot be read must not cost the run its summary
+            paths.append(fig_paths(panels, Path(out_dir) / "fig_mpm_paths.png", episode_s, policy))
+        except (ImportError, KeyError, ValueError, OSError) as exc:
+            print(f"fig_mpm_paths.png skipped: a recording in {Path(out_dir) / 'recordings'} could not be read "
+                  f"({type(exc).__name__}: {exc})", file=sys.stderr)  # fmt: skip
     return paths

@@ -79,6 +79,9 @@ def recordings_by_cell(run_dirs: list[str | Path]) -> dict[tuple[str, str], list
 def fig_paths(panels: list[tuple[str, list[Path]]], path: str | Path, episode_s: float, title: str) -> Path:
     """One panel per (label, recordings): executed paths solid, commanded dashed, in each walk's start frame.
 
+    Raises:
+        KeyError, ValueError, OSError: A recording cannot be read (:func:`recorded_path`); nothing is written.
+
     Args:
         panels: (panel title, its recordings), e.g. one policy's recordings of one cell at each speed.
         path: Output ``.png``.
@@ -92,11 +95,11 @@ def fig_paths(panels: list[tuple[str, list[Path]]], path: str | Path, episode_s:
 
     from gmloco.eval.metrics.locomotion import circular_path
 
+    walks = [(label, [recorded_path(r) for r in recordings]) for label, recordings in panels]  # read all first
     width = max(6.0, 3.6 * len(panels))  # room for the title over a single panel
     fig, axes = plt.subplots(1, len(panels), figsize=(width, 3.8), squeeze=False, constrained_layout=True)
-    for ax, (label, recordings) in zip(axes[0], panels, strict=True):
-        for k, rec in enumerate(recordings):
-            p = recorded_path(rec)
+    for ax, (label, recorded) in zip(axes[0], walks, strict=True):
+        for k, p in enumerate(recorded):
             cmd, _ = circular_path(p.speed, p.yaw_rate, episode_s, p.dt)
             color = f"C{k}"
             ax.plot(cmd[:, 0], cmd[:, 1], "--", color=color, lw=1.0, alpha=0.6)

@@ -33,6 +33,7 @@ from __future__ import annotations
 import argparse
 import json
 import math
+import sys
 from pathlib import Path
 from typing import Any
 
@@ -194,8 +195,15 @@ def _path_figures(
             by_speed = {r.stem.rsplit("__v", 1)[-1]: r for r in reversed(recs)}
             cells.setdefault(cell, []).append((label, [by_speed[k] for k in sorted(by_speed, key=float)]))
     episode_s = float(summaries[next(iter(summaries))][0].get("cfg", {}).get("episode_s", 10.0))
-    return [fig_paths(panels, out_dir / f"fig_paths_{terrain}_{scenario}.png", episode_s, f"{terrain} / {scenario}")
-            for (terrain, scenario), panels in cells.items()]  # fmt: skip
+    figures = []
+    for (terrain, scenario), panels in cells.items():
+        try:
+            figures.append(fig_paths(panels, out_dir / f"fig_paths_{terrain}_{scenario}.png", episode_s,
+                                     f"{terrain} / {scenario}"))  # fmt: skip
+        except (KeyError, ValueError, OSError) as exc:
+            print(f"fig_paths_{terrain}_{scenario}.png skipped: a recording could not be read "
+                  f"({type(exc).__name__}: {exc})", file=sys.stderr)  # fmt: skip
+    return figures
 
 
 def _mixed_note(first: str, mixed: dict[str, list[str]]) -> str:
