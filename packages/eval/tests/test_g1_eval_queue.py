@@ -137,3 +137,20 @@ def test_a_row_in_shares_gets_its_wall_clock(tmp_path: Path) -> None:
     ends = [(r.started_min or 0.0) + r.minutes for r in results[:4]]
     assert span["wall_minutes"] == pytest.approx(max(ends) - min(r.started_min or 0.0 for r in results[:4]), abs=0.011)
     assert span["wall_minutes"] >= max(r.minutes for r in results[:4])
+
+
+def test_check_parses_every_task_without_a_gpu(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    """--check: good lines parse and nothing runs; a line g1_eval_cli refuses is named with the reason."""
+    f = tmp_path / "tasks.txt"
+    f.write_text("a --policy p.onnx --terrains basalt --shard 1/4\nb --scenarios circle --speeds 1.0 2.0\n")
+    assert main(["--tasks", str(f), "--check"]) == []
+    assert "2 tasks parse: a, b" in capsys.readouterr().out
+    assert not (tmp_path / "a").exists()
+    f.write_text("a --policy p.onnx\nbad --scenarios zigzag\n")
+    with pytest.raises(SystemExit):
+        main(["--tasks", str(f), "--check"])
+    err = capsys.readouterr().err
+    assert "task bad" in err and "zigzag" in err
+    with pytest.raises(SystemExit):
+        main(["--tasks", str(f)])  # to run, --gpus and --out are needed
+    assert "--gpus and --out are required" in capsys.readouterr().err

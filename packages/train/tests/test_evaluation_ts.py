@@ -15,6 +15,7 @@ from gmloco.train.evaluation_ts import (
     _cells,
     evaluate_teacher_student,
     finite_json,
+    pinned_walk,
     swing_apexes,
 )
 
@@ -120,3 +121,16 @@ def test_teacher_acting_walk_returns_per_material_stats(device: str, tmp_path: P
     assert sum(r["steps"] for r in rows) == 2 * 10 and rows[0]["steps"] > 0
     assert 0.0 <= rows[0]["eta_teacher"] <= 1.0 and rows[0]["eta_true"] > 0.0
     assert {p.name for p in tmp_path.iterdir()} == {"summary.json", "adaptation.png", "adaptation_env0.json"}
+
+
+@pytest.mark.skipif(not TEACHER_CHECKPOINT.exists(), reason=f"{TEACHER_CHECKPOINT} absent")
+def test_pinned_walk_returns_one_pelvis_trace_per_env(device: str) -> None:
+    """Two envs (dry sand / basalt, two commands) for 5 steps: [T, W] traces, unit quaternions, all alive at first."""
+    cfg = TsEvalCfg(actor="teacher", teacher_checkpoint=str(TEACHER_CHECKPOINT), device=device)
+    with pytest.raises(ValueError, match="one each per env"):
+        pinned_walk(cfg, ["dry_sand"], [(1.0, 0.0, 0.0), (1.0, 0.0, 0.5)], 0.1)
+    walk = pinned_walk(cfg, ["dry_sand", "basalt"], [(1.0, 0.0, 0.0), (1.0, 0.0, 0.5)], 0.1)
+    assert walk["dt"] == pytest.approx(0.02)
+    assert walk["quat_wxyz"].shape == (5, 2, 4) and walk["xy"].shape == (5, 2, 2) and walk["wz"].shape == (5, 2)
+    np.testing.assert_allclose(np.linalg.norm(walk["quat_wxyz"], axis=-1), 1.0, atol=1e-5)
+    assert walk["alive"][0].all() and walk["wall_s"] > 0.0

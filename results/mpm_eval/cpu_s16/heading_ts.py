@@ -14,11 +14,9 @@ from __future__ import annotations
 
 import argparse
 import json
-import time
 from pathlib import Path
 
 import numpy as np
-import torch
 
 HERE = Path(__file__).resolve().parent
 SPEEDS = (1.0, 1.5, 2.0, 2.5)
@@ -26,12 +24,9 @@ MATERIALS = ("basalt", "dry_sand")
 
 
 def main() -> None:
-    """Build the play env, pin materials and commands, walk 10 s, report the heading turn per cell."""
-    from tensordict import TensorDict
-
-    from gmloco.contact import MATERIAL_PRESETS
+    """Walk the student under the straight commands, report the heading turn per cell."""
     from gmloco.eval.metrics.locomotion import quat_wxyz_to_roll_pitch_yaw
-    from gmloco.train.evaluation_ts import TsEvalCfg, _build_runner, _pin_materials, _policy_step, _start
+    from gmloco.train.evaluation_ts import TsEvalCfg, pinned_walk
 
     p = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     p.add_argument("--repeats", type=int, default=2)
@@ -42,35 +37,18 @@ def main() -> None:
                     teacher_checkpoint="artifacts/gm_loco_teacher_td/checkpoint.pt", foot_faces="box",
                     baseline_policy=None, device=a.device)  # fmt: skip
     cells = [(m, v) for m in MATERIALS for v in SPEEDS for _ in range(a.repeats)]
-    t0 = time.perf_counter()
-    runner = _build_runner(cfg, len(cells), a.duration)
-    env = runner.env.unwrapped
-    mats = [MATERIAL_PRESETS[m] for m, _ in cells]
-    _pin_materials(env, [x.rho_c for x in mats], [x.mu_int for x in mats], [x.mu_surf for x in mats])
-    commands = torch.tensor([[v, 0.0, 0.0] for _, v in cells], dtype=torch.float32, device=env.device)
-    runner.alg.eval_mode()
-    obs = _start(runner, commands)
-    robot = env.scene["robot"]
-    alive = torch.ones(len(cells), dtype=torch.bool, device=env.device)
-    quats, alives = [], []
-    for _ in range(round(a.duration / env.step_dt)):
-        quats.append(robot.data.root_link_quat_w.clone())  # w x y z
-        alives.append(alive.clone())
-        out = _policy_step(runner, obs)
-        obs_dict, _, terminated, _, _ = env.step(out["actions"])
-        obs = TensorDict(obs_dict, batch_size=[len(cells)])
-        alive &= ~terminated
-    yaw = np.unwrap(quat_wxyz_to_roll_pitch_yaw(torch.stack(quats).cpu().numpy())[..., 2], axis=0)
-    live = torch.stack(alives).cpu().numpy()
+    walk = pinned_walk(cfg, [m for m, _ in cells], [(v, 0.0, 0.0) for _, v in cells], a.duration)
+    yaw = np.unwrap(quat_wxyz_to_roll_pitch_yaw(walk["quat_wxyz"])[..., 2], axis=0)
+    live, dt = walk["alive"], walk["dt"]
     rows = []
     for w, (m, v) in enumerate(cells):
         t_alive = int(live[:, w].sum())
         turn = np.degrees(yaw[:t_alive, w] - yaw[0, w])
-        rows.append({"material": m, "speed": v, "alive_s": t_alive * env.step_dt,
+        rows.append({"material": m, "speed": v, "alive_s": t_alive * dt,
                      "heading_turn_max_deg": float(np.max(np.abs(turn))) if t_alive else float("nan"),
                      "heading_turn_end_deg": float(turn[-1]) if t_alive else float("nan")})  # fmt: skip
     doc = {"policy": cfg.student_checkpoint, "simulator": "granular training simulator (3D-RFT, whole foot box)",
-           "device": a.device, "duration_s": a.duration, "wall_s": round(time.perf_counter() - t0, 1), "rows": rows}  # fmt: skip
+           "device": a.device, "duration_s": a.duration, "wall_s": round(walk["wall_s"], 1), "rows": rows}  # fmt: skip
     (HERE / "heading_ts.json").write_text(json.dumps(doc, indent=1) + "\n")
     for r in rows:
         print(f"{r['material']:9s} v={r['speed']:.1f}: alive {r['alive_s']:.1f} s, largest turn "

@@ -16,11 +16,9 @@ from __future__ import annotations
 
 import argparse
 import json
-import time
 from pathlib import Path
 
 import numpy as np
-import torch
 
 HERE = Path(__file__).resolve().parent
 SPEEDS = (1.0, 1.5, 2.0, 2.5)
@@ -40,12 +38,9 @@ def _finished_at(xy: np.ndarray, cmd_xy: np.ndarray, dt: float) -> float | None:
 
 
 def main() -> None:
-    """Build the play env, pin materials and commands, walk 10 s, score each env's circle."""
-    from tensordict import TensorDict
-
-    from gmloco.contact import MATERIAL_PRESETS
+    """Walk the student under the circle commands, score each env's circle."""
     from gmloco.eval.metrics.locomotion import circular_path, metric_path_error, quat_wxyz_to_roll_pitch_yaw
-    from gmloco.train.evaluation_ts import TsEvalCfg, _build_runner, _pin_materials, _policy_step, _start
+    from gmloco.train.evaluation_ts import TsEvalCfg, pinned_walk
 
     p = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     p.add_argument("--repeats", type=int, default=2)
@@ -56,30 +51,9 @@ def main() -> None:
                     teacher_checkpoint="artifacts/gm_loco_teacher_td/checkpoint.pt", foot_faces="box",
                     baseline_policy=None, device=a.device)  # fmt: skip
     cells = [(m, v) for m in MATERIALS for v in SPEEDS for _ in range(a.repeats)]
-    t0 = time.perf_counter()
-    runner = _build_runner(cfg, len(cells), a.duration)
-    env = runner.env.unwrapped
-    mats = [MATERIAL_PRESETS[m] for m, _ in cells]
-    _pin_materials(env, [x.rho_c for x in mats], [x.mu_int for x in mats], [x.mu_surf for x in mats])
-    commands = torch.tensor([[v, 0.0, v / RADIUS_M] for _, v in cells], dtype=torch.float32, device=env.device)
-    runner.alg.eval_mode()
-    obs = _start(runner, commands)
-    robot = env.scene["robot"]
-    alive = torch.ones(len(cells), dtype=torch.bool, device=env.device)
-    quats, xys, wzs, alives = [], [], [], []
-    for _ in range(round(a.duration / env.step_dt)):
-        quats.append(robot.data.root_link_quat_w.clone())  # w x y z
-        xys.append(robot.data.root_link_pos_w[:, :2].clone())
-        wzs.append(robot.data.root_link_ang_vel_w[:, 2].clone())
-        alives.append(alive.clone())
-        out = _policy_step(runner, obs)
-        obs_dict, _, terminated, _, _ = env.step(out["actions"])
-        obs = TensorDict(obs_dict, batch_size=[len(cells)])
-        alive &= ~terminated
-    dt = env.step_dt
-    yaw = np.unwrap(quat_wxyz_to_roll_pitch_yaw(torch.stack(quats).cpu().numpy())[..., 2], axis=0)
-    xy, wz = torch.stack(xys).cpu().numpy(), torch.stack(wzs).cpu().numpy()
-    live = torch.stack(alives).cpu().numpy()
+    walk = pinned_walk(cfg, [m for m, _ in cells], [(v, 0.0, v / RADIUS_M) for _, v in cells], a.duration)
+    dt, xy, wz, live = walk["dt"], walk["xy"], walk["wz"], walk["alive"]
+    yaw = np.unwrap(quat_wxyz_to_roll_pitch_yaw(walk["quat_wxyz"])[..., 2], axis=0)
     rows = []
     for w, (m, v) in enumerate(cells):
         n = int(live[:, w].sum())
@@ -94,7 +68,7 @@ def main() -> None:
                      "heading_turn_cmd_deg": float(np.degrees(v / RADIUS_M * n * dt))})  # fmt: skip
     doc = {"policy": cfg.student_checkpoint, "simulator": "granular training simulator (3D-RFT, whole foot box)",
            "command": f"(v, 0, v / {RADIUS_M}) for {a.duration} s", "device": a.device, "duration_s": a.duration,
-           "wall_s": round(time.perf_counter() - t0, 1), "rows": rows}  # fmt: skip
+           "wall_s": round(walk["wall_s"], 1), "rows": rows}  # fmt: skip
     (HERE / "circle_ts.json").write_text(json.dumps(doc, indent=1) + "\n")
     for r in rows:
         print(f"{r['material']:9s} v={r['speed']:.1f}: alive {r['alive_s']:.1f} s, finished {r['finished_at_s']}, "

@@ -14,14 +14,13 @@
 #      the square window (13 of its 24 walks at 1.0 m/s turned out of the tables' window in session 17; the whole
 #      row, so the tables can take it in place of the old one; the shares above 1.0 m/s fall within ~3 s).
 #   What the time box leaves undone resumes from the fetched folders (copy them to .devsrc/row/).
+#   This script writes the task file and hands it to scripts/gpu/run_queue.sh (one queue process per machine).
 #   Usage (in ~/src, after the wheels and the Warp cache): bash job_next.sh END_EPOCH
 #   Fetch: cd ~/chunks && tar czf - g1_eval job.log job.out tasks.txt | split -b 15M - $OUT/s18.tgz.part
 #   Check on a CPU (writes and parses the task file, runs nothing): DRY=1 bash job_next.sh 0
 END=$1
 cd ~/src || exit 1
-[ -n "${DRY:-}" ] || source scripts/gpu/env.sh
-mkdir -p ~/chunks/g1_eval
-[ -d ~/src/.devsrc/row ] && cp -r ~/src/.devsrc/row/* ~/chunks/g1_eval/
+mkdir -p ~/chunks
 TD=artifacts/gm_loco_student_td/policy.onnx
 RIGID=artifacts/ppo_rigid/policy.onnx
 RFT=artifacts/ppo_rft3d/policy.onnx
@@ -42,22 +41,4 @@ shares() {  # shares NAME ARGS...: the row as four task lines, one per share
   shares table_td_basalt_sq --policy $TD --terrains basalt $ROW $SQ
   shares table_td_dry_sand_rough_sq --policy $TD --terrains dry_sand_rough $ROW $SQ
 } > ~/chunks/tasks.txt
-if [ -n "${DRY:-}" ]; then  # every line must parse as the queue and g1_eval_cli read it
-  python3 - <<'PY'
-from pathlib import Path
-from gmloco.eval.g1_eval_cli import _parse
-from gmloco.eval.g1_eval_queue import file_tasks
-tasks = file_tasks(Path.home() / "chunks" / "tasks.txt", [])
-for t in tasks:
-    _parse([*t.argv, "--out", "x"])
-print(f"{len(tasks)} tasks parse:", ", ".join(t.name for t in tasks))
-PY
-  exit
-fi
-NGPU=$(nvidia-smi -L | wc -l)
-M=$(python3 -c "import time; print(round(($END - time.time()) / 60 - 0.7, 2))")
-echo "start: $NGPU GPUs, $M min at $(date +%T)" > ~/chunks/job.log
-python3 -m gmloco.eval.g1_eval_queue --gpus $(seq -s ' ' 0 $((NGPU - 1))) --out ~/chunks/g1_eval \
-  --tasks ~/chunks/tasks.txt --max-minutes "$M" >> ~/chunks/job.log 2>&1
-echo "queue rc=$? at $(date +%T)" >> ~/chunks/job.log
-touch ~/chunks/DONE
+bash scripts/gpu/run_queue.sh ~/chunks/tasks.txt "$END"

@@ -15,7 +15,8 @@ would get less than a minute is not started. Afterwards, combine the folders wit
         --terrains basalt dry_sand poppy_seed --scenarios straight circle --max-minutes 25
         -- --policy artifacts/gm_loco_student_td/policy.onnx
 
-Everything after ``--`` goes to every ``g1_eval_cli`` call (policy, window, numerics, episodes). Writes
+``--check`` parses every task's arguments as ``g1_eval_cli`` will and exits: run it on the CPU before spending
+device time on a job. Everything after ``--`` goes to every ``g1_eval_cli`` call (policy, window, numerics, episodes). Writes
 ``OUT/queue.json`` (per task: GPU, return code, start and minutes, log file; per row split into shares: its
 wall-clock from the first share's start to the last one's end, ``row_spans``).
 
@@ -42,7 +43,17 @@ from dataclasses import asdict, dataclass
 from pathlib import Path
 from typing import Any
 
-__all__ = ["Launch", "QueueTask", "TaskResult", "cell_tasks", "file_tasks", "main", "row_spans", "run_queue"]
+__all__ = [
+    "Launch",
+    "QueueTask",
+    "TaskResult",
+    "cell_tasks",
+    "check_tasks",
+    "file_tasks",
+    "main",
+    "row_spans",
+    "run_queue",
+]
 
 MIN_TASK_MINUTES = 1.0
 """A task that would get less than this is not started [min] (it would only build its solver)."""
@@ -144,6 +155,27 @@ def _command(task: QueueTask, out_root: Path, minutes: float | None) -> list[str
     return cmd if minutes is None else [*cmd, "--max-minutes", f"{minutes:.2f}"]
 
 
+def check_tasks(tasks: list[QueueTask]) -> None:
+    """Parse every task's arguments as ``g1_eval_cli`` will (before device time is spent on a typo).
+
+    Raises:
+        ValueError: A task's arguments do not parse; the message names the task and what ``g1_eval_cli`` said.
+    """
+    import contextlib
+    import io
+
+    from gmloco.eval.g1_eval_cli import _parse
+
+    for t in tasks:
+        err = io.StringIO()
+        try:
+            with contextlib.redirect_stderr(err):
+                _parse([*t.argv, "--out", t.name])
+        except SystemExit:
+            said = err.getvalue().strip().splitlines()
+            raise ValueError(f"task {t.name}: g1_eval_cli refuses its arguments: {said[-1] if said else ''}") from None
+
+
 def run_queue(
     tasks: list[QueueTask],
     gpus: list[str],
@@ -229,8 +261,8 @@ def main(argv: list[str] | None = None) -> list[TaskResult]:
     argv = sys.argv[1:] if argv is None else argv
     own, passthrough = (argv[: argv.index("--")], argv[argv.index("--") + 1 :]) if "--" in argv else (argv, [])
     p = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    p.add_argument("--gpus", nargs="+", required=True, help="CUDA_VISIBLE_DEVICES values, one task at a time each")
-    p.add_argument("--out", type=Path, required=True, help="folder of the run folders (one per task)")
+    p.add_argument("--gpus", nargs="+", help="CUDA_VISIBLE_DEVICES values, one task at a time each (required to run)")
+    p.add_argument("--out", type=Path, help="folder of the run folders, one per task (required to run)")
     p.add_argument("--terrains", nargs="+", help="one task per (terrain, scenario) cell")
     p.add_argument("--tasks", type=Path, help="task file instead of --terrains: one task per line (see above)")
     p.add_argument("--scenarios", nargs="+", default=["straight"])
@@ -238,9 +270,13 @@ def main(argv: list[str] | None = None) -> list[TaskResult]:
     p.add_argument("--shards", type=int, default=1,
                    help="split each cell's episodes into this many tasks (e.g. the GPU count: one row on all GPUs)")  # fmt: skip
     p.add_argument("--label", default=None, help="policy label in the combined tables (default: the policy's folder)")
+    p.add_argument("--check", action="store_true",
+                   help="parse every task's arguments as g1_eval_cli does, print the tasks and exit (no GPU needed)")  # fmt: skip
     a = p.parse_args(own)
     if (a.terrains is None) == (a.tasks is None):
         p.error("give either --terrains (one task per cell) or --tasks FILE (one task per line)")
+    if not a.check and (a.gpus is None or a.out is None):
+        p.error("--gpus and --out are required to run the queue (only --check goes without them)")
     if a.tasks is not None and a.shards != 1:
         p.error("--shards splits --terrains cells; in a task file write the shares as lines with --shard I/N")
     try:
@@ -248,6 +284,10 @@ def main(argv: list[str] | None = None) -> list[TaskResult]:
             tasks = file_tasks(a.tasks, passthrough)
         else:
             tasks = cell_tasks(a.terrains, a.scenarios, passthrough, a.shards)
+        if a.check:
+            check_tasks(tasks)
+            print(f"{len(tasks)} tasks parse: {', '.join(t.name for t in tasks)}")
+            return []
         results = run_queue(tasks, a.gpus, a.out, a.max_minutes)
     except ValueError as exc:
         p.error(str(exc))

@@ -48,6 +48,7 @@ __all__ = [
     "decoded_eta_check",
     "evaluate_teacher_adaptation",
     "evaluate_teacher_student",
+    "pinned_walk",
     "swing_apexes",
 ]
 
@@ -263,6 +264,48 @@ def _rollout(runner: Any, commands: torch.Tensor, steps: int) -> dict[str, np.nd
     result |= {k: v.cpu().numpy() for k, v in stats.items()}
     result["failed"] = (~alive).cpu().numpy()
     return result
+
+
+def pinned_walk(cfg: TsEvalCfg, materials: list[str], commands: list[tuple[float, float, float]],
+                duration_s: float) -> dict[str, Any]:  # fmt: skip
+    """Walk the acting checkpoint, one env per (material, command), under commands held for ``duration_s``.
+
+    The training simulator's side of a comparison with the MPM evaluation: each env's material preset is pinned
+    (``gmloco.contact.MATERIAL_PRESETS`` names) and its command (v_x [m/s], v_y [m/s], w_z [rad/s]) held; an env
+    stops counting as alive at its first failure termination.
+
+    Returns:
+        ``quat_wxyz`` [T, W, 4] and ``xy`` [T, W, 2] [m] of the pelvis, ``wz`` [T, W] its world yaw rate [rad/s],
+        ``alive`` [T, W] (before each step), ``dt`` the policy step [s], ``wall_s`` the time it took [s].
+    """
+    import time
+
+    from tensordict import TensorDict
+
+    from gmloco.contact import MATERIAL_PRESETS
+
+    if len(materials) != len(commands):
+        raise ValueError(f"pinned_walk: {len(materials)} materials but {len(commands)} commands (one each per env)")
+    t0 = time.perf_counter()
+    runner = _build_runner(cfg, len(commands), duration_s)
+    env = runner.env.unwrapped
+    mats = [MATERIAL_PRESETS[m] for m in materials]
+    _pin_materials(env, [x.rho_c for x in mats], [x.mu_int for x in mats], [x.mu_surf for x in mats])
+    runner.alg.eval_mode()
+    obs = _start(runner, torch.tensor(commands, dtype=torch.float32, device=env.device))
+    robot, n = env.scene["robot"], len(commands)
+    alive = torch.ones(n, dtype=torch.bool, device=env.device)
+    trace: dict[str, list[torch.Tensor]] = {"quat_wxyz": [], "xy": [], "wz": [], "alive": []}
+    for _ in range(round(duration_s / env.step_dt)):
+        trace["quat_wxyz"].append(robot.data.root_link_quat_w.clone())
+        trace["xy"].append(robot.data.root_link_pos_w[:, :2].clone())
+        trace["wz"].append(robot.data.root_link_ang_vel_w[:, 2].clone())
+        trace["alive"].append(alive.clone())
+        obs_dict, _, terminated, _, _ = env.step(_policy_step(runner, obs)["actions"])
+        obs = TensorDict(obs_dict, batch_size=[n])
+        alive &= ~terminated
+    out: dict[str, Any] = {k: torch.stack(v).cpu().numpy() for k, v in trace.items()}
+    return out | {"dt": float(env.step_dt), "wall_s": time.perf_counter() - t0}
 
 
 def finite_json(obj: Any) -> Any:
