@@ -21,21 +21,12 @@
 END=$1
 cd ~/src || exit 1
 mkdir -p ~/chunks
-TD=artifacts/gm_loco_student_td/policy.onnx
-RIGID=artifacts/ppo_rigid/policy.onnx
-RFT=artifacts/ppo_rft3d/policy.onnx
-ROW="--speeds 1.0 1.5 2.0 2.5 --num-episodes 100 --robots-per-batch 50"
-SQ="--window-length 1.4 --window-width 1.4 --window-lead 0.2"
-WIDE="--window-length 1.4 --window-width 1.3 --window-lead 0.0"
-shares() {  # shares NAME ARGS...: the row as four task lines, one per share
-  local N=$1; shift
-  for i in 0 1 2 3; do echo "${N}_share${i}of4 $* --shard $i/4"; done
-}
+source scripts/gpu/queue_rows.sh  # TD CLR50 RIGID RFT ROW SQ WIDE, shares()
 {
   shares table_td_dry_sand_x4 --policy $TD --terrains dry_sand $ROW
   echo "table_td_dry_sand_circle_share3of4 --policy $TD --terrains dry_sand --scenarios circle $ROW --shard 3/4"
   shares table_ppo_rft3d_dry_sand_circle --policy $RFT --terrains dry_sand --scenarios circle $ROW
-  shares table_clr50_dry_sand_circle --policy artifacts/gm_loco_student_clr50/policy.onnx --terrains dry_sand --scenarios circle $ROW
+  shares table_clr50_dry_sand_circle --policy $CLR50 --terrains dry_sand --scenarios circle $ROW
   shares table_ppo_rigid_dry_sand_circle --policy $RIGID --terrains dry_sand --scenarios circle $ROW $WIDE
   shares table_td_transition_sq --policy $TD --terrains transition $ROW $SQ
   shares table_td_basalt_sq --policy $TD --terrains basalt $ROW $SQ
