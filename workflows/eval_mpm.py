@@ -12,6 +12,7 @@ returns success rate, velocity / yaw tracking error, DTW path error, support rat
 Run alone (time-boxed and resumable; works with plain ``python`` and ``PYTHONPATH=packages/*/src:workflows``)::
 
     python workflows/eval_mpm.py +exp=gm_loco run_dir=runs/gm_loco/<name> max_minutes=9
+    python workflows/eval_mpm.py +exp=gm_loco run_dir=runs/gm_loco/<name> 'eval_mpm.gpus=[0,1,2,3]'   # four GPUs
 
 The GPU machine's command line without Hydra: ``python -m gmloco.eval.g1_eval_cli``; whether a cheaper MPM setting
 walks as the accepted one does: ``python -m gmloco.eval.convergence`` (``docs/mpm_eval.md``).
@@ -84,10 +85,15 @@ def eval_cfg(cfg: DictConfig) -> G1EvalCfg:
 
 
 def run(cfg: DictConfig) -> dict[str, float]:
-    """Evaluate ``<policy_dir>/<policy_file>`` on MPM sand; raise ``StageIncompleteError`` at the time box."""
-    from gmloco.eval.g1_eval import run as run_eval
+    """Evaluate ``<policy_dir>/<policy_file>`` on MPM sand; raise ``StageIncompleteError`` at the time box.
 
-    metrics, complete = run_eval(eval_cfg(cfg))
+    With ``eval_mpm.gpus`` set, over those GPUs (one process each, every cell split into one share per GPU).
+    """
+    from gmloco.eval.g1_eval import run as run_eval
+    from gmloco.eval.g1_eval_gpus import run_on_gpus
+
+    gpus = [str(g) for g in cfg.eval_mpm.get("gpus", [])]
+    metrics, complete = run_on_gpus(eval_cfg(cfg), gpus) if gpus else run_eval(eval_cfg(cfg))
     if not complete:
         raise StageIncompleteError(
             f"time box reached after {int(metrics.get('all/num_episodes', 0))} episodes; episodes.jsonl kept"

@@ -316,6 +316,11 @@ class EvalMpmCfg(StageCfg):
     robot-frames/s of 3.0 (H200, 32 robots, results/mpm_eval/gpu_s13); an overflow stops the cell with an error."""
     record_mcap: bool = True
     """Write the first episode of every (terrain, scenario, speed) as an MCAP recording."""
+    gpus: list[int] = field(default_factory=list)
+    """CUDA devices to spread the evaluation over: one process per GPU, each (terrain, scenario) cell split into one
+    share per GPU, pooled into this stage's outputs (``gmloco.eval.g1_eval_gpus``; the shares' folders under
+    ``<out_dir>/cells``). Empty: one process on the pipeline's ``device``. One GPU steps ~110-130 robot-frames/s at
+    the default setting: 100 walking episodes of a cell take ~26-30 minutes on one GPU (``BENCHMARKS.md``)."""
 
 
 @dataclass

@@ -5,6 +5,7 @@ from __future__ import annotations
 
 from collections.abc import Callable
 
+import pytest
 from omegaconf import DictConfig
 
 import eval_mpm
@@ -37,3 +38,18 @@ def test_default_section_matches_the_eval_defaults(compose: Callable[..., DictCo
     assert out.window == base.window
     assert (out.bed_depth, out.cell_capacity_factor) == (base.bed_depth, base.cell_capacity_factor)
     assert out.solver == base.solver
+
+
+def test_gpus_send_the_stage_to_the_several_gpu_runner(
+    compose: Callable[..., DictConfig], monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """eval_mpm.gpus=[0,1] runs run_on_gpus with those GPUs and the section's config; empty runs in process."""
+    import gmloco.eval.g1_eval as g1_eval
+    import gmloco.eval.g1_eval_gpus as g1_eval_gpus
+
+    calls: list[tuple[str, object]] = []
+    monkeypatch.setattr(g1_eval_gpus, "run_on_gpus", lambda c, g: calls.append(("gpus", g)) or ({"m": 1.0}, True))
+    monkeypatch.setattr(g1_eval, "run", lambda c: calls.append(("one", c.out_dir)) or ({"m": 2.0}, True))
+    assert eval_mpm.run(compose("+exp=gm_loco", "+scale=full", "eval_mpm.gpus=[0,1]")) == {"m": 1.0}
+    assert eval_mpm.run(compose("+exp=gm_loco", "+scale=full")) == {"m": 2.0}
+    assert calls[0] == ("gpus", ["0", "1"]) and calls[1][0] == "one"

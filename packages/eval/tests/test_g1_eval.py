@@ -99,7 +99,7 @@ def test_a_sole_outside_the_sand_window_flags_the_episode() -> None:
 
 def test_a_run_reports_the_soles_reach_against_its_window(capsys: pytest.CaptureFixture[str]) -> None:
     """The largest reach over the episodes against the window's extent; a warning names the earliest exit."""
-    from gmloco.eval.g1_eval import _report_window
+    from gmloco.eval.g1_eval import report_window
 
     rows = [
         {
@@ -112,16 +112,16 @@ def test_a_run_reports_the_soles_reach_against_its_window(capsys: pytest.Capture
         }
         for i, (b, e) in enumerate([(0.3, None), (0.62, 0.8), (0.55, 0.5)])
     ]
-    _report_window(rows, SandWindowCfg(length=1.0, width=0.5, lead=0.1))
+    report_window(rows, SandWindowCfg(length=1.0, width=0.5, lead=0.1))
     err = capsys.readouterr().err
     assert "0.62 m behind the pelvis, 0.15 m ahead and 0.20 m sideways" in err
     assert "spans 0.40 m behind, 0.60 m ahead and 0.25 m sideways" in err
     assert "in 2 of 3 episodes" in err and "first at 0.50 s, k2" in err
     assert "turned" not in err  # rows without the cause (older runs) blame nothing on a turn
     rows[1]["window_exit_turn"] = True
-    _report_window(rows, SandWindowCfg(length=1.0, width=0.5, lead=0.1))
+    report_window(rows, SandWindowCfg(length=1.0, width=0.5, lead=0.1))
     assert "in 1 of them the robot had turned" in capsys.readouterr().err
-    _report_window(rows[:1], SandWindowCfg(length=1.0, width=0.5, lead=0.1))
+    report_window(rows[:1], SandWindowCfg(length=1.0, width=0.5, lead=0.1))
     assert "warning" not in capsys.readouterr().err
 
 
@@ -326,7 +326,7 @@ def _run_in(cfg: G1EvalCfg, monkeypatch: pytest.MonkeyPatch) -> tuple[dict, bool
 
     import gmloco.eval.g1_eval as g1_eval
 
-    monkeypatch.setattr(g1_eval, "_write_outputs", lambda *a, **k: None)
+    monkeypatch.setattr(g1_eval, "write_outputs", lambda *a, **k: None)
     with tempfile.TemporaryDirectory() as tmp:
         summary, complete = g1_eval.run(replace(cfg, out_dir=tmp))
         lines = (Path(tmp) / "episodes.jsonl").read_text().splitlines()

@@ -106,3 +106,28 @@ def test_shard_reaches_the_config_and_bad_shards_are_refused(
         with pytest.raises(SystemExit):
             _parse(["--out", "x", "--shard", bad])
         assert "--shard" in capsys.readouterr().err
+
+
+def test_cli_args_give_back_the_config() -> None:
+    """A config with every command-line field off its default survives cli_args -> parse -> cfg_from_args."""
+    from dataclasses import replace
+
+    from gmloco.eval.g1_eval import G1EvalCfg
+    from gmloco.eval.g1_eval_cli import cfg_from_args, cli_args
+    from gmloco.eval.mpm.window import SandWindowCfg
+
+    base = G1EvalCfg()
+    cfg = replace(base, policy_path="a/p.onnx", out_dir="o", terrains=("basalt", "transition"),
+                  scenarios=("straight", "circle"), speeds=(1.25, 2.0), num_episodes=7, episode_s=5.0,
+                  circle_radius=1.5, course_slack=0.1, bed_depth=0.25,
+                  window=SandWindowCfg(moving=False, length=1.1, width=0.7, lead=-0.05, particles_per_voxel=1),
+                  robots_per_batch=9, refill=False, cell_capacity_factor=1.25,
+                  solver=replace(base.solver, voxel_size=0.04, max_iterations=321, tolerance=1e-6, frame_dt=0.01,
+                                 rigid_substeps=2, rheology_solver="jacobi,gs"),
+                  record_mcap=False, resume=False, seed=3)  # fmt: skip
+    back = cfg_from_args(_parse([*cli_args(cfg), "--out", "o"]))
+    assert back == cfg
+    per_cell = cli_args(cfg, cells=False)
+    assert "--terrains" not in per_cell and "--scenarios" not in per_cell and "--out" not in per_cell
+    with pytest.raises(ValueError, match="lane_gap"):
+        cli_args(replace(cfg, lane_gap=3.0))

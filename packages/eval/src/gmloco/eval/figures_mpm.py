@@ -151,18 +151,25 @@ def fig_per_terrain(runs: list[tuple[str, list[dict[str, Any]]]], path: str | Pa
     return Path(path)
 
 
-def write_figures(rows: list[dict[str, Any]], out_dir: str | Path, policy: str, episode_s: float = 10.0) -> list[Path]:
+def write_figures(
+    rows: list[dict[str, Any]],
+    out_dir: str | Path,
+    policy: str,
+    episode_s: float = 10.0,
+    run_dirs: list[Path] | None = None,
+) -> list[Path]:
     """Write the evaluation figures under ``out_dir``; return their paths.
 
-    With recordings in ``out_dir/recordings`` also ``fig_mpm_paths.png``: each (terrain, scenario) cell's recorded
-    walks against their commanded paths (:mod:`gmloco.eval.figures_paths`; ``episode_s`` [s] is the commanded length).
+    With recordings in ``<run dir>/recordings`` (``run_dirs``, default ``[out_dir]``) also ``fig_mpm_paths.png``:
+    each (terrain, scenario) cell's recorded walks against their commanded paths (:mod:`gmloco.eval.figures_paths`;
+    ``episode_s`` [s] is the commanded length).
     """
     paths = [fig_mpm_speed_sweep(rows, Path(out_dir) / "fig_mpm_speed_sweep.png", policy)]
     if any(r.get("layers") for r in rows):
         paths.append(fig_mpm_transition(rows, Path(out_dir) / "fig_mpm_transition.png", policy))
     from gmloco.eval.figures_paths import fig_paths, recordings_by_cell
 
-    if cells := recordings_by_cell([out_dir]):
+    if cells := recordings_by_cell(list(run_dirs) if run_dirs is not None else [out_dir]):
         panels = [(f"{terrain} / {scenario}", recs) for (terrain, scenario), recs in cells.items()]
         try:  # a recording that cannot be read must not cost the run its summary
             paths.append(fig_paths(panels, Path(out_dir) / "fig_mpm_paths.png", episode_s, policy))

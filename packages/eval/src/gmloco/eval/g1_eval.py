@@ -72,12 +72,15 @@ __all__ = [
     "lane_failed",
     "load_policy",
     "read_episodes",
+    "report_window",
     "run",
     "run_cell",
     "score_episode",
     "sole_reach_max",
+    "summarize",
     "window_exit_cause",
     "window_exit_time",
+    "write_outputs",
 ]  # fmt: skip
 
 Scenario = Literal["straight", "circle"]
@@ -674,12 +677,12 @@ def run(cfg: G1EvalCfg) -> tuple[dict[str, float], bool]:
     wall = time.perf_counter() - t0
     summary["throughput/episodes_this_call"] = float(len(rows) - len(done))
     summary["throughput/episodes_per_minute"] = 60.0 * (len(rows) - len(done)) / max(wall, 1e-9)
-    _write_outputs(out, cfg, rows, summary, complete)
-    _report_window(rows, cfg.window)
+    write_outputs(out, cfg, rows, summary, complete)
+    report_window(rows, cfg.window)
     return summary, complete
 
 
-def _report_window(rows: list[dict[str, Any]], window: SandWindowCfg) -> None:
+def report_window(rows: list[dict[str, Any]], window: SandWindowCfg) -> None:
     """Say on stderr how far the soles reached against the window, and warn about episodes that left it early."""
     import sys
 
@@ -707,15 +710,25 @@ def _report_window(rows: list[dict[str, Any]], window: SandWindowCfg) -> None:
               file=sys.stderr, flush=True)  # fmt: skip
 
 
-def _write_outputs(out: Path, cfg: G1EvalCfg, rows: list[dict[str, Any]], summary: dict, complete: bool) -> None:
-    """``summary.json`` (temporary file + replace), the tables and the figures."""
+def write_outputs(
+    out: Path,
+    cfg: G1EvalCfg,
+    rows: list[dict[str, Any]],
+    summary: dict,
+    complete: bool,
+    run_dirs: list[Path] | None = None,
+) -> None:
+    """``summary.json`` (temporary file + replace), the tables and the figures of ``rows`` under ``out``.
+
+    ``run_dirs``: the folders whose ``recordings/`` hold the episodes' recordings (default: ``out``).
+    """
     from gmloco.eval.figures_mpm import write_figures
     from gmloco.eval.tables_mpm import write_tables
 
     policy = Path(cfg.policy_path).parent.name or Path(cfg.policy_path).stem
     tables = write_tables(rows, out, policy)
     try:  # the GPU image may lack matplotlib: the numbers must not be lost for a figure
-        figures, note = (write_figures(rows, out, policy, cfg.episode_s) if rows else []), ""
+        figures, note = (write_figures(rows, out, policy, cfg.episode_s, run_dirs) if rows else []), ""
     except ImportError as exc:
         figures, note = [], f"figures skipped: {exc}"
     doc = {"complete": complete, "policy": cfg.policy_path, "cfg": _jsonable(asdict(cfg)), "metrics": summary,

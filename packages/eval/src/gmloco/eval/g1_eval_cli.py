@@ -17,7 +17,7 @@ from gmloco.eval.g1_eval import G1EvalCfg, run
 from gmloco.eval.mpm.box_scene import frame_dt_problem
 from gmloco.eval.mpm.window import SandWindowCfg
 
-__all__ = ["main"]
+__all__ = ["cfg_from_args", "cli_args", "main"]
 
 _SOLVER = G1EvalCfg().solver
 """The evaluation's default MPM numerics (the command line's defaults)."""
@@ -39,7 +39,14 @@ def _parse(argv: list[str] | None) -> argparse.Namespace:
         help="I/N: score the share I (0 .. N-1) of each cell's episodes, those with index k %% N == I "
         "(several GPUs split one row; paper_tables pools the folders)",
     )
-    p.add_argument("--episode-s", type=float, default=10.0)
+    p.add_argument("--episode-s", type=float, default=G1EvalCfg.episode_s, help="episode = course time limit [s]")
+    p.add_argument("--circle-radius", type=float, default=G1EvalCfg.circle_radius, help="circular walk radius [m]")
+    p.add_argument(
+        "--course-slack",
+        type=float,
+        default=G1EvalCfg.course_slack,
+        help="fraction of the commanded path that may be left at the time limit and still count as finished",
+    )
     p.add_argument("--voxel", type=float, default=_SOLVER.voxel_size, help="MPM voxel size [m]")
     p.add_argument("--iters", type=int, default=_SOLVER.max_iterations, help="rheology iterations")
     p.add_argument(
@@ -100,11 +107,10 @@ def _parse(argv: list[str] | None) -> argparse.Namespace:
     return a
 
 
-def main(argv: list[str] | None = None) -> None:
-    """Run the evaluation from command-line arguments."""
-    a = _parse(argv)
+def cfg_from_args(a: argparse.Namespace) -> G1EvalCfg:
+    """The evaluation config of parsed command-line arguments."""
     base = G1EvalCfg()
-    cfg = replace(
+    return replace(
         base,
         policy_path=a.policy,
         out_dir=a.out,
@@ -115,6 +121,8 @@ def main(argv: list[str] | None = None) -> None:
         shard=a.shard,
         shards=a.shards,
         episode_s=a.episode_s,
+        circle_radius=a.circle_radius,
+        course_slack=a.course_slack,
         window=SandWindowCfg(
             moving=not a.static_bed,
             length=a.window_length,
@@ -141,7 +149,53 @@ def main(argv: list[str] | None = None) -> None:
         device=a.device,
         seed=a.seed,
     )
-    metrics, complete = run(cfg)
+
+
+def cli_args(cfg: G1EvalCfg, cells: bool = True) -> list[str]:
+    """The command-line arguments that give back ``cfg`` (the inverse of :func:`cfg_from_args`).
+
+    Leaves out what a caller running several processes sets per process: ``--out``, ``--shard``, ``--max-minutes``
+    and ``--device``; ``cells=False`` also leaves out ``--terrains`` and ``--scenarios`` (one task per cell).
+
+    Raises:
+        ValueError: ``cfg`` holds a setting the command line cannot express (e.g. other failure rules).
+    """
+    base = G1EvalCfg()
+    if (cfg.bed_margin, cfg.lane_gap) != (base.bed_margin, base.lane_gap):
+        raise ValueError(f"bed_margin {cfg.bed_margin} / lane_gap {cfg.lane_gap} differ from the defaults: the "
+                         "command line cannot pass them")  # fmt: skip
+    if cfg.failure != base.failure:
+        raise ValueError(f"failure rules {cfg.failure} differ from the defaults: the command line cannot pass them")
+    s, w = cfg.solver, cfg.window
+    if replace(s, voxel_size=_SOLVER.voxel_size, max_iterations=_SOLVER.max_iterations, tolerance=_SOLVER.tolerance,
+               frame_dt=_SOLVER.frame_dt, rigid_substeps=_SOLVER.rigid_substeps,
+               rheology_solver=_SOLVER.rheology_solver) != _SOLVER:  # fmt: skip
+        raise ValueError("the MPM solver config sets fields the command line cannot pass (only voxel, iterations, "
+                         "tolerance, frame, rigid substeps and rheology solver)")  # fmt: skip
+    if replace(w, moving=_WINDOW.moving, length=_WINDOW.length, width=_WINDOW.width, lead=_WINDOW.lead,
+               particles_per_voxel=_WINDOW.particles_per_voxel) != _WINDOW:  # fmt: skip
+        raise ValueError("the sand window sets fields the command line cannot pass (only moving, size, lead, "
+                         "particles per voxel)")  # fmt: skip
+    out = ["--policy", cfg.policy_path]
+    if cells:
+        out += ["--terrains", *cfg.terrains, "--scenarios", *cfg.scenarios]
+    out += ["--speeds", *(f"{v:g}" for v in cfg.speeds), "--num-episodes", str(cfg.num_episodes),
+            "--episode-s", repr(cfg.episode_s), "--circle-radius", repr(cfg.circle_radius),
+            "--course-slack", repr(cfg.course_slack), "--voxel", repr(s.voxel_size), "--iters", str(s.max_iterations),
+            "--frame-dt", repr(s.frame_dt), "--tolerance", repr(s.tolerance), "--rheology-solver", s.rheology_solver,
+            "--substeps", str(s.rigid_substeps), "--bed-depth", repr(cfg.bed_depth),
+            "--robots-per-batch", str(cfg.robots_per_batch), "--window-length", repr(w.length),
+            "--window-width", repr(w.width), "--window-lead", repr(w.lead),
+            "--particles-per-voxel", str(w.particles_per_voxel),
+            "--cell-capacity-factor", repr(cfg.cell_capacity_factor), "--seed", str(cfg.seed)]  # fmt: skip
+    flags = {"--no-refill": not cfg.refill, "--static-bed": not w.moving, "--no-mcap": not cfg.record_mcap,
+             "--fresh": not cfg.resume}  # fmt: skip
+    return out + [f for f, on in flags.items() if on]
+
+
+def main(argv: list[str] | None = None) -> None:
+    """Run the evaluation from command-line arguments."""
+    metrics, complete = run(cfg_from_args(_parse(argv)))
     print(json.dumps({"complete": complete, **{k: v for k, v in metrics.items() if "/v" not in k}}, indent=1))
 
 
