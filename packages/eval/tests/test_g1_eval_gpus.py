@@ -43,6 +43,8 @@ def _stand_in(complete_shares: set[int] | None = None):  # noqa: ANN202
     def launch(cmd: list[str], env: dict[str, str], log: Path) -> subprocess.Popen[bytes]:
         launched.append(cmd)
         cfg = cfg_from_args(_parse(cmd[cmd.index("-m") + 2 :]))
+        found = Path(cfg.out_dir) / "episodes.jsonl"
+        launch.found[Path(cfg.out_dir).name] = found.read_text().count("\n") if found.exists() else 0  # type: ignore[attr-defined]
         specs = episode_specs(cfg)
         done = complete_shares is None or cfg.shard in complete_shares
         rows = [score_episode(s, cfg, _walk(s.speed, 100, 20 if s.index % 2 else None)) for s in specs]
@@ -55,6 +57,7 @@ def _stand_in(complete_shares: set[int] | None = None):  # noqa: ANN202
         return subprocess.Popen([sys.executable, "-c", "pass"])
 
     launch.launched = launched  # type: ignore[attr-defined]
+    launch.found = {}  # type: ignore[attr-defined]
     return launch
 
 
@@ -94,3 +97,17 @@ def test_a_sharded_config_is_refused(tmp_path: Path) -> None:
     """A config that is already one share cannot be split again."""
     with pytest.raises(ValueError, match="shards the cells itself"):
         run_on_gpus(replace(_cfg(tmp_path), shards=2), ["0", "1"], launch=_stand_in())
+
+
+def test_shares_start_from_a_pooled_file(tmp_path: Path) -> None:
+    """A run folder whose episodes.jsonl another run wrote (3 basalt episodes): each share starts from its part."""
+    cfg = _cfg(tmp_path)
+    run = Path(cfg.out_dir)
+    run.mkdir(parents=True)
+    earlier = [score_episode(s, cfg, _walk(1.0, 100, None)) for s in episode_specs(cfg)[:3]]  # basalt 0, 1, 2
+    (run / "episodes.jsonl").write_text("".join(json.dumps(r) + "\n" for r in earlier))
+    launch = _stand_in()
+    run_on_gpus(cfg, ["0", "1"], launch=launch, poll_s=0.01)
+    found = launch.found  # type: ignore[attr-defined]
+    assert found["basalt__straight__share0of2"] == 2 and found["basalt__straight__share1of2"] == 1
+    assert found["dry_sand__straight__share0of2"] == 0

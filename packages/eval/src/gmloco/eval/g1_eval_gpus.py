@@ -6,7 +6,8 @@ minutes on it (``BENCHMARKS.md``). :func:`run_on_gpus` splits each (terrain, sce
 one share per GPU (``--shard I/N``: the episodes whose index k has k % N == I), runs the shares through
 :mod:`gmloco.eval.g1_eval_queue` (one ``g1_eval_cli`` process per GPU, the whole queue time-boxed to
 ``cfg.max_minutes``), and pools them into the outputs a one-process run writes under ``cfg.out_dir``:
-``episodes.jsonl`` (pooled; the same episode keys as a one-process run, so either kind can resume it),
+``episodes.jsonl`` (pooled; the same episode keys as a one-process run, so either kind resumes the other:
+share folders without episodes start from their share of it),
 ``summary.json``, the tables and figures. The shares' own folders stay under ``cfg.out_dir/cells`` (their
 recordings, logs and resume state; rerunning resumes each) beside the queue's ``queue.json``.
 """
@@ -21,7 +22,7 @@ from typing import Any
 
 from gmloco.eval.g1_eval import G1EvalCfg, read_episodes, report_window, summarize, write_outputs
 from gmloco.eval.g1_eval_cli import cli_args
-from gmloco.eval.g1_eval_queue import Launch, TaskResult, cell_tasks, row_spans, run_queue
+from gmloco.eval.g1_eval_queue import Launch, QueueTask, TaskResult, cell_tasks, row_spans, run_queue
 
 __all__ = ["CELLS_DIR", "run_on_gpus"]
 
@@ -37,6 +38,33 @@ def _share_state(folder: Path, result: TaskResult) -> tuple[list[dict[str, Any]]
         return rows, False, 0.0
     doc = json.loads(path.read_text())
     return rows, bool(doc.get("complete")), float(doc.get("metrics", {}).get("throughput/episodes_this_call", 0.0))
+
+
+def _arg(argv: tuple[str, ...], flag: str, default: str) -> str:
+    """The value after ``flag`` in a task's arguments (``default`` when absent)."""
+    return argv[argv.index(flag) + 1] if flag in argv else default
+
+
+def _seed_shares(out: Path, tasks: list[QueueTask]) -> None:
+    """Give each share folder without episodes its share of the run's pooled ``episodes.jsonl``, if there is one.
+
+    So a run resumes whatever wrote that file last: a one-process run, or shares of another GPU count.
+    """
+    pooled = out / "episodes.jsonl"
+    if not pooled.exists():
+        return
+    rows = read_episodes(pooled, repair=True)
+    for t in tasks:
+        folder = out / CELLS_DIR / t.name
+        if (folder / "episodes.jsonl").exists():
+            continue
+        terrain, scenario = _arg(t.argv, "--terrains", ""), _arg(t.argv, "--scenarios", "")
+        share, shares = (int(x) for x in _arg(t.argv, "--shard", "0/1").split("/"))
+        mine = [r for r in rows if (r["terrain"], r["scenario"]) == (terrain, scenario)
+                and int(str(r["key"]).rsplit("/", 1)[-1]) % shares == share]  # fmt: skip
+        if mine:
+            folder.mkdir(parents=True, exist_ok=True)
+            (folder / "episodes.jsonl").write_text("".join(json.dumps(r) + "\n" for r in mine))
 
 
 def run_on_gpus(
@@ -58,6 +86,8 @@ def run_on_gpus(
     out = Path(cfg.out_dir)
     cells = out / CELLS_DIR
     tasks = cell_tasks(list(cfg.terrains), list(cfg.scenarios), cli_args(cfg, cells=False), shards=len(gpus))
+    if cfg.resume:
+        _seed_shares(out, tasks)
     extra: dict[str, Any] = {} if launch is None else {"launch": launch}
     results = run_queue(tasks, gpus, cells, cfg.max_minutes, poll_s=poll_s, **extra)
     (cells / "queue.json").write_text(json.dumps({"gpus": gpus, "max_minutes": cfg.max_minutes,
