@@ -60,6 +60,11 @@ def test_figures_are_drawn_per_run_and_per_cell(tmp_path: Path) -> None:
     for v in (2.0, 1.0):
         _record(run, f"dry_sand__circle__v{v:g}", _circle_episode(v, v / 2.0, 0.0, (0.0, 0.0), 60, 0.02))
     (run / "recordings" / "notes.mcap").write_bytes(b"")  # a name that does not parse is skipped
+    other = tmp_path / "other_share"
+    _record(other, "dry_sand__circle__v1", _circle_episode(1.0, 0.5, 0.0, (0.0, 0.0), 60, 0.02))
+    _record(other, "dry_sand__circle__v3", _circle_episode(3.0, 1.5, 0.0, (0.0, 0.0), 60, 0.02))
+    two = recordings_by_cell([run, other])  # v1 from the first folder, v3 only in the second
+    assert [f.parent.parent.name for f in two["dry_sand", "circle"]] == ["run", "run", "other_share"]
     cells = recordings_by_cell([run])
     assert list(cells) == [("dry_sand", "circle")]
     assert [f.stem for f in cells["dry_sand", "circle"]] == ["dry_sand__circle__v1", "dry_sand__circle__v2"]

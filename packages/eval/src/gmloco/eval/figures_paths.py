@@ -67,13 +67,17 @@ def recorded_path(recording: str | Path) -> RecordedPath:
 
 
 def recordings_by_cell(run_dirs: list[str | Path]) -> dict[tuple[str, str], list[Path]]:
-    """The recordings of run folders by (terrain, scenario), ordered by speed (file names that do not parse skipped)."""
-    cells: dict[tuple[str, str], list[tuple[float, Path]]] = {}
+    """One recording per speed of each (terrain, scenario) in run folders, ordered by speed.
+
+    Where several folders recorded a speed (shares of one row), the first folder's is taken; file names that do
+    not parse are skipped.
+    """
+    cells: dict[tuple[str, str], dict[float, Path]] = {}
     for d in run_dirs:
         for f in sorted((Path(d) / "recordings").glob("*.mcap")):
             if (m := _NAME.match(f.stem)) is not None:
-                cells.setdefault((m["terrain"], m["scenario"]), []).append((float(m["speed"]), f))
-    return {cell: [f for _, f in sorted(fs)] for cell, fs in cells.items()}
+                cells.setdefault((m["terrain"], m["scenario"]), {}).setdefault(float(m["speed"]), f)
+    return {cell: [by_speed[v] for v in sorted(by_speed)] for cell, by_speed in cells.items()}
 
 
 def fig_paths(panels: list[tuple[str, list[Path]]], path: str | Path, episode_s: float, title: str) -> Path:

@@ -192,8 +192,7 @@ def _path_figures(
     cells: dict[tuple[str, str], list[tuple[str, list[Path]]]] = {}
     for label, dirs in grouped.items():
         for cell, recs in recordings_by_cell(list(dirs)).items():
-            by_speed = {r.stem.rsplit("__v", 1)[-1]: r for r in reversed(recs)}
-            cells.setdefault(cell, []).append((label, [by_speed[k] for k in sorted(by_speed, key=float)]))
+            cells.setdefault(cell, []).append((label, recs))
     episode_s = float(summaries[next(iter(summaries))][0].get("cfg", {}).get("episode_s", 10.0))
     figures = []
     for (terrain, scenario), panels in cells.items():
