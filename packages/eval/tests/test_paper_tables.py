@@ -162,3 +162,26 @@ def test_folders_with_one_label_are_pooled(tmp_path: Path) -> None:
     summary = combine([("td", a), ("td", b)], tmp_path / "out", episodes=20)
     assert [(r["policy"], r["episodes"], r["success_rate_pct"]) for r in summary["rows"]] == [("td", 20, 40.0)]
     assert summary["runs"]["td"]["dirs"] == [str(a), str(b)] and summary["partial_rows"] == []
+
+
+def test_a_runs_file_lists_labels_and_globs(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    """LABEL=DIR lines with comments; a glob pools a row's shares; a line matching nothing is named."""
+    from gmloco.eval.paper_tables import runs_file
+
+    shares = [_run(tmp_path, f"row_share{i}of2", i + 1, 2) for i in range(2)]
+    for d in shares:  # both shares scored one policy
+        doc = json.loads((d / "summary.json").read_text())
+        (d / "summary.json").write_text(json.dumps(doc | {"policy": "artifacts/td/policy.onnx"}))
+    other = _run(tmp_path, "rigid", 0, 4)
+    f = tmp_path / "runs.txt"
+    f.write_text(f"# the td row in two shares\ntd={tmp_path}/row_share*of2\n\nrigid={other}  # baseline\n")
+    assert runs_file(f) == [("td", shares[0]), ("td", shares[1]), ("rigid", other)]
+    summary = main(["--runs-file", str(f), "--out", str(tmp_path / "out"), "--episodes", "4"])
+    assert [(r["policy"], r["episodes"]) for r in summary["rows"]] == [("td", 4), ("rigid", 4)]
+    f.write_text(f"td={tmp_path}/nothing_here*\n")
+    with pytest.raises(SystemExit):
+        main(["--runs-file", str(f), "--out", str(tmp_path / "out")])
+    assert "runs.txt:1" in capsys.readouterr().err
+    with pytest.raises(SystemExit):
+        main(["--out", str(tmp_path / "out")])
+    assert "--runs-file" in capsys.readouterr().err

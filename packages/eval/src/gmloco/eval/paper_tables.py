@@ -6,6 +6,7 @@ by its own ``g1_eval`` run (often over several machines: a run folder resumes fr
 tool labels each run's episodes with the policy's name and writes the combined tables:
 
     python -m gmloco.eval.paper_tables --run td=RUN_DIR --run clr50=RUN_DIR [...] --out DIR [--episodes 100]
+    python -m gmloco.eval.paper_tables --runs-file results/mpm_eval/tables/runs.txt --out DIR   # LABEL=DIR lines
 
 * ``table_terrains.{md,csv}``: one row per (policy, terrain, scenario) with the success rate and its 95 % Wilson
   interval, tracking errors, DTW path error, sinkage and swing (``gmloco.eval.tables_mpm``);
@@ -37,7 +38,7 @@ import sys
 from pathlib import Path
 from typing import Any
 
-__all__ = ["SETTING_KEYS", "WINDOW_EXIT_NOTE_PCT", "combine", "main", "setting_of"]
+__all__ = ["SETTING_KEYS", "WINDOW_EXIT_NOTE_PCT", "combine", "main", "runs_file", "setting_of"]
 
 SETTING_KEYS = ("solver", "window", "bed_depth", "episode_s", "failure", "course_slack", "circle_radius")
 """Fields of a run's ``summary.json`` ``cfg`` that define the experiment; runs in one table must agree on them."""
@@ -270,6 +271,38 @@ def _run_arg(text: str) -> tuple[str, Path]:
     return label, Path(d)
 
 
+def runs_file(path: Path) -> list[tuple[str, Path]]:
+    """The runs a file lists: one ``LABEL=RUN_DIR`` per line, ``#`` comments and blank lines skipped.
+
+    ``RUN_DIR`` may be a glob pattern (e.g. the shares of one row, ``.../table_td_basalt_share*of4``), relative to
+    the working directory; its matches are taken in sorted order.
+
+    Raises:
+        FileNotFoundError: No such file, or a line's folder or pattern matches nothing.
+        ValueError: A line is not ``LABEL=RUN_DIR``.
+    """
+    import glob
+
+    if not path.is_file():
+        raise FileNotFoundError(f"--runs-file {path}: no such file")
+    out: list[tuple[str, Path]] = []
+    for n, raw in enumerate(path.read_text().splitlines(), 1):
+        line = raw.split("#", 1)[0].strip()
+        if not line:
+            continue
+        try:
+            label, pattern = _run_arg(line)
+        except argparse.ArgumentTypeError as exc:
+            raise ValueError(f"{path}:{n}: {exc}") from None
+        matches = sorted(glob.glob(str(pattern))) if glob.has_magic(str(pattern)) else [str(pattern)]
+        if not matches or not all(Path(m).is_dir() for m in matches):
+            raise FileNotFoundError(f"{path}:{n}: {pattern} is no run folder (nothing matches); fix the line")
+        out += [(label, Path(m)) for m in matches]
+    if not out:
+        raise ValueError(f"{path}: no run in it (one LABEL=RUN_DIR per line)")
+    return out
+
+
 def main(argv: list[str] | None = None) -> dict[str, Any]:
     """Command line: combine runs into the paper's tables."""
     p = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
@@ -277,9 +310,11 @@ def main(argv: list[str] | None = None) -> dict[str, Any]:
         "--run",
         type=_run_arg,
         action="append",
-        required=True,
+        default=[],
         help="LABEL=RUN_DIR (repeat per policy; folders with the same label are pooled)",
     )
+    p.add_argument("--runs-file", type=Path, default=None,
+                   help="a file of LABEL=RUN_DIR lines (RUN_DIR may be a glob, e.g. a row's shares), after --run")  # fmt: skip
     p.add_argument("--out", type=Path, required=True, help="folder for the tables")
     p.add_argument("--episodes", type=int, default=100, help="episodes a complete row has (the paper: 100)")
     p.add_argument("--allow-mixed-settings", action="store_true", help="tabulate runs scored at different settings")
@@ -287,7 +322,10 @@ def main(argv: list[str] | None = None) -> dict[str, Any]:
                    "results/mpm_eval/summary.json)")  # fmt: skip
     a = p.parse_args(argv)
     try:
-        summary = combine(a.run, a.out, a.episodes, a.allow_mixed_settings)
+        runs = list(a.run) + (runs_file(a.runs_file) if a.runs_file is not None else [])
+        if not runs:
+            p.error("give the runs: --run LABEL=RUN_DIR (repeat) and/or --runs-file FILE")
+        summary = combine(runs, a.out, a.episodes, a.allow_mixed_settings)
     except (FileNotFoundError, ValueError) as exc:
         p.error(str(exc))
     if a.summary is not None:
