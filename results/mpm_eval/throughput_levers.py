@@ -1,0 +1,92 @@
+# SPDX-License-Identifier: Apache-2.0
+"""Every throughput lever measured for issue 9, against the 10-minute target -> ``throughput_levers.{json,png}``.
+
+Reads the sessions' committed measurements (robot-frames/s of the MPM evaluation: MPM frames per second x robots
+stepping in one solver) and marks each case by the convergence check's verdict on its physics: ``accepted`` (the
+setting the tables use, or a change that leaves the physics alone: grid reserve, lanes, solver variant) or
+``rejected`` (a cheaper setting whose walks differ). The target: 100 ten-second walking episodes (5 ms frames) in
+10 minutes = 333 robot-frames/s.
+
+    python results/mpm_eval/throughput_levers.py
+"""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+HERE = Path(__file__).resolve().parent
+TARGET_RF_S = 100 * 10.0 / 0.005 / 600.0
+
+
+def _load(rel: str) -> dict:
+    return json.loads((HERE / rel).read_text())
+
+
+def cases() -> list[dict]:
+    """(label, GPU, robot-frames/s, verdict, source) of every measured case, oldest session first."""
+    out = []
+
+    def add(label: str, gpu: str, rf: float, verdict: str, source: str) -> None:
+        out.append({"label": label, "gpu": gpu, "robot_frames_per_s": round(rf, 1), "verdict": verdict,
+                    "x_target": round(rf / TARGET_RF_S, 3), "source": source})  # fmt: skip
+
+    s12 = {
+        json.loads(line)["case"]: json.loads(line) for line in (HERE / "gpu_s12/sweep.jsonl").read_text().splitlines()
+    }
+    add("s12: 5 cm / 1000 sweeps, 1.8 x 0.6 m, 32 lanes", "H100", s12["td_v0.05_it1000_r32"]["robot_frames_per_s"], "rejected",
+        "gpu_s12/sweep.jsonl")  # fmt: skip
+    s12best = _load("gpu_s12/throughput.json")
+    add("s12: accepted setting, grid reserve 3.0x, 64 lanes", "H200", s12best["robot_frames_per_s"], "accepted",
+        "gpu_s12/throughput.json")  # fmt: skip
+    for c in _load("gpu_s13/throughput.json")["cases"]:
+        add(f"s13: {c['label']}", "H200", c["robot_frames_per_s"], "accepted", "gpu_s13/throughput.json")
+    cost = _load("gpu_s15/cost.json")["cases"]
+    for key, verdict in (("cost/r32_l1.4_w0.6_d0.3", "accepted"), ("cost/r32_l1.0_w0.5_d0.3", "rejected"),
+                         ("cost/r32_l0.8_w0.5_d0.25", "rejected"), ("cost/r64_l0.8_w0.5_d0.25", "rejected")):  # fmt: skip
+        add(f"s15: {cost[key]['label']}", "H100", cost[key]["robot_frames_per_s"], verdict, "gpu_s15/cost.json")
+    for name, c in _load("gpu_s16/throughput.json")["rows"].items():
+        if name in ("table_td_poppy_seed", "table_td_dry_sand_deep", "table_clr50_dry_sand_l1.4"):
+            add(f"s16: row {name.removeprefix('table_')}, 50 lanes (shared host)", "H100",
+                c["robot_frames_per_s_all_lanes"], "accepted", "gpu_s16/throughput.json")  # fmt: skip
+    for c in sorted(_load("gpu_s17/throughput.json")["lanes_case"].values(), key=lambda v: v["lanes"]):
+        add(f"s17: {c['lanes']} lanes, 0.3 s (side by side)", "H100", c["robot_frames_per_s_all_lanes"], "accepted",
+            "gpu_s17/throughput.json")  # fmt: skip
+    return out
+
+
+def main() -> None:
+    """Write ``throughput_levers.json`` and ``fig_throughput_levers.png`` beside this script."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    rows = cases()
+    best = max((r for r in rows if r["verdict"] == "accepted"), key=lambda r: r["robot_frames_per_s"])
+    doc = {"target_robot_frames_per_s": round(TARGET_RF_S, 1), "best_accepted": best,
+           "target_over_best_accepted": round(TARGET_RF_S / best["robot_frames_per_s"], 2), "cases": rows}  # fmt: skip
+    (HERE / "throughput_levers.json").write_text(json.dumps(doc, indent=1) + "\n")
+    fig, ax = plt.subplots(figsize=(9, 0.32 * len(rows) + 1.4), constrained_layout=True)
+    y = range(len(rows))
+    colors = ["C0" if r["verdict"] == "accepted" else "0.7" for r in rows]
+    ax.barh(list(y), [r["robot_frames_per_s"] for r in rows], color=colors)
+    for k, r in enumerate(rows):
+        ax.text(r["robot_frames_per_s"] + 3, k, f"{r['robot_frames_per_s']:.0f} ({r['gpu']})", va="center", fontsize=7)
+    ax.set_yticks(list(y), [r["label"] for r in rows], fontsize=7)
+    ax.invert_yaxis()
+    ax.axvline(TARGET_RF_S, color="C3", ls="--", label=f"target: 100 x 10 s in 10 min ({TARGET_RF_S:.0f})")
+    ax.bar(0, 0, color="C0", label="accepted by the convergence check")
+    ax.bar(0, 0, color="0.7", label="rejected (the walk changes)")
+    ax.set_xlabel("robot-frames/s on one GPU (3 cm, 500 sweeps, 5 ms, 30 cm bed, 1.4 x 0.6 m unless named)")
+    ax.set_xlim(0, TARGET_RF_S * 1.1)
+    ax.legend(fontsize=7, loc="lower right")
+    fig.savefig(HERE / "fig_throughput_levers.png", dpi=130)
+    print(
+        f"best accepted: {best['label']} {best['robot_frames_per_s']} ({best['gpu']}); "
+        f"the target is {doc['target_over_best_accepted']}x that"
+    )
+
+
+if __name__ == "__main__":
+    main()
