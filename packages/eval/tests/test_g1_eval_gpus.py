@@ -111,3 +111,19 @@ def test_shares_start_from_a_pooled_file(tmp_path: Path) -> None:
     found = launch.found  # type: ignore[attr-defined]
     assert found["basalt__straight__share0of2"] == 2 and found["basalt__straight__share1of2"] == 1
     assert found["dry_sand__straight__share0of2"] == 0
+
+
+def test_a_failed_share_is_an_error_that_keeps_the_others(tmp_path: Path) -> None:
+    """A share whose process exits 3: RuntimeError naming it and its log, the other shares' episodes pooled."""
+    cfg = replace(_cfg(tmp_path), terrains=("basalt",))
+    inner = _stand_in()
+
+    def launch(cmd: list[str], env: dict[str, str], log: Path) -> subprocess.Popen[bytes]:
+        if cmd[cmd.index("--out") + 1].endswith("share1of2"):
+            return subprocess.Popen([sys.executable, "-c", "raise SystemExit(3)"])
+        return inner(cmd, env, log)
+
+    with pytest.raises(RuntimeError, match=r"1 of 2 shares failed: basalt__straight__share1of2 exited with 3 \(log"):
+        run_on_gpus(cfg, ["0", "1"], launch=launch, poll_s=0.01)
+    rows = (Path(cfg.out_dir) / "episodes.jsonl").read_text().splitlines()
+    assert len(rows) == 3  # share 0's episodes 0, 2, 4

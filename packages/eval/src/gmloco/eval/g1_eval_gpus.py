@@ -15,7 +15,6 @@ recordings, logs and resume state; rerunning resumes each) beside the queue's ``
 from __future__ import annotations
 
 import json
-import sys
 from dataclasses import asdict
 from pathlib import Path
 from typing import Any
@@ -80,6 +79,7 @@ def run_on_gpus(
 
     Raises:
         ValueError: No GPU, a GPU named twice, a sharded config, or a setting the command line cannot pass.
+        RuntimeError: A share's process failed (after the pooled outputs of the others are written).
     """
     if cfg.shards != 1:
         raise ValueError(f"cfg.shards = {cfg.shards}: run_on_gpus shards the cells itself; pass an unsharded config")
@@ -99,8 +99,7 @@ def run_on_gpus(
         rows += share_rows
         complete &= share_done
         added += share_added
-        if result.returncode not in (0, None):
-            print(f"eval on GPUs: {task.name} exited with {result.returncode}; see {result.log}", file=sys.stderr)
+    failed = [r for r in results if r.returncode not in (0, None)]
     rows.sort(key=lambda r: (r["terrain"], r["scenario"], int(str(r["key"]).rsplit("/", 1)[-1])))
     tmp = out / "episodes.jsonl.tmp"
     tmp.write_text("".join(json.dumps(r) + "\n" for r in rows))
@@ -110,4 +109,8 @@ def run_on_gpus(
     summary["throughput/gpus"] = float(len(gpus))
     write_outputs(out, cfg, rows, summary, complete, run_dirs=[cells / t.name for t in tasks])
     report_window(rows, cfg.window)
+    if failed:  # after the pooled outputs: what the other shares finished is kept
+        logs = "; ".join(f"{r.name} exited with {r.returncode} (log {r.log})" for r in failed)
+        raise RuntimeError(f"{len(failed)} of {len(results)} shares failed: {logs}. Fix the cause and rerun: "
+                           "finished episodes are kept and each share resumes")  # fmt: skip
     return summary, complete
