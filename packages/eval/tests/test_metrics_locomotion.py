@@ -148,3 +148,15 @@ def test_swing_clearance_alive_cut_and_no_swing() -> None:
     assert still.swings == 0 and math.isnan(still.apex) and math.isnan(still.lift)
     with pytest.raises(ValueError, match=r"\[T, F\]"):
         swing_clearance(h, load)
+
+
+def test_course_progress_counts_along_the_course() -> None:
+    """A straight 10 m course at 1 m/s: finished at 8 s (20 % slack), also 3 m off to the side; standing: never."""
+    from gmloco.eval.metrics.locomotion import circular_path, course_finished_at
+
+    dt = 0.02
+    cmd, _ = circular_path(1.0, 0.0, 10.0, dt)
+    walk = cmd[1:]  # the base one sample ahead of t = 0
+    assert course_finished_at(walk, cmd, dt, 0.2) == pytest.approx(8.0, abs=dt)
+    assert course_finished_at(walk + np.array([0.0, 3.0]), cmd, dt, 0.2) == pytest.approx(8.0, abs=dt)
+    assert course_finished_at(np.zeros((500, 2)), cmd, dt, 0.2) is None

@@ -27,19 +27,14 @@ RADIUS_M = 2.0
 COURSE_SLACK = 0.2
 
 
-def _finished_at(xy: np.ndarray, cmd_xy: np.ndarray, dt: float) -> float | None:
-    """Time the base passed 1 - COURSE_SLACK of the commanded path (nearest sample, searched forwards) [s]."""
-    idx, window = 0, max(1, round(0.5 / dt))
-    for t, p in enumerate(xy):
-        idx += int(np.argmin(np.linalg.norm(cmd_xy[idx : idx + window] - p, axis=1)))
-        if idx >= (1.0 - COURSE_SLACK) * (len(cmd_xy) - 1):
-            return (t + 1) * dt
-    return None
-
-
 def main() -> None:
     """Walk the student under the circle commands, score each env's circle."""
-    from gmloco.eval.metrics.locomotion import circular_path, metric_path_error, quat_wxyz_to_roll_pitch_yaw
+    from gmloco.eval.metrics.locomotion import (
+        circular_path,
+        course_finished_at,
+        metric_path_error,
+        quat_wxyz_to_roll_pitch_yaw,
+    )
     from gmloco.train.evaluation_ts import TsEvalCfg, pinned_walk
 
     p = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
@@ -58,7 +53,7 @@ def main() -> None:
     for w, (m, v) in enumerate(cells):
         n = int(live[:, w].sum())
         cmd_xy, _ = circular_path(v, v / RADIUS_M, a.duration, dt, start_xy=tuple(xy[0, w]), start_yaw=yaw[0, w])
-        fin = _finished_at(xy[:n, w], cmd_xy, dt)
+        fin = course_finished_at(xy[:n, w], cmd_xy, dt, COURSE_SLACK)
         rows.append({"material": m, "speed": v, "alive_s": n * dt, "finished_at_s": fin,
                      "success": bool(n == len(xy) and fin is not None) or (fin is not None and fin <= n * dt),
                      "path_error_m": metric_path_error(xy[:n, w], cmd_xy) if n else float("nan"),

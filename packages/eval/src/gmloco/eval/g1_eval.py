@@ -48,6 +48,7 @@ from gmloco.eval.g1_eval_policy import load_policy
 from gmloco.eval.metrics.locomotion import (
     FailureCfg,
     circular_path,
+    course_finished_at,
     episode_outcome,
     metric_path_error,
     metric_velocity_tracking_error,
@@ -407,14 +408,7 @@ def score_episode(spec: EpisodeSpec, cfg: G1EvalCfg, log: dict[str, Any]) -> dic
     rpy = quat_wxyz_to_roll_pitch_yaw(quat_wxyz)
     v, _, wz = command(spec, cfg)
     cmd_xy, _ = circular_path(v, wz, cfg.episode_s, dt, start_xy=tuple(log["start_xy"]))
-    # progress: nearest commanded sample, searched forwards from the last one (circles revisit points)
-    finished_at, idx, window = None, 0, max(1, round(0.5 / dt))
-    for t, p in enumerate(q[:, :2]):
-        seg = cmd_xy[idx : idx + window]
-        idx += int(np.argmin(np.linalg.norm(seg - p, axis=1)))
-        if idx >= (1.0 - cfg.course_slack) * (len(cmd_xy) - 1):
-            finished_at = (t + 1) * dt
-            break
+    finished_at = course_finished_at(q[:, :2], cmd_xy, dt, cfg.course_slack)
     height = np.asarray(log.get("base_height", q[:, 2]))
     out = episode_outcome(height, rpy[:, 0], rpy[:, 1], dt, finished_at, cfg.failure)
     alive = max(out.alive_steps, 1)

@@ -24,6 +24,7 @@ __all__ = [
     "FailureCfg",
     "SwingClearance",
     "circular_path",
+    "course_finished_at",
     "dtw_distance",
     "episode_outcome",
     "failure_step",
@@ -215,6 +216,26 @@ def circular_path(
         dy = -r * (np.cos(yaw) - math.cos(start_yaw))
     xy = np.stack([start_xy[0] + dx, start_xy[1] + dy], axis=-1)
     return xy, yaw
+
+
+def course_finished_at(xy: np.ndarray, commanded_xy: np.ndarray, dt: float, slack: float) -> float | None:
+    """When the base passed ``1 - slack`` of the commanded path [s] (None: never).
+
+    Progress is the commanded sample nearest the base, searched forwards from the last one within 0.5 s of
+    samples (a circle revisits points), so a walk that bent away from the course still progresses along it.
+
+    Args:
+        xy: Executed base path [T, 2] [m], one sample per ``dt``.
+        commanded_xy: Commanded path (``circular_path``) [N, 2] [m].
+        dt: Sample period [s].
+        slack: Fraction of the commanded path that may be left and still count as finished [-].
+    """
+    idx, window = 0, max(1, round(0.5 / dt))
+    for t, p in enumerate(np.asarray(xy)):
+        idx += int(np.argmin(np.linalg.norm(commanded_xy[idx : idx + window] - p, axis=1)))
+        if idx >= (1.0 - slack) * (len(commanded_xy) - 1):
+            return (t + 1) * dt
+    return None
 
 
 @dataclass(frozen=True)
