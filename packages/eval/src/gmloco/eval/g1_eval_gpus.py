@@ -15,11 +15,11 @@ recordings, logs and resume state; rerunning resumes each) beside the queue's ``
 from __future__ import annotations
 
 import json
-from dataclasses import asdict
+from dataclasses import asdict, replace
 from pathlib import Path
 from typing import Any
 
-from gmloco.eval.g1_eval import G1EvalCfg, read_episodes, report_window, summarize, write_outputs
+from gmloco.eval.g1_eval import G1EvalCfg, episode_specs, read_episodes, report_window, summarize, write_outputs
 from gmloco.eval.g1_eval_cli import cli_args
 from gmloco.eval.g1_eval_queue import Launch, QueueTask, TaskResult, cell_tasks, row_spans, run_queue
 
@@ -39,29 +39,25 @@ def _share_state(folder: Path, result: TaskResult) -> tuple[list[dict[str, Any]]
     return rows, bool(doc.get("complete")), float(doc.get("metrics", {}).get("throughput/episodes_this_call", 0.0))
 
 
-def _arg(argv: tuple[str, ...], flag: str, default: str) -> str:
-    """The value after ``flag`` in a task's arguments (``default`` when absent)."""
-    return argv[argv.index(flag) + 1] if flag in argv else default
-
-
-def _seed_shares(out: Path, tasks: list[QueueTask]) -> None:
+def _seed_shares(out: Path, cfg: G1EvalCfg, tasks: list[QueueTask]) -> None:
     """Give each share folder without episodes its share of the run's pooled ``episodes.jsonl``, if there is one.
 
-    So a run resumes whatever wrote that file last: a one-process run, or shares of another GPU count.
+    So a run resumes whatever wrote that file last: a one-process run, or shares of another GPU count. ``tasks``
+    are ``cell_tasks``' for ``cfg``: cell after cell, the shares of a cell in order.
     """
     pooled = out / "episodes.jsonl"
     if not pooled.exists():
         return
     rows = read_episodes(pooled, repair=True)
-    for t in tasks:
-        folder = out / CELLS_DIR / t.name
+    n = len(tasks) // (len(cfg.terrains) * len(cfg.scenarios))
+    shares = [replace(cfg, terrains=(t,), scenarios=(sc,), shard=i, shards=n)
+              for t in cfg.terrains for sc in cfg.scenarios for i in range(n)]  # fmt: skip
+    for task, share in zip(tasks, shares, strict=True):
+        folder = out / CELLS_DIR / task.name
         if (folder / "episodes.jsonl").exists():
             continue
-        terrain, scenario = _arg(t.argv, "--terrains", ""), _arg(t.argv, "--scenarios", "")
-        share, shares = (int(x) for x in _arg(t.argv, "--shard", "0/1").split("/"))
-        mine = [r for r in rows if (r["terrain"], r["scenario"]) == (terrain, scenario)
-                and int(str(r["key"]).rsplit("/", 1)[-1]) % shares == share]  # fmt: skip
-        if mine:
+        keys = {spec.key for spec in episode_specs(share)}
+        if mine := [r for r in rows if r["key"] in keys]:
             folder.mkdir(parents=True, exist_ok=True)
             (folder / "episodes.jsonl").write_text("".join(json.dumps(r) + "\n" for r in mine))
 
@@ -87,7 +83,7 @@ def run_on_gpus(
     cells = out / CELLS_DIR
     tasks = cell_tasks(list(cfg.terrains), list(cfg.scenarios), cli_args(cfg, cells=False), shards=len(gpus))
     if cfg.resume:
-        _seed_shares(out, tasks)
+        _seed_shares(out, cfg, tasks)
     extra: dict[str, Any] = {} if launch is None else {"launch": launch}
     results = run_queue(tasks, gpus, cells, cfg.max_minutes, poll_s=poll_s, **extra)
     (cells / "queue.json").write_text(json.dumps({"gpus": gpus, "max_minutes": cfg.max_minutes,
