@@ -2,7 +2,7 @@
 """Fill a Warp kernel cache for the GPU machine from a CPU-only machine (no driver needed: NVRTC is in the wheel).
 
 A fresh GPU machine spends ~4.5 minutes compiling the MPM evaluation's kernels before its first frame. This runs one
-tiny evaluation episode on the CPU (so every Warp module the evaluation uses is built and its kernel overloads
+tiny evaluation episode on the CPU in the CUDA layout (one mujoco_warp world per robot; so every Warp module the evaluation uses is built and its kernel overloads
 exist), then compiles each module that was loaded for CUDA ahead of time, at the launch block size
 (``Module.options['block_dim']``, which CUDA loads use; CPU loads use 1) as CUBIN (or PTX) for the given
 architectures, into ``--cache``. Carry the folder to the GPU machine (``tar czf``) and point ``WARP_CACHE_PATH`` at
@@ -61,6 +61,16 @@ def main(argv: list[str] | None = None) -> None:
 
     wp.config.kernel_cache_dir = os.path.abspath(a.cache)
     from gmloco.eval import g1_eval_cli
+    from gmloco.eval.mpm import g1_scene
+
+    build = g1_scene.G1MpmScene._build_robots
+
+    def as_worlds(self, newton, wp_):  # the CUDA layout (one mujoco_warp world per robot), so its kernels load too
+        if self.cfg.robots_as_worlds is None:
+            object.__setattr__(self.cfg, "robots_as_worlds", True)
+        return build(self, newton, wp_)
+
+    g1_scene.G1MpmScene._build_robots = as_worlds
 
     t0 = time.time()
     with tempfile.TemporaryDirectory() as out:
