@@ -19,6 +19,7 @@ import os
 import sys
 import tempfile
 import time
+from typing import Any
 
 
 def _compile_loaded(arches: list[int], formats: list[str]) -> tuple[int, int]:
@@ -39,7 +40,7 @@ def _compile_loaded(arches: list[int], formats: list[str]) -> tuple[int, int]:
                 try:
                     module._compile(None, module_dir, output_arch=arch, use_ptx=fmt == "ptx",
                                     options=module.resolved_options[block_dim])  # fmt: skip
-                except Exception as e:  # noqa: BLE001 - a module that fails here simply compiles on the GPU
+                except Exception as e:  # a module that fails here simply compiles on the GPU
                     failed += 1
                     print(f"  {module.name} sm{arch} {fmt}: {type(e).__name__}: {e}"[:300], flush=True)
         done += 1
@@ -48,12 +49,18 @@ def _compile_loaded(arches: list[int], formats: list[str]) -> tuple[int, int]:
 
 
 def main(argv: list[str] | None = None) -> None:
+    """Run the tiny CPU episode, then compile the modules it loaded for the GPU (see the module docstring)."""
     p = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     p.add_argument("--cache", required=True, help="kernel cache folder to fill (WARP_CACHE_PATH there)")
     p.add_argument("--arch", type=int, nargs="+", default=[90], help="CUDA architectures (H100 / H200: 90)")
-    p.add_argument("--formats", nargs="+", default=["cubin"], choices=["ptx", "cubin"],
-                   help="Warp loads CUBIN where the driver is older than its toolkit (the lent machines: driver 13.0, "
-                   "Warp 1.19's toolkit 13.4), PTX otherwise")
+    p.add_argument(
+        "--formats",
+        nargs="+",
+        default=["cubin"],
+        choices=["ptx", "cubin"],
+        help="Warp loads CUBIN where the driver is older than its toolkit (the lent machines: driver 13.0, "
+        "Warp 1.19's toolkit 13.4), PTX otherwise",
+    )
     p.add_argument("eval_args", nargs="*", help="g1_eval_cli arguments of the tiny CPU episode (after --)")
     a = p.parse_args(argv)
     os.environ["WARP_CACHE_PATH"] = os.path.abspath(a.cache)
@@ -65,7 +72,8 @@ def main(argv: list[str] | None = None) -> None:
 
     build = g1_scene.G1MpmScene._build_robots
 
-    def as_worlds(self, newton, wp_):  # the CUDA layout (one mujoco_warp world per robot), so its kernels load too
+    def as_worlds(self: Any, newton: Any, wp_: Any) -> Any:
+        # the CUDA layout (one mujoco_warp world per robot), so that mujoco_warp's kernels load too
         if self.cfg.robots_as_worlds is None:
             object.__setattr__(self.cfg, "robots_as_worlds", True)
         return build(self, newton, wp_)

@@ -12,30 +12,13 @@ host; the rows' rates are indicative (four processes shared the host).
 from __future__ import annotations
 
 import json
-import statistics
 from pathlib import Path
 
+from gmloco.eval.g1_eval import read_episodes
+from gmloco.eval.run_rates import TARGET_ROBOT_FRAMES_PER_S as TARGET_RF_S
+from gmloco.eval.run_rates import run_rate
+
 HERE = Path(__file__).resolve().parent
-TARGET_RF_S = 100 * 10.0 / 0.005 / 600.0
-"""Robot-frames/s for 100 ten-second walking episodes (5 ms frames) in 10 minutes."""
-
-
-def _episodes(folder: Path) -> list[dict]:
-    """The episode lines of one run folder (empty when it finished none)."""
-    path = folder / "episodes.jsonl"
-    if not path.exists():
-        return []
-    return [json.loads(line) for line in path.read_text().splitlines() if line.strip()]
-
-
-def _rate(eps: list[dict]) -> dict:
-    """Median solver rate, particles, lanes and build time of one run's episodes."""
-    fps = statistics.median(e["frames_per_s"] for e in eps)
-    lanes = eps[0]["batch_size"]
-    rf = fps * lanes
-    return {"episodes": len(eps), "particles": eps[0]["particles"], "lanes": lanes,
-            "solver_frames_per_s_median": round(fps, 3), "robot_frames_per_s_all_lanes": round(rf, 1),
-            "min_per_100_walking_episodes": round(200_000 / rf / 60, 1), "build_s": round(eps[0]["build_s"], 1)}  # fmt: skip
 
 
 def main() -> None:
@@ -49,11 +32,11 @@ def main() -> None:
     out = {"device": manifest["device"], "code": manifest["code"], "target_robot_frames_per_s": round(TARGET_RF_S, 1),
            "lanes_case": {}, "rows": {}}  # fmt: skip
     for folder in sorted((HERE / "runs").iterdir()):
-        eps = _episodes(folder)
+        eps = read_episodes(folder / "episodes.jsonl") if (folder / "episodes.jsonl").exists() else []
         if not eps:
             continue
         key = "lanes_case" if folder.name.startswith("cost_r") else "rows"
-        out[key][folder.name] = _rate(eps)
+        out[key][folder.name] = run_rate(eps)
         print(folder.name, out[key][folder.name])
     (HERE / "throughput.json").write_text(json.dumps(out, indent=1) + "\n")
     cases = sorted(out["lanes_case"].values(), key=lambda v: v["lanes"])

@@ -1,0 +1,78 @@
+# SPDX-License-Identifier: Apache-2.0
+"""A session folder's costs read back from its episodes and queue.json (issue 9)."""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import pytest
+
+from gmloco.eval.run_rates import TARGET_ROBOT_FRAMES_PER_S, main, run_rate, session_rates
+
+
+def _episode(k: int, fps: float, alive: float, success: bool) -> dict:
+    return {"key": f"dry_sand/straight/{k}", "success": success, "alive_s": alive, "frames_per_s": fps,
+            "batch_size": 25, "particles": 1_880_000, "build_s": 30.0 + k}  # fmt: skip
+
+
+def _session(tmp_path: Path) -> Path:
+    """Two shares of one row (GPU 0 and 1) and a lone task; the row took 9.5 min."""
+    for name, fps, alive in (("row_share0of2", [4.0, 4.2, 4.4], [10.0, 10.0, 3.0]), ("row_share1of2", [4.4], [2.0]),
+                             ("lone", [2.0, 2.0], [1.0, 1.5])):  # fmt: skip
+        run = tmp_path / "runs" / name
+        run.mkdir(parents=True)
+        eps = [_episode(k, f, a, a >= 10.0) for k, (f, a) in enumerate(zip(fps, alive, strict=True))]
+        (run / "episodes.jsonl").write_text("".join(json.dumps(e) + "\n" for e in eps))
+    (tmp_path / "runs" / "empty").mkdir()  # a task that finished no episode
+    (tmp_path / "logs").mkdir()
+    queue = {"tasks": [{"name": "row_share0of2", "minutes": 9.5}, {"name": "row_share1of2", "minutes": 4.0},
+                       {"name": "lone", "minutes": 2.0}],
+             "rows": {"row": {"shares": 2, "gpus": ["0", "1"], "wall_minutes": 9.5, "returncodes": [0, 0]}}}  # fmt: skip
+    (tmp_path / "logs" / "queue.json").write_text(json.dumps(queue))
+    (tmp_path / "manifest.json").write_text(json.dumps({"device": "4 x H200", "code": "abc1234"}))
+    return tmp_path
+
+
+def test_run_rate_is_the_median_solver_rate_times_lanes() -> None:
+    """Median of 4.0 / 4.2 / 4.4 frames/s with 25 lanes = 105 robot-frames/s; 200,000 robot-frames take 31.7 min."""
+    r = run_rate([_episode(k, f, 10.0, True) for k, f in enumerate([4.4, 4.0, 4.2])])
+    assert r["solver_frames_per_s_median"] == 4.2 and r["robot_frames_per_s_all_lanes"] == 105.0
+    assert r["min_per_100_walking_episodes"] == round(200_000 / 105.0 / 60, 1)
+    assert r["episodes"] == 3 and r["lanes"] == 25 and r["build_s"] == 30.0
+    assert round(TARGET_ROBOT_FRAMES_PER_S, 1) == 333.3
+
+
+def test_run_rate_refuses_empty_and_old_records() -> None:
+    """No episodes, or records without the batch's rate fields: an error naming what is missing."""
+    with pytest.raises(ValueError, match="no episodes"):
+        run_rate([])
+    with pytest.raises(ValueError, match="frames_per_s"):
+        run_rate([{"key": "a", "success": True}])
+
+
+def test_session_rates_reads_runs_and_rows(tmp_path: Path) -> None:
+    """Each run's rate and task minutes; the row pools its shares' episodes under queue.json's wall-clock."""
+    out = session_rates(_session(tmp_path))
+    assert set(out["runs"]) == {"row_share0of2", "row_share1of2", "lone"}  # the empty task has no rate
+    assert out["runs"]["lone"]["task_minutes"] == 2.0 and out["device"] == "4 x H200"
+    row = out["rows"]["row"]
+    assert row["wall_minutes"] == 9.5 and row["episodes"] == 4 and row["successes"] == 2
+    assert row["longest_alive_s"] == 10.0 and row["build_s_max"] == 30.0
+
+
+def test_session_rates_without_queue_and_bad_folder(tmp_path: Path) -> None:
+    """Without queue.json the runs still get rates (no rows); a folder without runs/ is refused."""
+    root = _session(tmp_path)
+    (root / "logs" / "queue.json").unlink()
+    out = session_rates(root)
+    assert out["rows"] == {} and out["runs"]["lone"]["task_minutes"] is None
+    with pytest.raises(FileNotFoundError, match="no runs/ folder"):
+        session_rates(tmp_path / "runs" / "lone")
+
+
+def test_main_writes_throughput_json(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    """The command line writes FOLDER/throughput.json and prints each row's wall-clock."""
+    main([str(_session(tmp_path))])
+    assert json.loads((tmp_path / "throughput.json").read_text())["rows"]["row"]["shares"] == 2
+    assert "row row: 9.5 min on GPUs 0 1" in capsys.readouterr().out
