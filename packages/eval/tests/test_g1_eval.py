@@ -229,6 +229,7 @@ class _LaneScene:
         self.mpm = SimpleNamespace(check_sparse_grid_rebuild_status=lambda: None)
         self.lane_episode, self.lane_step = list(range(n)), [0] * n
         self.resets: list[tuple[list[int], list[int], int]] = []
+        self.retired: list[tuple[list[int], int]] = []
         self.base_q: list[np.ndarray] = []
         for name in LOG_FIELDS[1:]:  # the scene's per-robot logs (base_q typed above: run_cell reads it)
             setattr(self, name, [])
@@ -251,6 +252,9 @@ class _LaneScene:
             for name in LOG_FIELDS:
                 getattr(self, name).append(sample.get(name, np.zeros((self.n, 1))))
         self.frame += 1
+
+    def retire_robots(self, robots: list[int]) -> None:
+        self.retired.append((list(robots), len(self.base_q)))
 
     def reset_robots(self, robots: list[int], commands: list, seeds: list[int]) -> None:
         if robots:
@@ -290,9 +294,18 @@ def test_a_fallen_lane_takes_the_next_episode(monkeypatch: pytest.MonkeyPatch) -
     assert [len(lg["base_q"]) for lg in logs] == [4, 10, 10, 10, 10]
     scene = _LaneScene.made[0]
     assert scene.resets == [([0], [3], 4), ([1], [4], 10), ([0], [5], 14)]
+    assert scene.retired == [([1], 20)]  # lane 1 has no episode left while lane 0 walks episode 4 to row 24
     rows = [score_episode(lg["spec"], cfg, lg) for lg in logs]
     assert (rows[0]["reason"], rows[0]["alive_s"]) == ("base_height", 3 * 0.02)
     assert [r["reason"] for r in rows[1:]] == ["timeout"] * 4  # standing still at a 1 m/s command
+
+
+def test_idle_lanes_keep_their_sand_when_asked(monkeypatch: pytest.MonkeyPatch) -> None:
+    """retire_idle_lanes=False: the same episodes, no lane retired (the cost of sessions before 19)."""
+    cfg, specs = _cell(monkeypatch, {0: 3}, retire_idle_lanes=False)
+    logs: list[dict] = []
+    assert run_cell(specs, cfg, _Policy(), logs.append)
+    assert [lg["spec"].index for lg in logs] == [0, 1, 2, 3, 4] and _LaneScene.made[0].retired == []
 
 
 def test_minutes_left_counts_waves_of_lanes() -> None:

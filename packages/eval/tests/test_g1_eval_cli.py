@@ -121,7 +121,7 @@ def test_cli_args_give_back_the_config() -> None:
                   scenarios=("straight", "circle"), speeds=(1.25, 2.0), num_episodes=7, episode_s=5.0,
                   circle_radius=1.5, course_slack=0.1, bed_depth=0.25,
                   window=SandWindowCfg(moving=False, length=1.1, width=0.7, lead=-0.05, particles_per_voxel=1),
-                  robots_per_batch=9, refill=False, cell_capacity_factor=1.25,
+                  robots_per_batch=9, refill=False, retire_idle_lanes=False, cell_capacity_factor=1.25,
                   solver=replace(base.solver, voxel_size=0.04, max_iterations=321, tolerance=1e-6, frame_dt=0.01,
                                  rigid_substeps=2, rheology_solver="jacobi,gs"),
                   record_mcap=False, resume=False, seed=3)  # fmt: skip

@@ -288,6 +288,33 @@ def test_reset_robot_restarts_its_lane_on_fresh_sand() -> None:
     np.testing.assert_allclose(z[5:], z[:5], atol=0.25 * scene.window.h)  # policy steps 0-4 again after the reset
 
 
+def test_a_retired_robot_loses_its_sand_and_the_other_walks_on_unchanged() -> None:
+    """Two standing robots; after 6 frames robot 1 is retired: no sand force on it, robot 0 as without the retire.
+
+    Its lane's sand leaves the MPM solve (``retire_robots``), so the sand pushes on its soles no more (hundreds of
+    newtons before, ~1e-3 N after); robot 0 moves as in a run where robot 1 kept its sand (lanes share no grid
+    cell), to 1e-5 m over 6 more frames.
+    """
+    if not POLICY.exists():
+        pytest.skip(f"no exported policy at {POLICY}")
+    spec = MjlabOnnxPolicy(POLICY).spec
+    cfg = G1MpmSceneCfg(window=SandWindowCfg(moving=True, length=0.9, width=0.6, lead=0.0), num_robots=2,
+                        solver=MpmSolverCfg(voxel_size=0.05, frame_dt=0.01, rigid_substeps=2))  # fmt: skip
+    pelvis, wrench = [], []
+    for retire in (False, True):
+        scene = G1MpmScene(cfg, spec)
+        scene.run(6)
+        if retire:
+            scene.retire_robots([1])
+        scene.run(6)
+        pelvis.append(scene.state_0.body_q.numpy()[:: scene.bodies_per_robot].copy())
+        wrench.append(scene.sand_wrench.numpy().reshape(2, scene.bodies_per_robot, 6).copy())
+    np.testing.assert_allclose(pelvis[1][0], pelvis[0][0], atol=1e-5)
+    assert np.abs(wrench[0][1]).max() > 1.0  # kept: the sand carries robot 1
+    assert np.abs(wrench[1][1]).max() < 1e-2  # retired: no sand force on robot 1 (1e-3 N of collider round-off)
+    np.testing.assert_allclose(wrench[1][0], wrench[0][0], rtol=1e-3, atol=1e-3)
+
+
 def test_policy_reset_of_one_robot_back_fills_its_history_only() -> None:
     """After ``reset([1])`` robot 1's history holds its next frame in every slot; robot 0's keeps shifting."""
     if not POLICY.exists():

@@ -134,3 +134,49 @@ def test_terrain_cfgs(name: str) -> None:
     if name == "transition":
         assert t.materials == ("basalt", "dry_sand", "poppy_seed")
         np.testing.assert_array_equal(terrain_layer(t, np.array([0.0, 4.5, 7.5, 30.0])), [0, 1, 2, 2])
+
+
+def _settle(win: SandWindow, state: Any, solver: Any, frames: int) -> None:
+    """``frames`` MPM steps of 10 ms under gravity, walls applied after each (as the scene's frame does)."""
+    for _ in range(frames):
+        solver.step(state, state, None, None, 0.01)
+        win.apply_walls()
+
+
+def test_a_retired_lane_leaves_the_solve_and_the_others_do_not_notice() -> None:
+    """Lane 1 retired (sand out of the solve), lane 0 settles exactly as with lane 1 in; a reseed brings it back.
+
+    Retiring clears the ACTIVE flag of exactly lane 1's particles in the sand model and in the solver's transfer and
+    material masks, and zeroes their material volume; its grains then stay where they are, while lane 0's sand
+    (2 m away, no shared grid cell) moves as in a run where lane 1 stayed in. A reseed puts lane 1 back.
+    """
+    import newton
+
+    lane_y = np.array([0.0, 2.0])
+    runs = []
+    for retire in (False, True):
+        win, model, state, solver = _window(terrain_cfg("dry_sand"), lane_y)
+        q0 = state.particle_q.numpy().copy()
+        if retire:
+            win.set_lanes_active([1], False)
+        _settle(win, state, solver, 3)
+        runs.append((win, model, state, solver, q0, state.particle_q.numpy().copy()))
+    per, active = runs[0][0].particles_per_robot, int(newton.ParticleFlags.ACTIVE)
+    (_, _, _, _, q0_in, q_in), (win, model, state, solver, q0, q_out) = runs
+    assert np.abs(q_in[per:] - q0_in[per:]).max() > 1e-4  # with lane 1 in, its sand moves in 30 ms
+    np.testing.assert_array_equal(q_out[per:], q0[per:])  # retired: its grains stay where they were
+    np.testing.assert_allclose(q_out[:per], q_in[:per], atol=1e-6)  # lane 0 unaffected
+    mm = solver._mpm_model
+    for arr in (model.particle_flags, mm.particle_flags, mm.material_particle_flags):
+        f = arr.numpy()
+        assert np.all(f[:per] & active) and not np.any(f[per:] & active)
+    assert not mm.material_particle_volume.numpy()[per:].any() and win.retired == {1}
+    import warp as wp
+
+    win.reseed_lanes([1], [5], wp.array(_pelvis(np.zeros(2), lane_y, 2), dtype=wp.transform, device="cpu"))
+    assert win.retired == set() and np.all(mm.particle_flags.numpy() & active)
+    cached = mm.material_particle_volume.numpy().copy()
+    mm.notify_particle_material_changed()
+    np.testing.assert_allclose(cached, mm.material_particle_volume.numpy(), rtol=1e-5)
+    with pytest.raises(ValueError, match="outside"):
+        win.set_lanes_active([2], False)

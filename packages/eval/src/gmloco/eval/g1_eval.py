@@ -129,6 +129,10 @@ class G1EvalCfg:
     refill: bool = True
     """Start a lane's next episode as soon as its robot falls or its episode ends (one solver per cell, episodes
     of any length share it); False: one solver per batch of ``robots_per_batch`` episodes, lanes idle after."""
+    retire_idle_lanes: bool = True
+    """Take a lane's sand out of the MPM solve once its robot has no episode left (``G1MpmScene.retire_robots``):
+    the cell's tail, while its last robots walk, costs only their sand. False: idle lanes keep their sand in the
+    solve (sessions before 19)."""
     lane_gap: float = 2.0
     """Free space between neighbouring lanes' windows or paths [m] (robots may drift)."""
     cell_capacity_factor: float = 1.5
@@ -303,8 +307,9 @@ def run_cell(
     ``min(robots_per_batch, len(specs))`` robots start together, one per lane. A lane's episode ends when its
     robot falls (``lane_failed``, checked at every policy step) or after ``episode_s``; its log (policy rate, up
     to and including the failing sample) goes to ``on_episode`` at once. With ``cfg.refill`` the lane then starts
-    the next episode of ``specs`` (``G1MpmScene.reset_robots``: start pose, fresh sand); else it stays idle. The
-    cell ends when every lane is idle. At ``deadline`` (``time.perf_counter`` s) the episodes still running are
+    the next episode of ``specs`` (``G1MpmScene.reset_robots``: start pose, fresh sand); else it stays idle, and
+    with ``cfg.retire_idle_lanes`` its sand leaves the solve (``G1MpmScene.retire_robots``). The cell ends when
+    every lane is idle. At ``deadline`` (``time.perf_counter`` s) the episodes still running are
     dropped, those finished before are already out. A progress line goes to stderr about every 30 s.
     """
     import sys
@@ -323,7 +328,7 @@ def run_cell(
     while True:
         if scene.frame % k == 0 and scene.base_q:
             rows = len(scene.base_q)
-            resets, checked = [], False
+            resets, retired, checked = [], [], False
             for r in range(n):
                 if not active[r]:
                     continue
@@ -341,8 +346,11 @@ def run_cell(
                     resets.append(r)
                 else:
                     active[r] = False
+                    retired.append(r)
             scene.reset_robots(resets, [command(lane_spec[r], cfg) for r in resets],
                                [lane_spec[r].index + 1 for r in resets])  # fmt: skip
+            if retired and cfg.retire_idle_lanes and any(active):
+                scene.retire_robots(retired)
             if not any(active):
                 break
             now = time.perf_counter()

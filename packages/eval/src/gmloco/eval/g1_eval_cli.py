@@ -69,6 +69,11 @@ def _parse(argv: list[str] | None) -> argparse.Namespace:
     p.add_argument(
         "--no-refill", action="store_true", help="one solver per batch of robots, lanes idle after their episode"
     )
+    p.add_argument(
+        "--keep-idle-lanes",
+        action="store_true",
+        help="keep a lane's sand in the MPM solve after its robot's last episode (the cost before session 19)",
+    )
     p.add_argument("--static-bed", action="store_true", help="naive baseline: a bed covering the course")
     p.add_argument("--window-length", type=float, default=_WINDOW.length)
     p.add_argument("--window-width", type=float, default=_WINDOW.width)
@@ -132,6 +137,7 @@ def cfg_from_args(a: argparse.Namespace) -> G1EvalCfg:
         ),
         robots_per_batch=a.robots_per_batch,
         refill=not a.no_refill,
+        retire_idle_lanes=not a.keep_idle_lanes,
         cell_capacity_factor=a.cell_capacity_factor,
         solver=replace(
             base.solver,
@@ -188,8 +194,8 @@ def cli_args(cfg: G1EvalCfg, cells: bool = True) -> list[str]:
             "--window-width", repr(w.width), "--window-lead", repr(w.lead),
             "--particles-per-voxel", str(w.particles_per_voxel),
             "--cell-capacity-factor", repr(cfg.cell_capacity_factor), "--seed", str(cfg.seed)]  # fmt: skip
-    flags = {"--no-refill": not cfg.refill, "--static-bed": not w.moving, "--no-mcap": not cfg.record_mcap,
-             "--fresh": not cfg.resume}  # fmt: skip
+    flags = {"--no-refill": not cfg.refill, "--keep-idle-lanes": not cfg.retire_idle_lanes,
+             "--static-bed": not w.moving, "--no-mcap": not cfg.record_mcap, "--fresh": not cfg.resume}  # fmt: skip
     return out + [f for f, on in flags.items() if on]
 
 

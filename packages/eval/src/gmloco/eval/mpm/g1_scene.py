@@ -513,6 +513,14 @@ class G1MpmScene:
             self.policy.reset(robots)
         self.window.reseed_lanes(list(robots), list(seeds), self.state_0.body_q)
 
+    def retire_robots(self, robots: list[int]) -> None:
+        """Take the sand of ``robots``' lanes out of the MPM solve: lanes with no episode left stop costing.
+
+        Their robots lose their support and keep stepping unscored; the other lanes are untouched (their sand never
+        shares a grid cell with a retired lane's). :meth:`reset_robots` brings a lane back. Between frames only.
+        """
+        self.window.set_lanes_active(list(robots), False)
+
     # -- stepping -------------------------------------------------------------------------------------------
 
     def simulate(self) -> None:

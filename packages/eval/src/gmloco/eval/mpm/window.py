@@ -127,6 +127,9 @@ class SandWindow:
         self._model_arrays = (sand_model.particle_mass, sand_model.particle_radius, m.friction,
                               mm.particle_volume, mm.particle_density, mm.material_particle_volume)  # fmt: skip
         self._sand_state = sand_state
+        self._flag_arrays = (sand_model.particle_flags, mm.particle_flags, mm.material_particle_flags)
+        self._volumes = (mm.particle_volume, mm.material_particle_volume)
+        self.retired: set[int] = set()
 
     def advance(self, body_q: Any) -> None:
         """Recentre moving windows on the robots and recycle the columns they left (graph-capturable)."""
@@ -137,12 +140,42 @@ class SandWindow:
         eval_window_origin(self.arrays, True, body_q, self.origin)
         eval_window_recycle(self.arrays, self.origin, self.column, self._state_arrays, self._model_arrays)
 
+    def set_lanes_active(self, lanes: list[int], active: bool) -> None:
+        """Take the sand of ``lanes`` out of the MPM solve (``active=False``) or put it back (``True``).
+
+        An inactive particle is neither transferred to the grid nor advected, and the rebuildable sparse grid
+        allocates no cell for it: a lane whose robot has no episode left stops costing its share of the transfers
+        and of the rheology solve's active cells (its robot loses its support; its frames are no longer scored).
+        The other lanes' sand never shares a cell with it (lanes are ``lane_gap`` apart). The flags (sand model,
+        solver's transfer and material masks) and the solver's material volumes are written in place, so a captured
+        CUDA graph reads the new values. Needs :meth:`bind`; runs outside a captured frame (host copies).
+        """
+        import newton
+
+        if not hasattr(self, "_flag_arrays"):
+            raise RuntimeError("set_lanes_active needs bind() first (the MPM solver's particle arrays)")
+        bad = [r for r in lanes if not 0 <= r < self.num_robots]
+        if bad:
+            raise ValueError(f"set_lanes_active: lanes {bad} outside 0..{self.num_robots - 1}")
+        if not lanes:
+            return
+        flag, per = int(newton.ParticleFlags.ACTIVE), self.particles_per_robot
+        rows = np.concatenate([np.arange(r * per, (r + 1) * per) for r in lanes])
+        for arr in self._flag_arrays:
+            f = arr.numpy()
+            f[rows] = (f[rows] | flag) if active else (f[rows] & ~flag)
+            arr.assign(f)
+        volume, material_volume = (a.numpy() for a in self._volumes)
+        material_volume[rows] = volume[rows] if active else 0.0
+        self._volumes[1].assign(material_volume)
+        self.retired = self.retired - set(lanes) if active else self.retired | set(lanes)
+
     def reseed_lanes(self, lanes: list[int], seeds: list[int], body_q: Any) -> None:
         """Fill the windows of ``lanes`` with fresh, stress-free sand (a new episode there); other lanes keep theirs.
 
         Moving windows are recentred on the robots' poses ``body_q`` (as every frame does); static beds keep their
-        place. ``seeds`` are jitter seed offsets, so a refilled lane gets new grains. Needs :meth:`bind`; runs
-        outside a captured frame (host copies).
+        place. ``seeds`` are jitter seed offsets, so a refilled lane gets new grains; a retired lane
+        (:meth:`set_lanes_active`) rejoins the solve. Needs :meth:`bind`; runs outside a captured frame (host copies).
         """
         import warp as wp
 
@@ -159,6 +192,7 @@ class SandWindow:
             column[r * self.particles_per_robot : (r + 1) * self.particles_per_robot] = _UNSEEDED
         self.arrays.lane_seed.assign(lane_seed)
         self.column.assign(wp.array(column, dtype=wp.vec2i, device=self.column.device))
+        self.set_lanes_active(sorted(self.retired & set(lanes)), True)
         eval_window_origin(self.arrays, self.cfg.moving, body_q, self.origin)
         eval_window_recycle(self.arrays, self.origin, self.column, self._state_arrays, self._model_arrays)
 
