@@ -2,50 +2,78 @@
 """Fill a Warp kernel cache for the GPU machine from a CPU-only machine (no driver needed: NVRTC is in the wheel).
 
 A fresh GPU machine spends ~4.5 minutes compiling the MPM evaluation's kernels before its first frame. This runs one
-tiny evaluation episode on the CPU in the CUDA layout (one mujoco_warp world per robot; so every Warp module the evaluation uses is built and its kernel overloads
-exist), then compiles each module that was loaded for CUDA ahead of time, at the launch block size
-(``Module.options['block_dim']``, which CUDA loads use; CPU loads use 1) as CUBIN (or PTX) for the given
-architectures, into ``--cache``. Carry the folder to the GPU machine (``tar czf``) and point ``WARP_CACHE_PATH`` at
-it: modules whose hash matches load as ``(cached)``; any the CPU run did not touch (CUDA-only code paths, kernels
-launched with their own block size) still compile there as before, so a partial cache is never wrong.
+tiny evaluation episode on the CPU in the CUDA layout (one mujoco_warp world per robot), so that every Warp module
+the evaluation uses is built and its kernel overloads exist, then compiles each module that was loaded ahead of
+time for CUDA into ``--cache``: at the module's launch block size (``Module.options['block_dim']``, which CUDA loads
+use; CPU loads use 1), as CUBIN (or PTX), for the given architectures. Kernels launched with a block size of their
+own (mujoco_warp's tile kernels) hash differently; ``--gpu-logs`` names the logs of an earlier GPU run, and every
+module variant they show compiled there is compiled here too when some block size reproduces its hash. Carry the
+folder to the GPU machine (``tar czf``) and point ``WARP_CACHE_PATH`` at it: modules whose hash matches load as
+``(cached)``; any the CPU run did not reproduce still compile there as before, so a partial cache is never wrong.
 
-    python scripts/gpu/warm_cache.py --cache .devcache/warp -- --terrains dry_sand --speeds 1.0
+    python scripts/gpu/warm_cache.py --cache .devcache/warp --gpu-logs results/mpm_eval/gpu_s18/logs/*.log \
+        -- --terrains dry_sand --speeds 1.0
 """
 
 from __future__ import annotations
 
 import argparse
 import os
+import re
 import sys
 import tempfile
 import time
+from pathlib import Path
 from typing import Any
 
+_COMPILED = re.compile(r"Module (\S+) ([0-9a-f]{7}) load on device 'cuda:\d+' took [\d.]+ ms\s+\(compiled\)")
+BLOCK_DIMS = (16, 32, 64, 128, 256, 512, 1024)
+"""Block sizes tried for a module a GPU log names (tile kernels are launched with their own)."""
 
-def _compile_loaded(arches: list[int], formats: list[str]) -> tuple[int, int]:
-    """AOT-compile every module with a loaded executable; returns (modules, failures)."""
+
+def wanted_from_logs(paths: list[str]) -> dict[str, set[str]]:
+    """The modules a GPU run had to compile, by name, with their 7-digit hashes (its logs' ``(compiled)`` lines)."""
+    out: dict[str, set[str]] = {}
+    for path in paths:
+        for m in _COMPILED.finditer(Path(path).read_text(errors="replace")):
+            out.setdefault(m[1], set()).add(m[2])
+    return out
+
+
+def _block_dims(module: Any, wanted: dict[str, set[str]]) -> list[int]:
+    """The module's default block size, plus those at which it hashes as a GPU log's compiled variant did."""
+    dims = [module.options["block_dim"]]
+    for bd in BLOCK_DIMS:
+        if bd not in dims and module.get_module_hash(bd).hex()[:7] in wanted.get(module.name, ()):
+            dims.append(bd)
+    return dims
+
+
+def _compile_loaded(arches: list[int], formats: list[str], wanted: dict[str, set[str]]) -> tuple[int, int, set]:
+    """AOT-compile every module with a loaded executable; returns (variants, failures, GPU-log hashes matched)."""
     import warp as wp
     from warp._src import context as ctx
 
     done = failed = 0
+    matched: set[tuple[str, str]] = set()
     for module in list(ctx.user_modules.values()):
         if not module.execs:
             continue
-        block_dim = module.options["block_dim"]
-        module.resolved_options[block_dim] = module.resolve_options(wp.config, block_dim=block_dim)
-        module.get_module_hash(block_dim)
-        module_dir = os.path.join(wp.config.kernel_cache_dir, module.get_module_identifier(block_dim))
-        for arch in arches:
-            for fmt in formats:
-                try:
-                    module._compile(None, module_dir, output_arch=arch, use_ptx=fmt == "ptx",
-                                    options=module.resolved_options[block_dim])  # fmt: skip
-                except Exception as e:  # a module that fails here simply compiles on the GPU
-                    failed += 1
-                    print(f"  {module.name} sm{arch} {fmt}: {type(e).__name__}: {e}"[:300], flush=True)
-        done += 1
-        print(f"[warm_cache] {done} modules ({module.name})", flush=True)
-    return done, failed
+        for block_dim in _block_dims(module, wanted):
+            digest = module.get_module_hash(block_dim).hex()[:7]
+            matched |= {(module.name, digest)} & {(module.name, h) for h in wanted.get(module.name, ())}
+            module_dir = os.path.join(wp.config.kernel_cache_dir, module.get_module_identifier(block_dim))
+            for arch in arches:
+                for fmt in formats:
+                    try:
+                        module._compile(None, module_dir, output_arch=arch, use_ptx=fmt == "ptx",
+                                        options=module.resolved_options[block_dim])  # fmt: skip
+                    except Exception as e:  # a module that fails here simply compiles on the GPU
+                        failed += 1
+                        print(f"  {module.name} sm{arch} {fmt}: {type(e).__name__}: {e}"[:300], flush=True)
+            done += 1
+            print(f"[warm_cache] {done} module variants ({module.name}, block {block_dim})", flush=True)
+    return done, failed, matched
 
 
 def main(argv: list[str] | None = None) -> None:
@@ -61,6 +89,8 @@ def main(argv: list[str] | None = None) -> None:
         help="Warp loads CUBIN where the driver is older than its toolkit (the lent machines: driver 13.0, "
         "Warp 1.19's toolkit 13.4), PTX otherwise",
     )
+    p.add_argument("--gpu-logs", nargs="*", default=[], help="logs of an earlier GPU run: also compile the block-size "
+                   "variants of the modules it had to compile (their '(compiled)' lines)")  # fmt: skip
     p.add_argument("eval_args", nargs="*", help="g1_eval_cli arguments of the tiny CPU episode (after --)")
     a = p.parse_args(argv)
     os.environ["WARP_CACHE_PATH"] = os.path.abspath(a.cache)
@@ -86,8 +116,15 @@ def main(argv: list[str] | None = None) -> None:
                 "--robots-per-batch", "2", "--no-mcap", "--fresh"]  # fmt: skip
         g1_eval_cli.main(tiny + a.eval_args)
     print(f"[warm_cache] CPU episode done in {time.time() - t0:.0f} s; compiling for sm{a.arch} {a.formats}")
-    done, failed = _compile_loaded(a.arch, a.formats)
-    print(f"[warm_cache] {done} modules compiled into {a.cache} ({failed} failures) in {time.time() - t0:.0f} s")
+    wanted = wanted_from_logs(a.gpu_logs)
+    done, failed, matched = _compile_loaded(a.arch, a.formats, wanted)
+    print(
+        f"[warm_cache] {done} module variants compiled into {a.cache} ({failed} failures) in {time.time() - t0:.0f} s"
+    )
+    if wanted:
+        missed = sorted(f"{n} {h}" for n, hs in wanted.items() for h in hs if (n, h) not in matched)
+        print(f"[warm_cache] of the GPU logs' {sum(map(len, wanted.values()))} compiled variants, {len(matched)} are "
+              f"in the cache now; not reproduced on the CPU: {', '.join(missed) or 'none'}")  # fmt: skip
     sys.exit(0)
 
 
