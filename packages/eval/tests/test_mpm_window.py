@@ -24,8 +24,13 @@ def _pelvis(x: np.ndarray, lane_y: np.ndarray, bodies: int) -> np.ndarray:
     return q
 
 
-def _window(terrain: TerrainCfg, lane_y: np.ndarray, bodies: int = 2) -> tuple[SandWindow, Any, Any, Any]:
-    """A 2-robot window (0.5 x 0.3 m, 5 cm columns), seeded at x = 0, with its sand model, state and solver."""
+def _window(
+    terrain: TerrainCfg, lane_y: np.ndarray, bodies: int = 2, capacity: int = -1
+) -> tuple[SandWindow, Any, Any, Any]:
+    """A 2-robot window (0.5 x 0.3 m, 5 cm columns), seeded at x = 0, with its sand model, state and solver.
+
+    ``capacity`` > 0: the evaluation's rebuildable sparse grid of that many cells (else one allocated per step).
+    """
     import newton
     import warp as wp
 
@@ -37,7 +42,8 @@ def _window(terrain: TerrainCfg, lane_y: np.ndarray, bodies: int = 2) -> tuple[S
     win.allocate(wp, model.device)
     body_q = wp.array(_pelvis(np.zeros(len(lane_y)), lane_y, bodies), dtype=wp.transform, device="cpu")
     win.seed_model(wp, model, body_q)
-    solver = make_mpm_solver(newton, model, MpmSolverCfg(voxel_size=VOXEL), win.materials[0])
+    solver = make_mpm_solver(newton, model, MpmSolverCfg(voxel_size=VOXEL, max_active_cell_count=capacity),
+                             win.materials[0])  # fmt: skip
     state = model.state()
     win.bind(model, state, solver)
     return win, model, state, solver
@@ -146,21 +152,24 @@ def _settle(win: SandWindow, state: Any, solver: Any, frames: int) -> None:
 def test_a_retired_lane_leaves_the_solve_and_the_others_do_not_notice() -> None:
     """Lane 1 retired (sand out of the solve), lane 0 settles exactly as with lane 1 in; a reseed brings it back.
 
-    Retiring clears the ACTIVE flag of exactly lane 1's particles in the sand model and in the solver's transfer and
+    On the evaluation's rebuildable grid (fixed capacity) the retired lane's cells leave the grid. Retiring clears the ACTIVE flag of exactly lane 1's particles in the sand model and in the solver's transfer and
     material masks, and zeroes their material volume; its grains then stay where they are, while lane 0's sand
     (2 m away, no shared grid cell) moves as in a run where lane 1 stayed in. A reseed puts lane 1 back.
     """
     import newton
 
     lane_y = np.array([0.0, 2.0])
-    runs = []
+    runs, cells = [], []
     for retire in (False, True):
-        win, model, state, solver = _window(terrain_cfg("dry_sand"), lane_y)
+        win, model, state, solver = _window(terrain_cfg("dry_sand"), lane_y, capacity=200)
         q0 = state.particle_q.numpy().copy()
         if retire:
             win.set_lanes_active([1], False)
         _settle(win, state, solver, 3)
         runs.append((win, model, state, solver, q0, state.particle_q.numpy().copy()))
+        # the grid's active cells (warp.fem's partition of the reserved capacity; -1 = unused slot)
+        cells.append(int((solver._scratchpad.domain.geometry_partition._partition_cells.numpy() >= 0).sum()))
+    assert cells[1] < 0.6 * cells[0]  # the retired lane's cells left the grid (60 -> 30 after one frame)
     per, active = runs[0][0].particles_per_robot, int(newton.ParticleFlags.ACTIVE)
     (_, _, _, _, q0_in, q_in), (win, model, state, solver, q0, q_out) = runs
     assert np.abs(q_in[per:] - q0_in[per:]).max() > 1e-4  # with lane 1 in, its sand moves in 30 ms
