@@ -66,6 +66,7 @@ def eval_cfg(cfg: DictConfig) -> G1EvalCfg:
             lead=float(s.window_lead),
         ),
         robots_per_batch=int(s.robots_per_batch),
+        retire_idle_lanes=bool(s.retire_idle_lanes),
         cell_capacity_factor=float(s.cell_capacity_factor),
         record_mcap=bool(s.record_mcap),
         solver=replace(

@@ -12,7 +12,7 @@ import eval_mpm
 
 
 def test_section_settings_reach_the_eval_cfg(compose: Callable[..., DictConfig]) -> None:
-    """Window (size and lead), bed, lanes and numerics set in the section are the ones the evaluation runs with."""
+    """Window (size and lead), bed, lanes (and retiring them) and numerics set in the section reach the evaluation."""
     cfg = compose(
         "+exp=gm_loco",
         "+scale=full",
@@ -22,10 +22,12 @@ def test_section_settings_reach_the_eval_cfg(compose: Callable[..., DictConfig])
         "eval_mpm.bed_depth=0.25",
         "eval_mpm.robots_per_batch=50",
         "eval_mpm.max_iterations=400",
+        "eval_mpm.retire_idle_lanes=false",
     )
     out = eval_mpm.eval_cfg(cfg)
     assert (out.window.length, out.window.width, out.window.lead, out.window.moving) == (0.8, 0.5, -0.1, True)
     assert (out.bed_depth, out.robots_per_batch, out.solver.max_iterations) == (0.25, 50, 400)
+    assert out.retire_idle_lanes is False
     assert out.policy_path.endswith("policy.onnx")
 
 
@@ -37,6 +39,7 @@ def test_default_section_matches_the_eval_defaults(compose: Callable[..., DictCo
     base = G1EvalCfg()
     assert out.window == base.window
     assert (out.bed_depth, out.cell_capacity_factor) == (base.bed_depth, base.cell_capacity_factor)
+    assert out.retire_idle_lanes == base.retire_idle_lanes
     assert out.solver == base.solver
 
 
