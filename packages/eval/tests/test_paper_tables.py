@@ -67,6 +67,26 @@ def test_runs_at_different_settings_are_refused_by_name(tmp_path: Path) -> None:
         assert md.read_text().endswith("- `y`: solver.max_iterations (500 vs 250)\n"), md.name
 
 
+def test_a_rows_shares_at_one_other_setting_are_named_once(tmp_path: Path) -> None:
+    """Three shares of one label all at a wider window: one note line under the label.
+
+    A label with one differing folder among two names that folder.
+    """
+
+    def share(name: str, policy: str, **setting: object) -> Path:
+        d = _run(tmp_path, name, 1, 2, **setting)
+        sm = json.loads((d / "summary.json").read_text()) | {"policy": policy}
+        (d / "summary.json").write_text(json.dumps(sm))
+        return d
+
+    wide = {"window": {"length": 1.4, "width": 1.3}}
+    runs = [("x", share("a", "x"))] + [("y", share(f"y{i}", "y", **wide)) for i in range(3)]
+    odd = share("z1", "z", **wide)
+    runs += [("z", share("z0", "z")), ("z", odd)]
+    mixed = combine(runs, tmp_path / "out", 2, allow_mixed=True)["mixed_settings"]
+    assert mixed == {"y": ["window.width (None vs 1.3)"], f"z ({odd})": ["window.width (None vs 1.3)"]}
+
+
 def test_seeds_and_time_boxes_may_differ(tmp_path: Path) -> None:
     """Fields outside the setting (seed, max_minutes) do not split a table."""
     summary = combine([("x", _run(tmp_path, "a", 1, 2)), ("y", _run(tmp_path, "bb", 2, 2))], tmp_path / "o", 2)

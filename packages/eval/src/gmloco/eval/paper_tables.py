@@ -110,11 +110,7 @@ def combine(
                              "policy its own label")  # fmt: skip
     first = labels[0]
     base = setting_of(summaries[first][0])
-    mixed = {}
-    for label, ds in grouped.items():
-        for i, (d, sm) in enumerate(zip(ds, summaries[label], strict=True)):
-            if diff := _differences(base, setting_of(sm)):
-                mixed[label if i == 0 else f"{label} ({d})"] = diff
+    mixed = _mixed_settings(base, grouped, summaries)
     if mixed and not allow_mixed:
         lines = "; ".join(f"{label}: {', '.join(diff)}" for label, diff in mixed.items())
         raise ValueError(f"runs were scored at different MPM settings than {first!r} ({lines}); rerun them at one "
@@ -204,6 +200,26 @@ def _path_figures(
             print(f"fig_paths_{terrain}_{scenario}.png skipped: a recording could not be read "
                   f"({type(exc).__name__}: {exc})", file=sys.stderr)  # fmt: skip
     return figures
+
+
+def _mixed_settings(
+    base: dict[str, Any], grouped: dict[str, list[Path]], summaries: dict[str, list[dict[str, Any]]]
+) -> dict[str, list[str]]:
+    """Each label's setting differences from ``base``, one entry per distinct difference.
+
+    The entry is keyed by the label when every folder of it differs so (a row's shares), else by the label and the
+    folders that do.
+    """
+    mixed: dict[str, list[str]] = {}
+    for label, ds in grouped.items():
+        by_diff: dict[tuple[str, ...], list[Path]] = {}
+        for d, sm in zip(ds, summaries[label], strict=True):
+            if diff := _differences(base, setting_of(sm)):
+                by_diff.setdefault(tuple(diff), []).append(d)
+        for diff, dirs in by_diff.items():
+            more = f" and {len(dirs) - 1} more folders" if len(dirs) > 1 else ""
+            mixed[label if len(dirs) == len(ds) else f"{label} ({dirs[0]}{more})"] = list(diff)
+    return mixed
 
 
 def _mixed_note(first: str, mixed: dict[str, list[str]]) -> str:
