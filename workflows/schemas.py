@@ -312,7 +312,7 @@ class EvalMpmCfg(StageCfg):
     """Robots sharing one MPM solver (one lane each)."""
     retire_idle_lanes: bool = True
     """Take a lane's sand out of the MPM solve once its robot has no episode left (a cell's tail then carries only
-    the sand of the robots still walking); False keeps it in (the cost before session 18)."""
+    the sand of the robots still walking); False keeps it in (the runs up to session 18)."""
     cell_capacity_factor: float = 1.5
     """Grid capacity = factor x particles / particles-per-cell (fixed capacity: CUDA graph); 0 = unbounded.
     The rheology solver sweeps the whole capacity, so its cost grows with the factor: 1.5 gave 1.46x the

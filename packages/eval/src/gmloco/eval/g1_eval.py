@@ -132,7 +132,7 @@ class G1EvalCfg:
     retire_idle_lanes: bool = True
     """Take a lane's sand out of the MPM solve once its robot has no episode left (``G1MpmScene.retire_robots``):
     the cell's tail, while its last robots walk, costs only their sand. False: idle lanes keep their sand in the
-    solve (sessions before 19)."""
+    solve (the runs up to session 18)."""
     lane_gap: float = 2.0
     """Free space between neighbouring lanes' windows or paths [m] (robots may drift)."""
     cell_capacity_factor: float = 1.5
