@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # Pack the committed tree (HEAD) for the GPU machine: .devsrc/src.tar (git-ignored via .git/info/exclude).
 # The device copies the *working tree*, including other people's uncommitted edits; a job run from this snapshot
-# runs exactly the commit it names. There: carry [".devsrc"] and
+# runs exactly the commit it names. There: carry [".devsrc"] and run scripts/gpu/launch_job.sh, or by hand
 #   rm -rf ~/src && mkdir -p ~/src && tar -xf .devsrc/src.tar -C ~/src && cp -r artifacts ~/src/ && cd ~/src
 #   source scripts/gpu/env.sh && <job>
 set -euo pipefail

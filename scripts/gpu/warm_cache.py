@@ -61,7 +61,8 @@ def _compile_loaded(arches: list[int], formats: list[str], wanted: dict[str, set
             continue
         for block_dim in _block_dims(module, wanted):
             digest = module.get_module_hash(block_dim).hex()[:7]
-            matched |= {(module.name, digest)} & {(module.name, h) for h in wanted.get(module.name, ())}
+            if digest in wanted.get(module.name, ()):
+                matched.add((module.name, digest))
             module_dir = os.path.join(wp.config.kernel_cache_dir, module.get_module_identifier(block_dim))
             for arch in arches:
                 for fmt in formats:

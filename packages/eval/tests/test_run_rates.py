@@ -76,3 +76,14 @@ def test_main_writes_throughput_json(tmp_path: Path, capsys: pytest.CaptureFixtu
     main([str(_session(tmp_path))])
     assert json.loads((tmp_path / "throughput.json").read_text())["rows"]["row"]["shares"] == 2
     assert "row row: 9.5 min on GPUs 0 1" in capsys.readouterr().out
+
+
+def test_rows_split_by_the_queue_shares_flag_are_found_too(tmp_path: Path) -> None:
+    """``--shards`` names a cell's shares ``CELL__shareIofN``: their episodes pool under the row as task files' do."""
+    root = _session(tmp_path)
+    for name in ("row_share0of2", "row_share1of2"):
+        (root / "runs" / name).rename(root / "runs" / name.replace("row_", "dry_sand__straight__"))
+    queue = json.loads((root / "logs" / "queue.json").read_text())
+    queue["rows"] = {"dry_sand__straight": queue["rows"]["row"]}
+    (root / "logs" / "queue.json").write_text(json.dumps(queue))
+    assert session_rates(root)["rows"]["dry_sand__straight"]["episodes"] == 4

@@ -53,6 +53,7 @@ __all__ = [
     "main",
     "row_spans",
     "run_queue",
+    "share_row",
 ]
 
 MIN_TASK_MINUTES = 1.0
@@ -223,6 +224,12 @@ def run_queue(
 
 _SHARE = re.compile(r"^(?P<row>.+?)_{1,2}share(?P<i>\d+)of(?P<n>\d+)$")
 """A share's task name: ``ROW_shareIofN`` (task files) or ``CELL__shareIofN`` (``--shards``)."""
+
+
+def share_row(name: str) -> str | None:
+    """The row a share's task (or run folder) name belongs to: ``ROW`` of ``ROW_shareIofN`` / ``CELL__shareIofN``."""
+    m = _SHARE.match(name)
+    return None if m is None else m["row"]
 
 
 def row_spans(results: list[TaskResult]) -> dict[str, dict[str, Any]]:

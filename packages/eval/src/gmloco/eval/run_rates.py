@@ -25,6 +25,7 @@ from pathlib import Path
 from typing import Any
 
 from gmloco.eval.g1_eval import read_episodes
+from gmloco.eval.g1_eval_queue import share_row
 
 ROW_ROBOT_FRAMES = 100 * 10.0 / 0.005
 """Robot-frames of a row of 100 ten-second walking episodes at 5 ms frames."""
@@ -79,7 +80,7 @@ def session_rates(folder: str | Path) -> dict[str, Any]:
         runs[run.name] = run_rate(eps) | {"task_minutes": minutes.get(run.name)}
     rows = {}
     for name, row in queue.get("rows", {}).items():
-        shares = [eps for run, eps in episodes.items() if run.startswith(f"{name}_share")]
+        shares = [eps for run, eps in episodes.items() if share_row(run) == name]
         pooled = [e for eps in shares for e in eps]
         rows[name] = {"shares": row["shares"], "gpus": row["gpus"], "wall_minutes": row["wall_minutes"],
                       "episodes": len(pooled), "successes": sum(bool(e["success"]) for e in pooled),
