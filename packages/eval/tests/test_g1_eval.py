@@ -298,6 +298,9 @@ def test_a_fallen_lane_takes_the_next_episode(monkeypatch: pytest.MonkeyPatch) -
     rows = [score_episode(lg["spec"], cfg, lg) for lg in logs]
     assert (rows[0]["reason"], rows[0]["alive_s"]) == ("base_height", 3 * 0.02)
     assert [r["reason"] for r in rows[1:]] == ["timeout"] * 4  # standing still at a 1 m/s command
+    elapsed = [r["elapsed_s"] for r in rows]  # the wall clock since the first frame, in the order the ends came
+    assert all(e >= 0.0 for e in elapsed) and elapsed == sorted(elapsed)
+    assert [r["end_frame"] for r in rows] == [16, 40, 56, 80, 96]  # the scene's frame at each end (4 per step)
 
 
 def test_idle_lanes_keep_their_sand_when_asked(monkeypatch: pytest.MonkeyPatch) -> None:

@@ -8,7 +8,7 @@ from pathlib import Path
 
 import pytest
 
-from gmloco.eval.run_rates import TARGET_ROBOT_FRAMES_PER_S, main, run_rate, session_rates
+from gmloco.eval.run_rates import TARGET_ROBOT_FRAMES_PER_S, main, run_rate, running_rates, session_rates
 
 
 def _episode(k: int, fps: float, alive: float, success: bool) -> dict:
@@ -87,3 +87,43 @@ def test_rows_split_by_the_queue_shares_flag_are_found_too(tmp_path: Path) -> No
     queue["rows"] = {"dry_sand__straight": queue["rows"]["row"]}
     (root / "logs" / "queue.json").write_text(json.dumps(queue))
     assert session_rates(root)["rows"]["dry_sand__straight"]["episodes"] == 4
+
+
+def _rounded(out: dict[int, tuple[float, float]]) -> dict[int, tuple[float, float]]:
+    return {n: (round(f, 6), round(t, 6)) for n, (f, t) in out.items()}
+
+
+def _ends(ends: list[tuple[float, float]], build_s: float = 30.0, lanes: int | None = None) -> list[dict]:
+    """A scene's episode records from (wall s, frame) at each end: the scene's clock and mean rate then."""
+    n = lanes if lanes is not None else len(ends)
+    return [{"key": f"k{i}", "sim_s": t, "frames_per_s": f / t, "batch_size": n, "build_s": build_s}
+            for i, (t, f) in enumerate(ends)]  # fmt: skip
+
+
+def test_running_rates_splits_a_batch_by_robots_walking() -> None:
+    """Three lanes ending at 10 / 20 / 40 s (frames 40 / 60 / 80): 40 frames in 10 s with 3 walking, then 2, then 1."""
+    out = running_rates(_ends([(20.0, 60.0), (10.0, 40.0), (40.0, 80.0)]))  # any line order
+    assert _rounded(out) == {3: (40.0, 10.0), 2: (20.0, 10.0), 1: (20.0, 20.0)}
+    assert list(out) == [3, 2, 1]
+
+
+def test_running_rates_merges_short_stretches_by_frame_weight() -> None:
+    """Ends 2 s apart merge with the next stretch: 4 frames with 2 walking + 36 with 1 is labelled 1 (44/40)."""
+    out = running_rates(_ends([(10.0, 40.0), (12.0, 44.0), (40.0, 80.0)]), min_s=10.0)
+    assert _rounded(out) == {3: (40.0, 10.0), 1: (40.0, 30.0)}
+
+
+def test_running_rates_leaves_out_cut_batches() -> None:
+    """A scene with fewer records than lanes (cut by a time box) is not rated; the next scene (another build) is."""
+    cut = _ends([(10.0, 40.0), (20.0, 60.0)], build_s=30.0, lanes=3)
+    whole = _ends([(5.0, 50.0), (15.0, 70.0)], build_s=31.0)
+    assert _rounded(running_rates(cut + whole, min_s=1.0)) == {2: (50.0, 5.0), 1: (20.0, 10.0)}
+    assert running_rates([{"key": "a", "batch_size": 1, "build_s": 1.0, "frames_per_s": 2.0}]) == {}
+
+
+def test_running_rates_prefers_the_elapsed_clock() -> None:
+    """Records with ``elapsed_s`` / ``end_frame`` (session 19 on) are timed by them, not by the in-step ``sim_s``."""
+    eps = _ends([(10.0, 40.0), (20.0, 60.0)])
+    for e, (elapsed, frame) in zip(eps, [(12.0, 40), (24.0, 60)], strict=True):
+        e |= {"elapsed_s": elapsed, "end_frame": frame}
+    assert _rounded(running_rates(eps)) == {2: (40.0, 12.0), 1: (20.0, 12.0)}

@@ -324,7 +324,7 @@ def run_cell(
     k = scene.frames_per_policy
     steps = round(cfg.episode_s / (scene.frame_dt * k))
     start, active, done = [0] * n, [True] * n, 0
-    last = time.perf_counter()
+    last = t_steps = time.perf_counter()
     while True:
         if scene.frame % k == 0 and scene.base_q:
             rows = len(scene.base_q)
@@ -339,7 +339,8 @@ def run_cell(
                 if not checked:  # an episode is kept only if the grid held all its cells (one device sync)
                     check_grid_capacity(scene, solver)
                     checked = True
-                on_episode(_lane_log(scene, r, start[r], rows, lane_spec[r], terrain, build_s, n))
+                log = _lane_log(scene, r, start[r], rows, lane_spec[r], terrain, build_s, n)
+                on_episode(log | {"elapsed_s": time.perf_counter() - t_steps})
                 done += 1
                 if queue:
                     lane_spec[r], start[r] = queue.pop(0), rows
@@ -454,6 +455,10 @@ def score_episode(spec: EpisodeSpec, cfg: G1EvalCfg, log: dict[str, Any]) -> dic
         "floor_reached": bool(len(sink) and np.max(sink) >= log.get("depth", math.inf) - 0.005),
         "particles": log["particles"], "batch_size": log.get("batch_size", 1), "build_s": log["build_s"],
         "sim_s": log["sim_s"], "frames_per_s": log["frames"] / max(log["sim_s"], 1e-9),
+        # the scene's frame at the episode's end and the wall seconds since its first frame, host work included
+        # (``sim_s`` counts the time inside ``G1MpmScene.step`` only: frames in flight while episodes are scored
+        # go uncounted, so rates from it read high where many episodes end)
+        "end_frame": log["frames"], "elapsed_s": log.get("elapsed_s"),
     }  # fmt: skip
 
 

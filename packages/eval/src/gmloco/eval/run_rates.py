@@ -11,7 +11,10 @@ leave it (``runs/<task>/episodes.jsonl``, ``logs/queue.json``) into one ``throug
   minutes on its GPU;
 * per row split into shares: the shares' GPUs, the row's wall-clock from the first share's start to the last
   one's end, its episodes and successes, and the longest time alive (a row's wall-clock follows its longest walk:
-  fallen lanes take the next episode, but a batch ends with its last robot).
+  fallen lanes take the next episode, but a batch ends with its last robot);
+* per run, the solver rate by robots still walking (``by_running``): between two successive episode ends of one
+  scene the lanes step together with a known number of robots left, so the records give the rate of a frame with
+  25, 24, ... 1 robots, with or without idle lanes retired (``retire_idle_lanes`` from the run's ``summary.json``).
 
     python -m gmloco.eval.run_rates results/mpm_eval/gpu_s18 [--out results/mpm_eval/gpu_s18/throughput.json]
 """
@@ -52,6 +55,68 @@ def run_rate(episodes: list[dict[str, Any]]) -> dict[str, Any]:
             "min_per_100_walking_episodes": round(ROW_ROBOT_FRAMES / rf / 60, 1), "build_s": round(episodes[0]["build_s"], 1)}  # fmt: skip
 
 
+MIN_PIECE_S = 10.0
+"""Shortest stretch of wall time ``running_rates`` rates on its own [s]: the scene's clock is read when a policy
+step syncs the GPU, so a frame's time can land up to three frames late (~1 s at 3 cm)."""
+
+
+def running_rates(episodes: list[dict[str, Any]], min_s: float = MIN_PIECE_S) -> dict[int, tuple[float, float]]:
+    """MPM frames and wall seconds a run's scenes stepped with n robots walking: ``{n: (frames, seconds)}``.
+
+    An episode record carries its scene's frame at its end (``end_frame``; before session 19
+    ``sim_s * frames_per_s``) and the wall seconds since the scene's first frame (``elapsed_s``, host work
+    included; before session 19 only ``sim_s``, the time inside the scene's step, which misses the frames in flight
+    while ended episodes are scored: up to three frames per end, so stretches with many ends read fast).
+    Records of one scene are consecutive lines with one ``build_s``. Only scenes that recorded exactly
+    ``batch_size`` episodes count: one batch, every lane's episode recorded, so after the k-th end (by ``sim_s``)
+    ``batch_size - k`` robots were walking. A scene cut by a time box (its running episodes dropped unrecorded) or
+    resumed with fewer episodes than lanes is left out, as is a scene whose lanes took queued episodes.
+    Successive ends closer than ``min_s`` of wall time are merged into one stretch, labelled with its
+    frame-weighted mean count of robots walking (rounded); a last stretch shorter than that is dropped.
+    """
+    scenes: list[list[dict[str, Any]]] = []
+    for e in episodes:
+        if scenes and scenes[-1][0].get("build_s") == e.get("build_s"):
+            scenes[-1].append(e)
+        else:
+            scenes.append([e])
+    out: dict[int, tuple[float, float]] = {}
+    for scene in scenes:
+        lanes = scene[0].get("batch_size")
+        if lanes is None or len(scene) != lanes or "sim_s" not in scene[0]:
+            continue
+        t0 = f0 = last_f = wsum = 0.0
+        for k, (t, f) in enumerate(sorted(_clock(e) for e in scene)):
+            wsum += (lanes - k) * max(f - last_f, 0.0)
+            last_f = max(f, last_f)
+            if t - t0 >= min_s and f > f0:
+                n = round(wsum / (f - f0))
+                frames, secs = out.get(n, (0.0, 0.0))
+                out[n] = (frames + f - f0, secs + t - t0)
+                t0, f0, wsum = t, f, 0.0
+    return dict(sorted(out.items(), reverse=True))
+
+
+def _clock(e: dict[str, Any]) -> tuple[float, float]:
+    """(wall s, frame) of an episode's end: ``elapsed_s`` / ``end_frame`` where recorded, else from ``sim_s``."""
+    if e.get("elapsed_s") is not None and e.get("end_frame") is not None:
+        return float(e["elapsed_s"]), float(e["end_frame"])
+    return float(e["sim_s"]), float(e["sim_s"] * e["frames_per_s"])
+
+
+def _by_running(episodes: list[dict[str, Any]]) -> dict[str, float]:
+    """``running_rates`` as ``{n: frames/s}`` with JSON keys, for ``throughput.json``."""
+    return {str(n): round(f / s, 3) for n, (f, s) in running_rates(episodes).items()}
+
+
+def _retire_setting(run: Path) -> bool | None:
+    """Whether a run retired idle lanes: its ``summary.json`` config (runs before session 18 never did)."""
+    path = run / "summary.json"
+    if not path.is_file():
+        return None
+    return bool(json.loads(path.read_text()).get("cfg", {}).get("retire_idle_lanes", False))
+
+
 def _task_minutes(queue: dict[str, Any]) -> dict[str, float]:
     """Minutes of each task that ran (the last entry wins when a task was restarted)."""
     return {t["name"]: t["minutes"] for t in queue.get("tasks", []) if t.get("minutes") is not None}
@@ -77,7 +142,8 @@ def session_rates(folder: str | Path) -> dict[str, Any]:
         if not eps:
             continue
         episodes[run.name] = eps
-        runs[run.name] = run_rate(eps) | {"task_minutes": minutes.get(run.name)}
+        runs[run.name] = run_rate(eps) | {"task_minutes": minutes.get(run.name), "retire_idle_lanes": _retire_setting(run),
+                                          "by_running": _by_running(eps)}  # fmt: skip
     rows = {}
     for name, row in queue.get("rows", {}).items():
         shares = [eps for run, eps in episodes.items() if share_row(run) == name]

@@ -1,0 +1,111 @@
+# SPDX-License-Identifier: Apache-2.0
+"""What retiring idle lanes buys, read from the runs' own records -> ``retire_lanes.{json,png}`` (issue 9).
+
+A batch of 25 robots steps together until its last robot's episode ends; a fallen robot's lane is idle from then
+on. Since session 18 an idle lane's sand leaves the MPM solve (``G1EvalCfg.retire_idle_lanes``); before, it was
+stepped to the end. ``gmloco.eval.run_rates.running_rates`` splits each complete batch's wall time by how many
+robots were still walking. This script pools those stretches, per setting (particles reserved) and per retire
+setting, into bins of robots walking, and draws the solver rate [MPM frames/s] against them.
+
+Caveat written on the figure: Newton's rheology loop stops at its tolerance (a conditional CUDA graph), so a frame
+costs what its sand needs, up to the 500-sweep cap; fallen robots' settled sand costs fewer sweeps than walking
+robots' whether or not their lanes are retired. The comparison that isolates retiring is the tail, 1-3 robots
+walking among 25 lanes, where walking robots set the sweep count either way.
+
+    python results/mpm_eval/retire_lanes.py
+"""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+from gmloco.eval.g1_eval import read_episodes
+from gmloco.eval.run_rates import running_rates
+
+HERE = Path(__file__).resolve().parent
+BINS = ((25, 25), (10, 24), (4, 9), (1, 3))
+"""Robots walking (of 25 lanes), inclusive ranges."""
+SESSIONS = ("gpu_s18", "gpu_s19")
+
+
+def _retire(run: Path) -> bool:
+    cfg = json.loads((run / "summary.json").read_text()).get("cfg", {}) if (run / "summary.json").is_file() else {}
+    return bool(cfg.get("retire_idle_lanes", False))
+
+
+def pooled() -> dict[str, dict[str, dict[str, float]]]:
+    """``{"<particles> particles, retire on|off": {"lo-hi": {frames, seconds, frames_per_s, runs}}}``."""
+    out: dict[str, dict[str, dict[str, float]]] = {}
+    for session in SESSIONS:
+        for run in sorted((HERE / session / "runs").iterdir()):
+            path = run / "episodes.jsonl"
+            if not path.is_file():
+                continue
+            eps = read_episodes(path)
+            if not eps or eps[0].get("batch_size") != 25:
+                continue  # a resumed batch has fewer lanes: not comparable
+            key = f"{eps[0]['particles'] / 1e6:.2f}M particles, retire {'on' if _retire(run) else 'off'}"
+            for n, (frames, secs) in running_rates(eps).items():
+                lo, hi = next(b for b in BINS if b[0] <= n <= b[1])
+                cell = out.setdefault(key, {}).setdefault(f"{lo}-{hi}", {"frames": 0.0, "seconds": 0.0, "runs": []})
+                cell["frames"] += frames
+                cell["seconds"] += secs
+                if f"{session}/{run.name}" not in cell["runs"]:
+                    cell["runs"].append(f"{session}/{run.name}")
+    for bins in out.values():
+        for cell in bins.values():
+            cell["frames_per_s"] = round(cell["frames"] / cell["seconds"], 3)
+            cell["frames"], cell["seconds"] = round(cell["frames"]), round(cell["seconds"], 1)
+    return dict(sorted(out.items()))
+
+
+def figure(data: dict, path: Path) -> None:
+    """Solver rate by robots walking, one panel per particle count, retire on vs off side by side."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    sizes = sorted({k.split(",")[0] for k in data})
+    fig, axes = plt.subplots(1, len(sizes), figsize=(5.2 * len(sizes), 4.0), squeeze=False)
+    labels = [f"{lo}-{hi}" if lo != hi else f"{lo}" for lo, hi in BINS]
+    for ax, size in zip(axes[0], sizes, strict=True):
+        for j, (mode, color) in enumerate((("off", "tab:gray"), ("on", "tab:green"))):
+            bins = data.get(f"{size}, retire {mode}", {})
+            vals = [bins.get(f"{lo}-{hi}", {}).get("frames_per_s", 0.0) for lo, hi in BINS]
+            xs = [i + (j - 0.5) * 0.38 for i in range(len(BINS))]
+            bars = ax.bar(
+                xs, vals, width=0.38, color=color, label=f"idle lanes {'retired' if mode == 'on' else 'kept'}"
+            )
+            for b, v, (lo, hi) in zip(bars, vals, BINS, strict=True):
+                secs = bins.get(f"{lo}-{hi}", {}).get("seconds")
+                if v:
+                    ax.text(
+                        b.get_x() + b.get_width() / 2, v, f"{v:.1f}\n{secs:.0f} s", ha="center", va="bottom", fontsize=7
+                    )
+        ax.set_xticks(range(len(BINS)), labels)
+        ax.set_xlabel("robots still walking (of 25 lanes)")
+        ax.set_ylabel("MPM frames per second (all lanes step together)")
+        ax.set_title(size)
+        ax.set_ylim(0, 1.25 * max(c["frames_per_s"] for k, b in data.items() if k.startswith(size) for c in b.values()))
+        ax.legend(loc="upper left", fontsize=8)
+    fig.suptitle("Retiring idle lanes (issue 9; H200, 3 cm, 500-sweep cap; label: rate and wall seconds pooled)\n"
+                 "the rheology loop stops at its tolerance, so settled sand is cheap either way: compare the 1-3 tail",
+                 fontsize=9)  # fmt: skip
+    fig.tight_layout()
+    fig.savefig(path, dpi=130)
+    plt.close(fig)
+
+
+def main() -> None:
+    """Write ``retire_lanes.json`` and ``fig_retire_lanes.png`` beside this script and print the pooled rates."""
+    data = pooled()
+    (HERE / "retire_lanes.json").write_text(json.dumps(data, indent=1) + "\n")
+    figure(data, HERE / "fig_retire_lanes.png")
+    for key, bins in data.items():
+        print(key, {b: c["frames_per_s"] for b, c in bins.items()})
+
+
+if __name__ == "__main__":
+    main()
