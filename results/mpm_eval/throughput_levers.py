@@ -61,6 +61,13 @@ def cases() -> list[dict]:
     row = s18["rows"]["table_td_dry_sand_x4"]
     add(f"s18: the same row on 4 GPUs at once: {row['wall_minutes']} min incl. build (as a rate)", "4x H200",
         100 * 10.0 / 0.005 / (row["wall_minutes"] * 60), "accepted", "gpu_s18/throughput.json", gpus=4)  # fmt: skip
+    s19 = _load("gpu_s19/throughput.json")
+    for run, how in (("retire_ab_keep", "idle lanes kept"), ("retire_ab_on", "idle lanes retired")):
+        add(f"s19: 25 lanes, 6 s at 1.5 m/s, {how} (side by side)", "H200",
+            s19["runs"][run]["robot_frames_per_s_all_lanes"], "accepted", "gpu_s19/throughput.json")  # fmt: skip
+    row = s19["rows"]["table_td_transition_sq"]
+    add(f"s19: transition row, square 1.4 x 1.4 m window, 4 GPUs: {row['wall_minutes']} min (as a rate)", "4x H200",
+        100 * 10.0 / 0.005 / (row["wall_minutes"] * 60), "accepted", "gpu_s19/throughput.json", gpus=4)  # fmt: skip
     return out
 
 
