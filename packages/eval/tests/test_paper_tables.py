@@ -205,3 +205,19 @@ def test_a_runs_file_lists_labels_and_globs(tmp_path: Path, capsys: pytest.Captu
     with pytest.raises(SystemExit):
         main(["--out", str(tmp_path / "out")])
     assert "--runs-file" in capsys.readouterr().err
+
+
+def test_the_transition_course_gets_its_table_and_figure(tmp_path: Path) -> None:
+    """Layered episodes: one table row per medium reached (pooled over speeds) and a figure per policy label."""
+    d = _run(tmp_path, "td", 1, 4, speeds=(1.0, 2.0))
+    layer = {"steps": 10, "swings": 2, "swing_apex": 0.02, "swing_lift": 0.08}
+    rows = [json.loads(line) for line in (d / "episodes.jsonl").read_text().splitlines()]
+    for k, r in enumerate(rows):  # every walk crosses basalt; the two at 1 m/s (k = 0, 2) reach the dry sand
+        r |= {"terrain": "transition", "layers": [layer | {"medium": "basalt", "eta_mean": 0.3 + 0.1 * (k % 2)},
+              layer | {"medium": "dry_sand", "eta_mean": 0.2, "steps": 10 * (k % 2 == 0)}]}  # fmt: skip
+    (d / "episodes.jsonl").write_text("".join(json.dumps(r) + "\n" for r in rows))
+    summary = combine([("td", d)], tmp_path / "out", episodes=4)
+    table = list(csv.DictReader((tmp_path / "out" / "table_transition.csv").open()))
+    assert [(r["medium"], r["episodes_reached"]) for r in table] == [("basalt", "4"), ("dry_sand", "2")]
+    assert float(table[0]["eta_decoded"]) == pytest.approx(0.35) and float(table[0]["swing_lift_cm"]) == 8.0
+    assert "fig_transition_td.png" in summary["figures"] and (tmp_path / "out" / "fig_transition_td.png").stat().st_size

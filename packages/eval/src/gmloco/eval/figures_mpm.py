@@ -60,7 +60,11 @@ def fig_mpm_speed_sweep(rows: list[dict[str, Any]], path: str | Path, policy: st
 
 
 def fig_mpm_transition(rows: list[dict[str, Any]], path: str | Path, policy: str) -> Path:
-    """Decoded eta and swing apex / lift per medium of the transition course (``tables_mpm.table_transition``)."""
+    """The transition course per medium, in walking order: decoded stiffness eta [-], swing apex and lift [cm].
+
+    One line per commanded speed [m/s] and the mean over all episodes (black, ``tables_mpm.table_transition``);
+    a point is the mean over the episodes that stepped on that medium, labelled with their count.
+    """
     import matplotlib
 
     matplotlib.use("Agg")
@@ -68,19 +72,27 @@ def fig_mpm_transition(rows: list[dict[str, Any]], path: str | Path, policy: str
 
     from gmloco.eval.tables_mpm import table_transition
 
-    table = table_transition(rows)
-    fig, (ax0, ax1) = plt.subplots(1, 2, figsize=(9, 3.4), constrained_layout=True)
+    layered = [r for r in rows if r.get("layers")]
+    table = table_transition(layered)
+    fig, axes = plt.subplots(1, 3, figsize=(12, 3.6), constrained_layout=True)
+    columns = ((3, "decoded stiffness eta [-]"), (4, "swing apex above the surface [cm]"), (5, "swing lift [cm]"))
+    speeds = sorted({float(r["speed"]) for r in layered if "speed" in r})
     for scenario in dict.fromkeys(r[0] for r in table):
+        media = [r[1] for r in table if r[0] == scenario]
+        for v in speeds:
+            cells = {r[1]: r for r in table_transition([r for r in layered if float(r.get("speed", -1)) == v])
+                     if r[0] == scenario}  # fmt: skip
+            xs = [m for m in media if m in cells]
+            for ax, (col, _) in zip(axes, columns, strict=True):
+                ax.plot(xs, [cells[m][col] for m in xs], "o-", alpha=0.6, label=f"{v:g} m/s")
         cells = [r for r in table if r[0] == scenario]
-        media = [r[1] for r in cells]
-        ax0.plot(media, [r[3] for r in cells], "o-", label=scenario)
-        ax1.plot(media, [r[4] for r in cells], "o-", label=f"{scenario}: apex")
-        ax1.plot(media, [r[5] for r in cells], "s--", label=f"{scenario}: lift")
-    ax0.set(ylabel="decoded stiffness eta [-]")
-    ax1.set(ylabel="swing height [cm]")
-    ax0.legend(fontsize=7)
-    ax1.legend(fontsize=7)
-    fig.suptitle(f"{policy} on the MPM transition course (media in walking order)", fontsize=9)
+        for ax, (col, label) in zip(axes, columns, strict=True):
+            ax.plot(media, [r[col] for r in cells], "ks-", lw=2, label=f"all ({scenario})")
+            for r in cells:
+                ax.annotate(f"n={r[2]}", (r[1], r[col]), textcoords="offset points", xytext=(4, 4), fontsize=7)
+            ax.set(ylabel=label)
+    axes[0].legend(fontsize=7)
+    fig.suptitle(f"{policy} on the MPM transition course (media in walking order; {len(layered)} episodes)", fontsize=9)
     fig.savefig(path, dpi=120)
     plt.close(fig)
     return Path(path)

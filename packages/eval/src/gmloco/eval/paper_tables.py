@@ -11,7 +11,8 @@ tool labels each run's episodes with the policy's name and writes the combined t
 * ``table_terrains.{md,csv}``: one row per (policy, terrain, scenario) with the success rate and its 95 % Wilson
   interval, tracking errors, DTW path error, sinkage and swing (``gmloco.eval.tables_mpm``);
 * ``table_speeds.{md,csv}``: success rate per commanded speed, one row per (policy, terrain, scenario);
-* ``table_transition.{md,csv}`` when a run walked the layered course;
+* ``table_transition.{md,csv}`` and ``fig_transition_<label>.png`` (per medium and speed) when a run walked the
+  layered course;
 * ``table_ablation.{md,csv}`` (the contact-model ablation's layout: per terrain and policy, the straight walk's
   success beside the circular walk's success and DTW path error) and ``table_per_terrain.{md,csv}`` (one row per
   terrain, each policy's success rate and velocity / yaw tracking errors on the straight walk);
@@ -137,6 +138,7 @@ def combine(
     write_table(out_dir / "table_ablation", ABLATION_COLUMNS, table_ablation(terrains), note)
     write_table(out_dir / "table_per_terrain", *table_per_terrain(terrains), note)
     figures = _figures_by_cell(loaded, out_dir) + _path_figures(grouped, summaries, out_dir)
+    figures += _transition_figures(loaded, out_dir)
     if any(r["scenario"] == "straight" for _, rows in loaded for r in rows):
         from gmloco.eval.figures_mpm import fig_per_terrain
 
@@ -175,6 +177,14 @@ def _figures_by_cell(loaded: list[tuple[str, list[dict[str, Any]]]], out_dir: Pa
             fig_policies_by_speed(runs, out_dir / f"fig_speeds_{terrain}_{scenario}.png", f"{terrain} / {scenario}")
         )
     return paths
+
+
+def _transition_figures(loaded: list[tuple[str, list[dict[str, Any]]]], out_dir: Path) -> list[Path]:
+    """``fig_transition_<label>.png``: each policy's transition-course walks per medium and speed."""
+    from gmloco.eval.figures_mpm import fig_mpm_transition
+
+    return [fig_mpm_transition(rows, out_dir / f"fig_transition_{label}.png", label)
+            for label, rows in loaded if any(r.get("layers") for r in rows)]  # fmt: skip
 
 
 def _path_figures(
