@@ -276,7 +276,9 @@ def pinned_walk(cfg: TsEvalCfg, materials: list[str], commands: list[tuple[float
 
     Returns:
         ``quat_wxyz`` [T, W, 4] and ``xy`` [T, W, 2] [m] of the pelvis, ``wz`` [T, W] its world yaw rate [rad/s],
-        ``alive`` [T, W] (before each step), ``dt`` the policy step [s], ``wall_s`` the time it took [s].
+        ``alive`` [T, W] (before each step), ``eta_true`` [T, W] the pinned material's normalized stiffness and the
+        acting policy's decoded ones (``eta_student`` and ``eta_teacher`` for a student, ``eta_teacher`` for a
+        teacher) [-], ``dt`` the policy step [s], ``wall_s`` the time it took [s].
     """
     import time
 
@@ -295,13 +297,18 @@ def pinned_walk(cfg: TsEvalCfg, materials: list[str], commands: list[tuple[float
     obs = _start(runner, torch.tensor(commands, dtype=torch.float32, device=env.device))
     robot, n = env.scene["robot"], len(commands)
     alive = torch.ones(n, dtype=torch.bool, device=env.device)
-    trace: dict[str, list[torch.Tensor]] = {"quat_wxyz": [], "xy": [], "wz": [], "alive": []}
+    trace: dict[str, list[torch.Tensor]] = {"quat_wxyz": [], "xy": [], "wz": [], "alive": [], "eta_true": []}
     for _ in range(round(duration_s / env.step_dt)):
         trace["quat_wxyz"].append(robot.data.root_link_quat_w.clone())
         trace["xy"].append(robot.data.root_link_pos_w[:, :2].clone())
         trace["wz"].append(robot.data.root_link_ang_vel_w[:, 2].clone())
         trace["alive"].append(alive.clone())
-        obs_dict, _, terminated, _, _ = env.step(_policy_step(runner, obs)["actions"])
+        trace["eta_true"].append(env.sand.eta.clone())
+        out = _policy_step(runner, obs)
+        for k in ("eta_student", "eta_teacher"):
+            if k in out:
+                trace.setdefault(k, []).append(out[k])
+        obs_dict, _, terminated, _, _ = env.step(out["actions"])
         obs = TensorDict(obs_dict, batch_size=[n])
         alive &= ~terminated
     out: dict[str, Any] = {k: torch.stack(v).cpu().numpy() for k, v in trace.items()}
