@@ -56,6 +56,7 @@ def test_session_rates_reads_runs_and_rows(tmp_path: Path) -> None:
     out = session_rates(_session(tmp_path))
     assert set(out["runs"]) == {"row_share0of2", "row_share1of2", "lone"}  # the empty task has no rate
     assert out["runs"]["lone"]["task_minutes"] == 2.0 and out["device"] == "4 x H200"
+    assert out["runs"]["lone"]["by_running_clock"].startswith("sim_s")  # records without elapsed_s
     row = out["rows"]["row"]
     assert row["wall_minutes"] == 9.5 and row["episodes"] == 4 and row["successes"] == 2
     assert row["longest_alive_s"] == 10.0 and row["build_s_max"] == 30.0

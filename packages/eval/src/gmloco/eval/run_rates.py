@@ -142,8 +142,9 @@ def session_rates(folder: str | Path) -> dict[str, Any]:
         if not eps:
             continue
         episodes[run.name] = eps
+        clock = "elapsed_s" if eps[0].get("elapsed_s") is not None else "sim_s (in-step: reads fast near episode ends)"
         runs[run.name] = run_rate(eps) | {"task_minutes": minutes.get(run.name), "retire_idle_lanes": _retire_setting(run),
-                                          "by_running": _by_running(eps)}  # fmt: skip
+                                          "by_running": _by_running(eps), "by_running_clock": clock}  # fmt: skip
     rows = {}
     for name, row in queue.get("rows", {}).items():
         shares = [eps for run, eps in episodes.items() if share_row(run) == name]
