@@ -136,4 +136,6 @@ def test_pinned_walk_returns_one_pelvis_trace_per_env(device: str) -> None:
     assert walk["alive"][0].all() and walk["wall_s"] > 0.0
     # the pinned materials' true eta (basalt stiffer than dry sand) and the teacher's decoded one, per step and env
     assert walk["eta_true"].shape == walk["eta_teacher"].shape == (5, 2) and "eta_student" not in walk
-    assert walk["eta_true"][0, 1] > walk["eta_true"][0, 0] and np.all((walk["eta_teacher"] >= 0) & (walk["eta_teacher"] <= 1))
+    assert walk["eta_true"][0, 1] > walk["eta_true"][0, 0] and np.all(
+        (walk["eta_teacher"] >= 0) & (walk["eta_teacher"] <= 1)
+    )
