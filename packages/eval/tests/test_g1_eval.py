@@ -208,6 +208,13 @@ def test_episode_mcap_round_trip(tmp_path: Path) -> None:
     _, acc = lg.signal("imu.accelerometer")
     np.testing.assert_allclose(acc[:, 2], 9.81, atol=1e-6)
     assert lg.metadata.contact_model == "mpm" and lg.metadata.material == "dry_sand"
+    assert not lg.has("student.eta")  # no decoded eta given: no topic
+    eta = np.linspace(0.1, 0.4, n)
+    eta[:3] = np.nan  # e.g. a policy step before the student's history is read: not written
+    lg = read_log(write_episode_mcap(tmp_path / "eta.mcap", ep | {"eta": eta}, {"policy": "p"}))
+    t_eta, eta_back = lg.signal("student.eta")
+    np.testing.assert_allclose(t_eta, np.arange(3, n) * dt, atol=1e-9)
+    np.testing.assert_allclose(eta_back.ravel(), eta[3:], rtol=1e-6)
 
 
 class _LaneScene:

@@ -36,12 +36,14 @@ def write_episode_mcap(path: str | Path, ep: dict[str, Any], meta: dict[str, str
         ep: Per-step arrays of one robot at the policy rate: ``dt`` [s], ``base_q`` [T, 7] (p, q_xyzw),
             ``base_qd`` [T, 6] (world linear, angular), ``joint_q`` / ``joint_qd`` / ``target`` / ``action``
             [T, A], ``foot_force`` [T, 2, 3] [N], ``foot_sinkage`` [T, 2] [m], ``command`` [3], ``joint_names`` [A],
-            ``kp`` / ``kd`` [A].
+            ``kp`` / ``kd`` [A]; optionally ``eta`` [T], the student's decoded stiffness [-] (``/student/eta``,
+            written where finite: other policies decode none).
         meta: ``policy``, ``material`` and free-form notes for the run metadata.
     """
     from gmloco.deploy.logs import G1_JOINT_NAMES, G1LogWriter, LogWriterCfg, RunMetadata
     from gmloco.deploy.logs.schema import (
         TOPIC_COMMAND,
+        TOPIC_ETA,
         TOPIC_IMU,
         TOPIC_JOINT_STATES,
         TOPIC_LOWCMD,
@@ -71,7 +73,11 @@ def write_episode_mcap(path: str | Path, ep: dict[str, Any], meta: dict[str, str
                      notes=meta.get("notes", ""))  # fmt: skip
     cmd = np.asarray(ep["command"], dtype=np.float64)
     zeros = np.zeros(len(G1_JOINT_NAMES))
+    eta = np.asarray(ep.get("eta", np.full(len(q), np.nan)), dtype=np.float64).reshape(-1)[: len(q)]
+    has_eta = bool(np.isfinite(eta).any())
     with G1LogWriter(path, md, LogWriterCfg(topics=topics, overwrite=True)) as w:
+        if has_eta:  # declared with its names and units (the log analysis' eta panel reads them)
+            w.declare(TOPIC_ETA, names=["eta"], units=["1"])
         for t in range(len(q)):
             ts = t * dt
             tau = kp * (tgt[t] - jq[t]) - kd * jqd[t]
@@ -81,5 +87,7 @@ def write_episode_mcap(path: str | Path, ep: dict[str, Any], meta: dict[str, str
             w.write_odometry(ts, q[t, :3], quat_wxyz[t], v_body[t], gyro[t])
             w.write_policy(ts, action=np.asarray(ep["action"][t], dtype=np.float64))
             w.write_sim_contact(ts, force[t, :, 2] > CONTACT_FORCE_N, force[t], sink[t])
+            if has_eta and t < len(eta) and np.isfinite(eta[t]):
+                w.write_eta(ts, eta[t : t + 1])
         w.close(meta.get("end_reason", "completed"))
     return Path(path)
