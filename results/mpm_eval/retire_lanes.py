@@ -23,17 +23,12 @@ import json
 from pathlib import Path
 
 from gmloco.eval.g1_eval import read_episodes
-from gmloco.eval.run_rates import running_rates
+from gmloco.eval.run_rates import retire_setting, running_rates
 
 HERE = Path(__file__).resolve().parent
 BINS = ((25, 25), (10, 24), (4, 9), (1, 3))
 """Robots walking (of 25 lanes), inclusive ranges."""
 SESSIONS = ("gpu_s18", "gpu_s19")
-
-
-def _retire(run: Path) -> bool:
-    cfg = json.loads((run / "summary.json").read_text()).get("cfg", {}) if (run / "summary.json").is_file() else {}
-    return bool(cfg.get("retire_idle_lanes", False))
 
 
 def pooled() -> dict[str, dict[str, dict[str, float]]]:
@@ -47,7 +42,7 @@ def pooled() -> dict[str, dict[str, dict[str, float]]]:
             eps = read_episodes(path)
             if not eps or eps[0].get("batch_size") != 25:
                 continue  # a resumed batch has fewer lanes: not comparable
-            key = f"{eps[0]['particles'] / 1e6:.2f}M particles, retire {'on' if _retire(run) else 'off'}"
+            key = f"{eps[0]['particles'] / 1e6:.2f}M particles, retire {'on' if retire_setting(run) else 'off'}"
             for n, (frames, secs) in running_rates(eps).items():
                 lo, hi = next(b for b in BINS if b[0] <= n <= b[1])
                 cell = out.setdefault(key, {}).setdefault(f"{lo}-{hi}", {"frames": 0.0, "seconds": 0.0, "runs": []})

@@ -68,7 +68,7 @@ def running_rates(episodes: list[dict[str, Any]], min_s: float = MIN_PIECE_S) ->
     included; before session 19 only ``sim_s``, the time inside the scene's step, which misses the frames in flight
     while ended episodes are scored: up to three frames per end, so stretches with many ends read fast).
     Records of one scene are consecutive lines with one ``build_s``. Only scenes that recorded exactly
-    ``batch_size`` episodes count: one batch, every lane's episode recorded, so after the k-th end (by ``sim_s``)
+    ``batch_size`` episodes count: one batch, every lane's episode recorded, so after the k-th end (by its clock)
     ``batch_size - k`` robots were walking. A scene cut by a time box (its running episodes dropped unrecorded) or
     resumed with fewer episodes than lanes is left out, as is a scene whose lanes took queued episodes.
     Successive ends closer than ``min_s`` of wall time are merged into one stretch, labelled with its
@@ -97,9 +97,14 @@ def running_rates(episodes: list[dict[str, Any]], min_s: float = MIN_PIECE_S) ->
     return dict(sorted(out.items(), reverse=True))
 
 
+def _has_wall_clock(e: dict[str, Any]) -> bool:
+    """Whether an episode record carries ``elapsed_s`` / ``end_frame`` (session 19 on)."""
+    return e.get("elapsed_s") is not None and e.get("end_frame") is not None
+
+
 def _clock(e: dict[str, Any]) -> tuple[float, float]:
     """(wall s, frame) of an episode's end: ``elapsed_s`` / ``end_frame`` where recorded, else from ``sim_s``."""
-    if e.get("elapsed_s") is not None and e.get("end_frame") is not None:
+    if _has_wall_clock(e):
         return float(e["elapsed_s"]), float(e["end_frame"])
     return float(e["sim_s"]), float(e["sim_s"] * e["frames_per_s"])
 
@@ -109,7 +114,7 @@ def _by_running(episodes: list[dict[str, Any]]) -> dict[str, float]:
     return {str(n): round(f / s, 3) for n, (f, s) in running_rates(episodes).items()}
 
 
-def _retire_setting(run: Path) -> bool | None:
+def retire_setting(run: Path) -> bool | None:
     """Whether a run retired idle lanes: its ``summary.json`` config (runs before session 18 never did)."""
     path = run / "summary.json"
     if not path.is_file():
@@ -142,8 +147,8 @@ def session_rates(folder: str | Path) -> dict[str, Any]:
         if not eps:
             continue
         episodes[run.name] = eps
-        clock = "elapsed_s" if eps[0].get("elapsed_s") is not None else "sim_s (in-step: reads fast near episode ends)"
-        runs[run.name] = run_rate(eps) | {"task_minutes": minutes.get(run.name), "retire_idle_lanes": _retire_setting(run),
+        clock = "elapsed_s" if _has_wall_clock(eps[0]) else "sim_s (in-step: reads fast near episode ends)"
+        runs[run.name] = run_rate(eps) | {"task_minutes": minutes.get(run.name), "retire_idle_lanes": retire_setting(run),
                                           "by_running": _by_running(eps), "by_running_clock": clock}  # fmt: skip
     rows = {}
     for name, row in queue.get("rows", {}).items():

@@ -304,11 +304,11 @@ def pinned_walk(cfg: TsEvalCfg, materials: list[str], commands: list[tuple[float
         trace["wz"].append(robot.data.root_link_ang_vel_w[:, 2].clone())
         trace["alive"].append(alive.clone())
         trace["eta_true"].append(env.sand.eta.clone())
-        out = _policy_step(runner, obs)
+        step = _policy_step(runner, obs)
         for k in ("eta_student", "eta_teacher"):
-            if k in out:
-                trace.setdefault(k, []).append(out[k])
-        obs_dict, _, terminated, _, _ = env.step(out["actions"])
+            if k in step:
+                trace.setdefault(k, []).append(step[k])
+        obs_dict, _, terminated, _, _ = env.step(step["actions"])
         obs = TensorDict(obs_dict, batch_size=[n])
         alive &= ~terminated
     out: dict[str, Any] = {k: torch.stack(v).cpu().numpy() for k, v in trace.items()}
