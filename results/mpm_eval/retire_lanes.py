@@ -7,7 +7,7 @@ stepped to the end. ``gmloco.eval.run_rates.running_rates`` splits each complete
 robots were still walking. This script pools those stretches, per setting (particles reserved) and per retire
 setting, into bins of robots walking, and draws the solver rate [MPM frames/s] against them.
 
-Caveat written on the figure: these sessions' records time a scene by ``sim_s``, the wall time inside its step,
+Caveat written on the figure: sessions 18-19's records time a scene by ``sim_s``, the wall time inside its step,
 which misses the frames in flight while ended episodes are scored (up to three frames per end). Bins where many
 episodes end (10-24, 4-9) therefore read fast whichever the setting (19 ends within 44 frames took 1.9 s
 by that clock in session 19's transition share 3 at ~2 frames/s); the 25-robot bin has no ends
@@ -28,11 +28,17 @@ from gmloco.eval.run_rates import retire_setting, running_rates
 HERE = Path(__file__).resolve().parent
 BINS = ((25, 25), (10, 24), (4, 9), (1, 3))
 """Robots walking (of 25 lanes), inclusive ranges."""
-SESSIONS = ("gpu_s18", "gpu_s19")
+SESSIONS = ("gpu_s18", "gpu_s19", "gpu_s20")
+SERIES = (("off", "step clock", "tab:gray"), ("on", "step clock", "tab:olive"), ("on", "wall clock", "tab:green"))
+"""(retire setting, clock, colour) of the figure's bars, left to right."""
 
 
 def pooled() -> dict[str, dict[str, dict[str, float]]]:
-    """``{"<particles> particles, retire on|off": {"lo-hi": {frames, seconds, frames_per_s, runs}}}``."""
+    """``{"<particles> particles, retire on|off, wall|step clock": {"lo-hi": {frames, seconds, frames_per_s, runs}}}``.
+
+    Records with ``elapsed_s`` (session 20 on) are timed by the wall clock, older ones by the step clock; the two
+    are pooled apart.
+    """
     out: dict[str, dict[str, dict[str, float]]] = {}
     for session in SESSIONS:
         for run in sorted((HERE / session / "runs").iterdir()):
@@ -42,7 +48,9 @@ def pooled() -> dict[str, dict[str, dict[str, float]]]:
             eps = read_episodes(path)
             if not eps or eps[0].get("batch_size") != 25:
                 continue  # a resumed batch has fewer lanes: not comparable
-            key = f"{eps[0]['particles'] / 1e6:.2f}M particles, retire {'on' if retire_setting(run) else 'off'}"
+            clock = "wall clock" if "elapsed_s" in eps[0] else "step clock"
+            retire = "on" if retire_setting(run) else "off"
+            key = f"{eps[0]['particles'] / 1e6:.2f}M particles, retire {retire}, {clock}"
             for n, (frames, secs) in running_rates(eps).items():
                 lo, hi = next(b for b in BINS if b[0] <= n <= b[1])
                 cell = out.setdefault(key, {}).setdefault(f"{lo}-{hi}", {"frames": 0.0, "seconds": 0.0, "runs": []})
@@ -68,13 +76,14 @@ def figure(data: dict, path: Path) -> None:
     fig, axes = plt.subplots(1, len(sizes), figsize=(5.2 * len(sizes), 4.0), squeeze=False)
     labels = [f"{lo}-{hi}" if lo != hi else f"{lo}" for lo, hi in BINS]
     for ax, size in zip(axes[0], sizes, strict=True):
-        for j, (mode, color) in enumerate((("off", "tab:gray"), ("on", "tab:green"))):
-            bins = data.get(f"{size}, retire {mode}", {})
+        series = [(m, c, col) for m, c, col in SERIES if f"{size}, retire {m}, {c}" in data]
+        width = 0.8 / max(len(series), 1)
+        for j, (mode, clock, color) in enumerate(series):
+            bins = data[f"{size}, retire {mode}, {clock}"]
             vals = [bins.get(f"{lo}-{hi}", {}).get("frames_per_s", 0.0) for lo, hi in BINS]
-            xs = [i + (j - 0.5) * 0.38 for i in range(len(BINS))]
-            bars = ax.bar(
-                xs, vals, width=0.38, color=color, label=f"idle lanes {'retired' if mode == 'on' else 'kept'}"
-            )
+            xs = [i + (j - (len(series) - 1) / 2) * width for i in range(len(BINS))]
+            label = f"idle lanes {'retired' if mode == 'on' else 'kept'} ({clock})"
+            bars = ax.bar(xs, vals, width=width, color=color, label=label)
             for b, v, (lo, hi) in zip(bars, vals, BINS, strict=True):
                 secs = bins.get(f"{lo}-{hi}", {}).get("seconds")
                 if v:
@@ -88,8 +97,8 @@ def figure(data: dict, path: Path) -> None:
         ax.set_ylim(0, 1.25 * max(c["frames_per_s"] for k, b in data.items() if k.startswith(size) for c in b.values()))
         ax.legend(loc="upper left", fontsize=8)
     fig.suptitle("Retiring idle lanes (issue 9; H200, 3 cm, 500 sweeps; labels: rate, wall seconds pooled)\n"
-                 "clock of sessions 18-19 misses frames in flight at each episode end: 10-24 and 4-9 read high; "
-                 "compare 25 and the 1-3 tail", fontsize=9)  # fmt: skip
+                 "step clock (sessions 18-19) misses frames in flight at each episode end: its 10-24 and 4-9 read "
+                 "high; wall clock (session 20 on) does not", fontsize=9)  # fmt: skip
     fig.tight_layout()
     fig.savefig(path, dpi=130)
     plt.close(fig)

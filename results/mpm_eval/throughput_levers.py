@@ -68,6 +68,10 @@ def cases() -> list[dict]:
     row = s19["rows"]["table_td_transition_sq"]
     add(f"s19: transition row, square 1.4 x 1.4 m window, 4 GPUs: {row['wall_minutes']} min (as a rate)", "4x H200",
         100 * 10.0 / 0.005 / (row["wall_minutes"] * 60), "accepted", "gpu_s19/throughput.json", gpus=4)  # fmt: skip
+    s20 = _load("gpu_s20/throughput.json")
+    shares = [s20["runs"][f"table_td_dry_sand_sq_share{i}of4"]["robot_frames_per_s_all_lanes"] for i in (0, 1, 3)]
+    add("s20: td dry-sand row, square 1.4 x 1.4 m window, 25 lanes (median of 3 shares)", "H200",
+        statistics.median(shares), "accepted", "gpu_s20/throughput.json")  # fmt: skip
     return out
 
 
