@@ -233,7 +233,8 @@ class _LaneScene:
         self.commands = np.array(cfg.commands, dtype=float)  # type: ignore[attr-defined]
         self.spec = SimpleNamespace(joint_names=["j"], kp=np.ones(1), kd=np.ones(1))
         self.robot_mass, self.particle_count, self.wall_time, self.frames_per_second = 30.0, 1, 1.0, 1.0
-        self.mpm = SimpleNamespace(check_sparse_grid_rebuild_status=lambda: None)
+        self.events: list[str] = []  # "sync" / "check": the order of device waits and grid checks
+        self.mpm = SimpleNamespace(check_sparse_grid_rebuild_status=lambda: self.events.append("check"))
         self.lane_episode, self.lane_step = list(range(n)), [0] * n
         self.resets: list[tuple[list[int], list[int], int]] = []
         self.retired: list[tuple[list[int], int]] = []
@@ -244,6 +245,9 @@ class _LaneScene:
 
     def capture(self) -> None:
         pass
+
+    def sync(self) -> None:
+        self.events.append("sync")
 
     def step(self) -> None:
         if self.frame % self.frames_per_policy == 0:
@@ -308,6 +312,9 @@ def test_a_fallen_lane_takes_the_next_episode(monkeypatch: pytest.MonkeyPatch) -
     elapsed = [r["elapsed_s"] for r in rows]  # the wall clock since the first frame, in the order the ends came
     assert all(e >= 0.0 for e in elapsed) and elapsed == sorted(elapsed)
     assert [r["end_frame"] for r in rows] == [16, 40, 56, 80, 96]  # the scene's frame at each end (4 per step)
+    # every grid check waits for the frames in flight through the scene's clock first (session 20's clock fix)
+    ev = scene.events
+    assert ev.count("check") >= 5 and all(ev[i - 1] == "sync" for i, e in enumerate(ev) if e == "check")
 
 
 def test_idle_lanes_keep_their_sand_when_asked(monkeypatch: pytest.MonkeyPatch) -> None:

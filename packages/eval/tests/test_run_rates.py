@@ -128,3 +128,20 @@ def test_running_rates_prefers_the_elapsed_clock() -> None:
     for e, (elapsed, frame) in zip(eps, [(12.0, 40), (24.0, 60)], strict=True):
         e |= {"elapsed_s": elapsed, "end_frame": frame}
     assert _rounded(running_rates(eps)) == {2: (40.0, 12.0), 1: (20.0, 12.0)}
+
+
+def test_run_rate_reads_the_wall_clock_where_records_have_it() -> None:
+    """The rate from end_frame / elapsed_s where recorded, else from the stepping clock's frames_per_s."""
+    # a batch of 2000 frames: the stepping clock says 2.0 frames/s, the wall clock (waits included) 1.8
+    eps = [_episode(k, 2.0, 10.0, True) | {"end_frame": 2000, "elapsed_s": 2000 / 1.8} for k in range(3)]
+    r = run_rate(eps)
+    assert r["rate_clock"] == "elapsed_s"
+    assert r["solver_frames_per_s_median"] == pytest.approx(1.8, abs=1e-3)
+    assert r["robot_frames_per_s_all_lanes"] == pytest.approx(45.0, abs=0.1)
+    # a run resumed from an older record without the wall clock: the rate comes from the records that have it
+    eps[0] = {k: v for k, v in eps[0].items() if k not in ("end_frame", "elapsed_s")} | {"frames_per_s": 5.0}
+    assert run_rate(eps)["solver_frames_per_s_median"] == pytest.approx(1.8, abs=1e-3)
+    # no record has it (runs before session 19): the stepping clock
+    old = [{k: v for k, v in e.items() if k not in ("end_frame", "elapsed_s")} for e in eps]
+    r = run_rate(old)
+    assert r["rate_clock"] == "sim_s" and r["solver_frames_per_s_median"] == pytest.approx(2.0)
