@@ -7,9 +7,12 @@
 #      clock: the td student on dry sand at 1.5 m/s, 25 episodes of the full 10 s in 25 lanes (session 19's 6 s
 #      A/B left no tail), idle lanes retired vs --keep-idle-lanes;
 #   2. the td student's dry-sand row at the square window: session 20's 2.0 m/s share resumed (13 of 25);
-#   3. basalt at the square window (session 16 at the tables' window: 50 of 100, 94 % turned out of it), resuming
+#   3. poppy seed and deep sand at the reach window (1.6 x 0.8 m, centred on the pelvis): at the tables' window 54 %
+#      and 37 % of their walks left it at ~0.7 s by a trailing sole 0.6-0.73 m behind the pelvis (its rear is
+#      0.5 m behind), 0.3 s before they fell; the square window would not help (same rear). They fall within
+#      ~1-2 s, so a share takes a few minutes: two rows done early;
+#   4. basalt at the square window (session 16 at the tables' window: 50 of 100, 94 % turned out of it), resuming
 #      session 20's share 0 (started, no episode ended), then rough dry sand (31 % exits, 20 % by turn);
-#   4. poppy seed and deep sand at the square window (54 % and 37 % exits by reach at the tables' window);
 #   5. the two circle shares cut by earlier time boxes: ppo_rigid 1.0 m/s (23 of 25), clr50 1.0 m/s (24 of 25).
 #   Before (here): scripts/gpu/snapshot_src.sh && cp results/mpm_eval/gpu_s20/job_next.sh .devsrc/job.sh &&
 #     rm -rf .devsrc/row && mkdir -p .devsrc/row &&
@@ -22,7 +25,7 @@
 END=$1
 cd ~/src || exit 1
 mkdir -p ~/chunks
-source scripts/gpu/queue_rows.sh  # TD CLR50 RIGID RFT ROW SQ WIDE, shares()
+source scripts/gpu/queue_rows.sh  # TD CLR50 RIGID RFT ROW SQ WIDE REACH, shares()
 AB="--policy $TD --terrains dry_sand --speeds 1.5 --num-episodes 25 --robots-per-batch 25 --no-mcap --fresh"
 row() { echo "table_td_${1}_sq_share${2}of4 --policy $TD --terrains $1 $ROW $SQ --shard $2/4"; }
 NGPU=$( (nvidia-smi -L 2>/dev/null || true) | wc -l)
@@ -32,7 +35,10 @@ NGPU=$( (nvidia-smi -L 2>/dev/null || true) | wc -l)
     echo "retire_ab10_keep $AB --keep-idle-lanes"
   fi
   row dry_sand 2
-  for t in basalt dry_sand_rough poppy_seed dry_sand_deep; do
+  for t in poppy_seed dry_sand_deep; do
+    for i in 0 1 2 3; do echo "table_td_${t}_reach_share${i}of4 --policy $TD --terrains $t $ROW $REACH --shard $i/4"; done
+  done
+  for t in basalt dry_sand_rough; do
     for i in 0 1 2 3; do row $t $i; done
   done
   echo "table_ppo_rigid_dry_sand_circle_share0of4 --policy $RIGID --terrains dry_sand --scenarios circle $ROW $WIDE --shard 0/4"
