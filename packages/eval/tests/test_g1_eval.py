@@ -123,6 +123,22 @@ def test_a_run_reports_the_soles_reach_against_its_window(capsys: pytest.Capture
     assert "in 1 of them the robot had turned" in capsys.readouterr().err
     report_window(rows[:1], SandWindowCfg(length=1.0, width=0.5, lead=0.1))
     assert "warning" not in capsys.readouterr().err
+    rows[1]["window_exit_turn"] = False  # reach only: rear 0.62 + 0.05 -> 0.70, front 0.60 and width 0.50 kept
+    report_window(rows, SandWindowCfg(length=1.0, width=0.5, lead=0.1))
+    assert "--window-length 1.3 --window-width 0.5 --window-lead -0.05" in capsys.readouterr().err
+
+
+def test_a_covering_window_grows_only_where_the_soles_reached_past_it() -> None:
+    """Session 16's poppy-seed reach against the tables' window, a turning walk, and a reach already held."""
+    from gmloco.eval.g1_eval import covering_window
+
+    tables = SandWindowCfg(length=1.4, width=0.6, lead=0.2)  # 0.5 m behind, 0.9 ahead, 0.3 beside
+    w = covering_window((0.73, 0.13, 0.31), tables, turned=False)
+    assert (w.length, w.width, w.lead) == pytest.approx((1.7, 0.8, 0.05))  # rear 0.8, front 0.9 kept, 0.4 beside
+    assert 0.5 * w.length - w.lead >= 0.73 and 0.5 * w.length + w.lead == pytest.approx(0.9)
+    w = covering_window((0.45, 0.13, 0.2), tables, turned=True)
+    assert (w.length, w.width, w.lead) == pytest.approx((1.4, 1.4, 0.2))  # the square of the tables' window
+    assert covering_window((0.45, 0.13, 0.2), tables, turned=False) == tables
 
 
 def test_a_circle_gets_a_square_moving_window() -> None:

@@ -7,8 +7,8 @@
 #      clock: the td student on dry sand at 1.5 m/s, 25 episodes of the full 10 s in 25 lanes (session 19's 6 s
 #      A/B left no tail), idle lanes retired vs --keep-idle-lanes;
 #   2. the td student's dry-sand row at the square window: session 20's 2.0 m/s share resumed (13 of 25);
-#   3. poppy seed and deep sand at the reach window (1.6 x 0.8 m, centred on the pelvis): at the tables' window 54 %
-#      and 37 % of their walks left it at ~0.7 s by a trailing sole 0.6-0.73 m behind the pelvis (its rear is
+#   3. poppy seed and deep sand at the reach window (1.7 x 0.8 m: rear 0.8 m behind the pelvis, front 0.9 ahead):
+#      at the tables' window 54 % and 37 % of their walks left it at ~0.7 s by a trailing sole 0.6-0.73 m behind the pelvis (its rear is
 #      0.5 m behind), 0.3 s before they fell; the square window would not help (same rear). They fall within
 #      ~1-2 s, so a share takes a few minutes: two rows done early;
 #   4. basalt at the square window (session 16 at the tables' window: 50 of 100, 94 % turned out of it), resuming

@@ -67,6 +67,7 @@ __all__ = [
     "build_cell_scene",
     "cell_minutes_left",
     "check_grid_capacity",
+    "covering_window",
     "episode_batches",
     "episode_specs",
     "heading_turn_deg",
@@ -692,6 +693,31 @@ def run(cfg: G1EvalCfg) -> tuple[dict[str, float], bool]:
     return summary, complete
 
 
+WINDOW_SUGGEST_MARGIN_M = 0.05
+"""Room a suggested window leaves beyond the soles' largest recorded reach [m]."""
+
+
+def covering_window(reach: tuple[float, float, float], window: SandWindowCfg, turned: bool) -> SandWindowCfg:
+    """The smallest moving window holding ``window`` and the soles' reach (behind, ahead, beside the pelvis) [m].
+
+    Each side grows to the reach plus ``WINDOW_SUGGEST_MARGIN_M`` where the reach passed it, rounded up to 5 cm;
+    no side shrinks (the convergence check accepted the window's front and rear clearances, not less). With
+    ``turned`` (walks that turned out of it) the window becomes a square of the larger side.
+    """
+
+    def up(x: float) -> float:
+        return math.ceil(round(x / 0.05, 6)) * 0.05
+
+    behind, ahead, side = reach
+    rear = max(0.5 * window.length - window.lead, up(behind + WINDOW_SUGGEST_MARGIN_M))
+    front = max(0.5 * window.length + window.lead, up(ahead + WINDOW_SUGGEST_MARGIN_M))
+    width = max(window.width, 2.0 * up(side + WINDOW_SUGGEST_MARGIN_M))
+    length = rear + front
+    if turned:
+        length = width = max(length, width)
+    return replace(window, length=round(length, 3), width=round(width, 3), lead=round(0.5 * (front - rear), 3))
+
+
 def report_window(rows: list[dict[str, Any]], window: SandWindowCfg) -> None:
     """Say on stderr how far the soles reached against the window, and warn about episodes that left it early."""
     import sys
@@ -713,10 +739,12 @@ def report_window(rows: list[dict[str, Any]], window: SandWindowCfg) -> None:
         why = (f"; in {turned} of them the robot had turned and the soles were within the window's reach along its "
                "heading: the window is a box of the grid's axes and does not turn, so a walk whose heading drifts "
                "needs a square window (--window-width equal to --window-length)") if turned else ""  # fmt: skip
+        cover = covering_window(tuple(reach), window, turned > 0)  # type: ignore[arg-type]
         print(f"warning: in {len(early)} of {len(rows)} episodes a sole that needed sand stood outside its sand window "
               f"more than {WINDOW_EXIT_GRACE_S} s before the episode ended (first at {worst['window_exit_s']:.2f} s, "
               f"{worst['key']}): those walks lost their support to the window, not to the sand. Lengthen the window "
-              f"or move it back (--window-length, --window-lead, --window-width){why}",
+              f"or move it back (--window-length, --window-lead, --window-width){why}. A window holding this run's "
+              f"reach: --window-length {cover.length:g} --window-width {cover.width:g} --window-lead {cover.lead:g}",
               file=sys.stderr, flush=True)  # fmt: skip
 
 
