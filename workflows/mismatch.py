@@ -27,19 +27,16 @@ from omegaconf import DictConfig
 __all__ = ["main", "run"]
 
 
-def _analysis_cfg(section: DictConfig) -> Any:
-    """Return the package's ``AnalysisCfg`` for the stage's section."""
+def _analysis_cfg(section: DictConfig, rate_hz: float = 500.0) -> Any:
+    """Return the package's ``AnalysisCfg`` for the stage's section and a recording sampled at ``rate_hz``."""
     from gmloco.deploy.mismatch.pipeline import AnalysisCfg
-    from gmloco.deploy.mismatch.replay import ReplayCfg, sand_replay_cfg
+    from gmloco.deploy.mismatch.replay import replay_cfg_for_rate
 
     ground, _, material = str(section.ground).partition(":")  # "plane" or "sand[:MATERIAL]"
     if ground not in ("plane", "sand") or (ground == "plane" and material):
         raise ValueError(f"mismatch.ground={section.ground!r}: use 'plane', 'sand' or 'sand:<material preset>'")
-    replay = (
-        sand_replay_cfg(material or "dry_sand", horizon=int(section.horizon))
-        if ground == "sand"
-        else ReplayCfg(horizon=int(section.horizon))
-    )
+    horizon = None if section.horizon is None else int(section.horizon)
+    replay = replay_cfg_for_rate(rate_hz, ground, material or "dry_sand", horizon)
     cfg = AnalysisCfg(replay=replay, mirror_check=bool(section.mirror_check))
     cfg.attribution.effects = None if section.effects is None else tuple(str(e) for e in section.effects)
     cfg.attribution.n_boot = int(section.n_boot)
@@ -69,7 +66,7 @@ def run(cfg: DictConfig) -> dict[str, Any]:
     rec = read_recording(str(section.real))
     if section.duration_s is not None:
         rec = rec.slice(0, min(rec.n, round(float(section.duration_s) / rec.dt)))
-    result = analyze(rec, _analysis_cfg(section))
+    result = analyze(rec, _analysis_cfg(section, 1.0 / rec.dt))
     write_report(result, Path(section.out_dir), plots=bool(section.plots))
     return _metrics(result.report) | {"recording_s": float(rec.n * rec.dt)}
 

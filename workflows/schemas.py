@@ -348,8 +348,8 @@ class MismatchCfg(StageCfg):
     """The "real" recording (MCAP, project schema); default: a committed sample recording."""
     duration_s: float | None = None
     """Analyze only the first ``duration_s`` seconds [s] (at least ~5 s); None: the whole recording."""
-    horizon: int = 30
-    """Shooting horizon of the replay [samples]."""
+    horizon: int | None = None
+    """Shooting horizon of the replay [samples]; None: 60 ms at the recording's rate (30 samples at 500 Hz)."""
     ground: str = "plane"
     """Nominal ground of the replay: ``plane`` (rigid) or ``sand[:MATERIAL]`` (3D-RFT sand, material preset, default
     dry_sand), as ``gmloco-mismatch --ground``."""

@@ -224,6 +224,7 @@ def test_episode_mcap_round_trip(tmp_path: Path) -> None:
     _, acc = lg.signal("imu.accelerometer")
     np.testing.assert_allclose(acc[:, 2], 9.81, atol=1e-6)
     assert lg.metadata.contact_model == "mpm" and lg.metadata.material == "dry_sand"
+    assert lg.metadata.extra["derived_signals"] == "imu.accelerometer"  # the mismatch replay leaves it out
     assert not lg.has("student.eta")  # no decoded eta given: no topic
     eta = np.linspace(0.1, 0.4, n)
     eta[:3] = np.nan  # e.g. a policy step before the student's history is read: not written

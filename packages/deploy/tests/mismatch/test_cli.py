@@ -36,3 +36,12 @@ def test_cli_writes_report(delay_rec: object, tmp_path: Path) -> None:
     assert rep["verdict"] == "explained" and rep["winner"] == "actuator.delay"
     assert "actuator.delay" in json.loads((out / "config_patch.json").read_text())
     assert "Verdict" in (out / "report.md").read_text()
+
+
+def test_cli_refuses_a_material_on_the_plane_and_a_zero_horizon(delay_rec: object, tmp_path: Path) -> None:
+    """``--ground plane:dry_sand`` and ``--horizon 0`` stop with exit code 2 and no report."""
+    path = write_recording(delay_rec, tmp_path / "real.mcap")
+    for extra in (["--ground", "plane:dry_sand"], ["--horizon", "0"]):
+        out = tmp_path / extra[0].strip("-")
+        assert main(["--real", str(path), "--out", str(out), "--no-plots", *extra]) == 2
+        assert not (out / "report.json").exists()

@@ -70,7 +70,9 @@ def write_episode_mcap(path: str | Path, ep: dict[str, Any], meta: dict[str, str
               TOPIC_POLICY_ACTION, TOPIC_SIM_CONTACT)  # fmt: skip
     md = RunMetadata(controller="policy", policy=meta.get("policy", "none"), material=meta.get("material", "sand"),
                      contact_model="mpm", source="sim", lowstate_rate_hz=1.0 / dt, control_rate_hz=1.0 / dt,
-                     notes=meta.get("notes", ""))  # fmt: skip
+                     notes=meta.get("notes", ""),
+                     # the accelerometer below is a central difference of the logged base velocity, not a sensor
+                     extra={"derived_signals": "imu.accelerometer"})  # fmt: skip
     cmd = np.asarray(ep["command"], dtype=np.float64)
     zeros = np.zeros(len(G1_JOINT_NAMES))
     eta = np.asarray(ep.get("eta", np.full(len(q), np.nan)), dtype=np.float64).reshape(-1)[: len(q)]

@@ -22,7 +22,12 @@ def _parser() -> argparse.ArgumentParser:
         "--out", required=True, type=Path, help="output directory (report.json, report.md, plots, config_patch.json)"
     )
     p.add_argument("--effects", default=None, help="comma-separated effect ids to screen (default: the whole library)")
-    p.add_argument("--horizon", type=int, default=30, help="shooting horizon [samples]")
+    p.add_argument(
+        "--horizon",
+        type=int,
+        default=None,
+        help="shooting horizon [samples]; default 60 ms at the recording's rate (30 samples at 500 Hz, 3 at 50 Hz)",
+    )
     p.add_argument(
         "--ground",
         default="plane",
@@ -40,7 +45,7 @@ def main(argv: list[str] | None = None) -> int:
 
     from gmloco.deploy.mismatch.io import read_recording
     from gmloco.deploy.mismatch.pipeline import AnalysisCfg, analyze
-    from gmloco.deploy.mismatch.replay import ReplayCfg, sand_replay_cfg
+    from gmloco.deploy.mismatch.replay import replay_cfg_for_rate
     from gmloco.deploy.mismatch.report import write_report
 
     args = _parser().parse_args(argv)
@@ -59,11 +64,14 @@ def main(argv: list[str] | None = None) -> int:
     if ground not in ("plane", "sand"):
         console.print(f"[red]--ground {args.ground!r}: expected 'plane' or 'sand[:MATERIAL]'")
         return 2
-    replay = (
-        sand_replay_cfg(material or "dry_sand", 1.0 / rec.dt, args.horizon)
-        if ground == "sand"
-        else ReplayCfg(horizon=args.horizon)
-    )
+    if ground == "plane" and material:
+        console.print(f"[red]--ground {args.ground!r}: a material goes with 'sand' only ('sand:{material}')")
+        return 2
+    if args.horizon is not None and args.horizon < 1:
+        console.print(f"[red]--horizon {args.horizon}: at least 1 sample")
+        return 2
+    # the physics step and the time spans follow the recording's rate (MPM recordings are 50 Hz, a G1 500 Hz)
+    replay = replay_cfg_for_rate(1.0 / rec.dt, ground, material or "dry_sand", args.horizon)
     cfg = AnalysisCfg(replay=replay)
     if args.effects:
         cfg.attribution.effects = tuple(s.strip() for s in args.effects.split(","))

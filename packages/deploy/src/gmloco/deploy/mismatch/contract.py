@@ -335,6 +335,16 @@ def _channels(rec: Recording) -> list[ContractIssue]:
                 "channels", "warning", "tau_est is all zero: torque channels excluded", {"tau_est": "missing"}
             )
         )
+    if rec.acc_derived:
+        issues.append(
+            ContractIssue(
+                "channels",
+                "warning",
+                "imu.accelerometer is derived (a finite difference of the logged velocity, as in the MPM evaluation's "
+                "recordings), not a sensor: acc channels excluded",
+                {"imu_acc": "derived"},
+            )
+        )
     return issues
 
 

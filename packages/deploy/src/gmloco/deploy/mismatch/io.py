@@ -4,6 +4,7 @@
 from __future__ import annotations
 
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 
@@ -24,6 +25,15 @@ def _resample(t_src: np.ndarray, x: np.ndarray, t: np.ndarray, hold: bool) -> np
     else:
         out = np.stack([np.interp(t, t_src, flat[:, i]) for i in range(flat.shape[1])], axis=1)
     return out.reshape((len(t), *x.shape[1:]))
+
+
+def _derived_signals(md: Any) -> str:
+    """Signals the log derived rather than measured (``RunMetadata.extra["derived_signals"]``, comma-separated).
+
+    MPM-evaluation logs (``contact_model == "mpm"``) written before they declared it derive the accelerometer too.
+    """
+    derived = md.extra.get("derived_signals", "")
+    return derived or ("imu.accelerometer" if md.contact_model == "mpm" else "")
 
 
 def read_recording(path: str | Path, rate_hz: float | None = None) -> Recording:
@@ -68,7 +78,12 @@ def read_recording(path: str | Path, rate_hz: float | None = None) -> Recording:
         imu_gyro=get("imu.gyroscope"),
         imu_acc=get("imu.accelerometer"),
         valid=near <= 1.5 / rate,
-        meta={"path": str(path), "controller": log.metadata.controller, "material": log.metadata.material},
+        meta={
+            "path": str(path),
+            "controller": log.metadata.controller,
+            "material": log.metadata.material,
+            "derived_signals": _derived_signals(log.metadata),
+        },
         base_pos=base_pos,
         base_quat=base_quat,
         base_linvel=base_linvel,

@@ -126,6 +126,8 @@ class Problem:
         self.weight = np.ones(N_CHANNELS)
         if np.allclose(rec.tau_est, 0.0):
             self.weight[58:87] = 0.0
+        if rec.acc_derived:  # a finite difference is no sensor sample: leave the acc group out
+            self.weight[90:93] = 0.0
         if floor.exclude_arms:
             for off in (0, 29, 58):
                 self.weight[off + 15 : off + 29] = 0.0

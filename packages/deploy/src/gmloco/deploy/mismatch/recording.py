@@ -81,6 +81,14 @@ class Recording:
             return None
         return self.base_pos, self.base_quat, self.base_linvel, self.base_angvel
 
+    @property
+    def acc_derived(self) -> bool:
+        """Whether the accelerometer is derived, not measured (``meta["derived_signals"]`` names it).
+
+        A finite difference of the logged velocity cannot be compared with a simulated sensor sample.
+        """
+        return "imu.accelerometer" in str(self.meta.get("derived_signals", "")).split(",")
+
     def valid_mask(self) -> np.ndarray:
         """Return the per-sample validity mask, shape [N]."""
         return np.ones(self.n, bool) if self.valid is None else self.valid.astype(bool)

@@ -31,6 +31,7 @@ __all__ = [
     "Replayer",
     "attitude_rate_residual",
     "channel_names",
+    "replay_cfg_for_rate",
     "sand_replay_cfg",
 ]
 
@@ -109,17 +110,53 @@ class ReplayCfg:
     """Half window of the gyro-vs-attitude-rate channel [samples] (16 ms at 500 Hz)."""
 
 
-def sand_replay_cfg(material: str = "dry_sand", rate_hz: float = 500.0, horizon: int = 30) -> ReplayCfg:
-    """Return the replay settings for the project's 3D-RFT sand as nominal ground.
+PLANE_STEP_S = 0.002
+"""Physics step of the rigid-plane replay [s] (one step per sample at 500 Hz)."""
+SAND_STEP_S = 0.001
+"""Physics step of the 3D-RFT sand replay [s]: on a walking null, 1 kHz removes a third of the 500 Hz residual
+energy (the sand's elastic branch is stiff) for 1.3x the cost."""
+HORIZON_S = 0.06
+"""Default shooting horizon [s] (30 samples at 500 Hz)."""
+ATTITUDE_HALF_WINDOW_S = 0.016
+"""Half window of the gyro-vs-attitude-rate channel [s] (8 samples at 500 Hz)."""
 
-    Two physics steps per log sample: on a walking null, 1 kHz removes a third of the 500 Hz residual energy
-    (the sand's elastic branch is stiff) for 1.3x the cost.
+
+def replay_cfg_for_rate(
+    rate_hz: float, ground: str = "plane", material: str = "dry_sand", horizon: int | None = None
+) -> ReplayCfg:
+    """Replay settings for a recording sampled at ``rate_hz``: the 500 Hz defaults' times, in its samples.
+
+    The physics step stays ``PLANE_STEP_S`` / ``SAND_STEP_S`` (``substeps`` per sample), the horizon
+    ``HORIZON_S`` (at least 3 samples) unless given [samples], the compare stride a tenth of the horizon and the
+    attitude window ``ATTITUDE_HALF_WINDOW_S``. At 500 Hz this is ``ReplayCfg()`` (plane) and the sand replay of
+    the benchmark; at 50 Hz (the MPM evaluation's recordings) 10 or 20 steps per sample and a 3-sample horizon.
+
+    Raises:
+        ValueError: a non-positive rate, an unknown ground or a horizon below 1.
     """
-    return ReplayCfg(
-        horizon=horizon,
-        substeps=2,
-        sim=G1SimCfg(timestep=0.5 / rate_hz, ground="sand", sand=SandCfg(material=material)),
-    )
+    if not rate_hz > 0:
+        raise ValueError(f"rate_hz={rate_hz}: a recording's sample rate must be positive")
+    if ground not in ("plane", "sand"):
+        raise ValueError(f"ground={ground!r}: use 'plane' or 'sand'")
+    if horizon is not None and horizon < 1:
+        raise ValueError(f"horizon={horizon}: at least 1 sample")
+    step = SAND_STEP_S if ground == "sand" else PLANE_STEP_S
+    substeps = max(1, round(1.0 / (rate_hz * step)))
+    h = horizon if horizon is not None else max(3, round(HORIZON_S * rate_hz))
+    timestep = 1.0 / (rate_hz * substeps)
+    sim = G1SimCfg(timestep=timestep, ground="sand", sand=SandCfg(material=material)) if ground == "sand" else \
+        G1SimCfg(timestep=timestep)  # fmt: skip
+    return ReplayCfg(horizon=h, stride=max(1, round(h / 10)), substeps=substeps, sim=sim,
+                     attitude_half_window=max(1, round(ATTITUDE_HALF_WINDOW_S * rate_hz)))  # fmt: skip
+
+
+def sand_replay_cfg(material: str = "dry_sand", rate_hz: float = 500.0, horizon: int = 30) -> ReplayCfg:
+    """Return the replay settings for the project's 3D-RFT sand as nominal ground (``replay_cfg_for_rate``).
+
+    Two physics steps per log sample at 500 Hz: on a walking null, 1 kHz removes a third of the 500 Hz residual
+    energy (the sand's elastic branch is stiff) for 1.3x the cost.
+    """
+    return replay_cfg_for_rate(rate_hz, "sand", material, horizon)
 
 
 @dataclass

@@ -61,12 +61,17 @@ def _explain(h: Any) -> str:
 
 
 def _group_nrmse(pb: Any, sim: np.ndarray) -> dict[str, float]:
-    """Held-out RMSE / std(real) per signal group."""
+    """Held-out RMSE / std(real) per signal group the residual uses.
+
+    Excluded groups (a missing ``tau_est``, a derived accelerometer) are left out.
+    """
     out, c = {}, 0
     y = pb.y[pb.held]
     for g, w in CHANNEL_GROUPS:
         sl = slice(c, c + w)
         c += w
+        if not np.any(pb.weight[sl] > 0):
+            continue
         err = np.sqrt(np.mean((y[..., sl] - sim[pb.held][..., sl]) ** 2))
         out[g] = float(err / max(np.std(y[..., sl]), 1e-12))
     return out
