@@ -3,6 +3,7 @@
 
 from __future__ import annotations
 
+import json
 import math
 import time
 from dataclasses import replace
@@ -544,3 +545,38 @@ def test_heading_turn_wraps_around() -> None:
     yaw = np.radians([170.0, 180.0, -170.0, 90.0])
     assert math.isclose(heading_turn_deg(yaw, 3), 20.0, rel_tol=1e-9)
     assert math.isclose(heading_turn_deg(yaw, 4), 80.0, rel_tol=1e-9)
+
+
+def test_each_group_records_its_best_walk_once_per_cell(monkeypatch: pytest.MonkeyPatch, tmp_path: Path) -> None:
+    """One recording per group, its best walk, written after the cell.
+
+    Episode 0 falls at step 3, episodes 1-4 stand the 0.2 s out: episode 1 (the first of the longest) is recorded; a
+    resumed run replaces it only with a better walk than its sidecar's.
+    """
+    import gmloco.eval.g1_eval as g1_eval
+    import gmloco.eval.g1_eval_record as g1_eval_record
+
+    cfg, _ = _cell(monkeypatch, {0: 3})
+    cfg = replace(cfg, record_mcap=True)
+    monkeypatch.setattr(g1_eval, "load_policy", lambda path, n=1: _Policy())
+    monkeypatch.setattr(g1_eval, "write_outputs", lambda *a, **k: None)
+    written: list[str] = []
+
+    def fake_write(path: Path, ep: dict, meta: dict) -> Path:
+        written.append(ep["spec"].key)
+        Path(path).write_bytes(b"mcap")
+        return Path(path)
+
+    monkeypatch.setattr(g1_eval_record, "write_episode_mcap", fake_write)
+    g1_eval.run(replace(cfg, out_dir=str(tmp_path)))
+    side = tmp_path / "recordings" / "dry_sand__straight__v1.json"
+    doc = json.loads(side.read_text())
+    assert written == ["dry_sand/straight/1"] and doc["key"] == "dry_sand/straight/1" and not doc["success"]
+    assert doc["alive_s"] == pytest.approx(0.2) and (tmp_path / "recordings" / doc["mcap"]).exists()
+    g1_eval.run(replace(cfg, out_dir=str(tmp_path), num_episodes=7))  # episodes 5-6 stand 0.2 s: not better
+    assert written == ["dry_sand/straight/1"]
+    side.write_text(json.dumps(doc | {"alive_s": 0.05}))  # an earlier pick that walked less
+    g1_eval.run(replace(cfg, out_dir=str(tmp_path), num_episodes=9))
+    # episodes 7-8 in a fresh scene: its lane 0 replays the stand-in's episode-0 fall, so 8 is the better walk
+    assert written == ["dry_sand/straight/1", "dry_sand/straight/8"]
+    assert g1_eval.recording_rank({"success": True, "alive_s": 8.2}) > g1_eval.recording_rank({"alive_s": 10.0})

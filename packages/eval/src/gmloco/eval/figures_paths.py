@@ -1,9 +1,9 @@
 # SPDX-License-Identifier: Apache-2.0
 """Executed against commanded paths of the MPM evaluation's recorded episodes (what the DTW path error scores).
 
-Each ``g1_eval`` run records the first episode of every (terrain, scenario, speed) group to end as
-``recordings/<terrain>__<scenario>__v<speed>.mcap`` (with lanes running side by side, an early fall ends first, so a
-recorded walk shows one episode, not the group's typical one). :func:`recorded_path` reads one back as the pelvis path in its
+Each ``g1_eval`` run records the best walk of every (terrain, scenario, speed) group (a success if any, else the
+longest time alive; runs before session 20: the first episode to end, often an early fall) as
+``recordings/<terrain>__<scenario>__v<speed>.mcap``: one episode, not the group's typical one. :func:`recorded_path` reads one back as the pelvis path in its
 start frame (start at the origin, heading +x) with the command it walked; :func:`fig_paths` draws a panel per policy
 (or run), each speed's executed path solid over its commanded path dashed, marked where it ended: a cross where the
 robot fell, a star where it finished the course (an episode ends there), nothing where the 10 s ran out.

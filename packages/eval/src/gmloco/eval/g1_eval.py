@@ -29,7 +29,8 @@ with :mod:`gmloco.eval.metrics.locomotion`:
 
 Outputs under ``out_dir``: ``episodes.jsonl`` (one line per finished episode; the resume state),
 ``summary.json`` (metrics per group, throughput, config), the paper-shaped tables (``tables_mpm``), figures
-(``figures_mpm``) and ``recordings/<terrain>__<scenario>__v<speed>.mcap`` (the first episode of every group).
+(``figures_mpm``) and ``recordings/<terrain>__<scenario>__v<speed>.mcap`` (the best walk of every group: a success
+if any, else the longest time alive; ``.json`` beside it names the episode).
 """
 
 from __future__ import annotations
@@ -151,7 +152,9 @@ class G1EvalCfg:
     failure: FailureCfg = field(default_factory=FailureCfg)
     """Failure rules."""
     record_mcap: bool = True
-    """Write the first episode of every (terrain, scenario, speed) group as an MCAP recording."""
+    """Write the best walk of every (terrain, scenario, speed) group as an MCAP recording (``recordings/``): a success
+    if any, else the longest time alive; a sidecar JSON names the episode. Runs before session 20 recorded the
+    group's first episode to end."""
     seed: int = 0
     """Seed of the sand."""
     device: str | None = None
@@ -602,16 +605,40 @@ def summarize(rows: list[dict[str, Any]]) -> dict[str, float]:
     return out
 
 
+def _recording_path(out: Path, spec: EpisodeSpec) -> Path:
+    return out / "recordings" / f"{spec.terrain}__{spec.scenario}__v{spec.speed:g}.mcap"
+
+
+def recording_rank(row: dict[str, Any]) -> tuple[bool, float]:
+    """How well an episode shows its group's walk: successes first, then the longer time alive."""
+    return bool(row.get("success")), float(row.get("alive_s") or 0.0)
+
+
+def _recorded_ranks(out: Path) -> dict[str, tuple[bool, float]]:
+    """Rank of each group's recording so far, from its sidecar (``recordings/<group>.json``)."""
+    ranks = {}
+    for side in (out / "recordings").glob("*.json"):
+        try:
+            doc = json.loads(side.read_text())
+            ranks[doc["group"]] = (bool(doc["success"]), float(doc["alive_s"]))
+        except (OSError, ValueError, KeyError):
+            continue  # a damaged sidecar: the group is recorded again
+    return ranks
+
+
 def _record(log: dict[str, Any], row: dict[str, Any], cfg: G1EvalCfg, out: Path) -> None:
-    """MCAP recording of one episode (the group's first)."""
+    """MCAP recording of one episode, with a sidecar saying which (``recordings/<group>.json``)."""
     from gmloco.eval.g1_eval_record import write_episode_mcap
 
     spec: EpisodeSpec = log["spec"]
-    path = out / "recordings" / f"{spec.terrain}__{spec.scenario}__v{spec.speed:g}.mcap"
+    path = _recording_path(out, spec)
     path.parent.mkdir(parents=True, exist_ok=True)
     notes = f"gmloco MPM eval episode {spec.key}: voxel {cfg.solver.voxel_size} m, moving window {cfg.window.moving}"
     write_episode_mcap(path, log, {"policy": Path(cfg.policy_path).name, "material": spec.terrain, "notes": notes,
                                    "end_reason": "completed" if row["success"] else row["reason"]})  # fmt: skip
+    side = {"group": spec.group, "key": spec.key, "success": bool(row["success"]), "alive_s": row["alive_s"],
+            "reason": row["reason"], "mcap": path.name}  # fmt: skip
+    path.with_suffix(".json").write_text(json.dumps(side) + "\n")
 
 
 def read_episodes(path: Path, repair: bool = False) -> list[dict[str, Any]]:
@@ -656,7 +683,13 @@ def run(cfg: G1EvalCfg) -> tuple[dict[str, float], bool]:
         log_path.unlink()
     rows = read_episodes(log_path, repair=True) if log_path.exists() else []
     done = {r["key"] for r in rows}
-    recorded = {f"{r['terrain']}/{r['scenario']}/v{r['speed']:g}" for r in rows}
+    # each group's recording is its best walk (recording_rank): earlier calls' picks, then this call's best so far
+    recorded = _recorded_ranks(out)
+    for r in rows:  # runs before session 20 recorded a group's first episode and wrote no sidecar
+        group = f"{r['terrain']}/{r['scenario']}/v{r['speed']:g}"
+        if group not in recorded and _recording_path(out, _spec_of(r)).exists():
+            recorded[group] = recording_rank(r)
+    best: dict[str, tuple[tuple[bool, float], dict[str, Any], dict[str, Any]]] = {}
     todo = [s for s in episode_specs(cfg) if s.key not in done]
     policy = load_policy(cfg.policy_path, min(cfg.robots_per_batch, max(len(todo), 1)))
     t0, complete = time.perf_counter(), True
@@ -664,14 +697,11 @@ def run(cfg: G1EvalCfg) -> tuple[dict[str, float], bool]:
     batches = episode_batches(todo, len(todo) if cfg.refill else cfg.robots_per_batch)
 
     def on_episode(lg: dict[str, Any]) -> None:
-        """Score, record (first episode of a group) and append one finished episode to ``episodes.jsonl``."""
+        """Score one finished episode, keep it if it is its group's best walk so far, append it to the log."""
         row = score_episode(lg["spec"], cfg, lg)
-        if cfg.record_mcap and lg["spec"].group not in recorded:
-            try:
-                _record(lg, row, cfg, out)
-            except ImportError as exc:  # no mcap / foxglove schemas installed: keep the episodes
-                row["recording"] = f"skipped: {exc}"
-            recorded.add(lg["spec"].group)
+        group, rank = lg["spec"].group, recording_rank(row)
+        if cfg.record_mcap and rank > max(recorded.get(group, (False, -1.0)), best.get(group, ((False, -1.0),))[0]):
+            best[group] = (rank, lg, row)
         rows.append(row)
         with log_path.open("a") as f:
             f.write(json.dumps(row) + "\n")
@@ -681,7 +711,9 @@ def run(cfg: G1EvalCfg) -> tuple[dict[str, float], bool]:
             complete = False
             break
         label = f"cell {i + 1}/{len(batches)} ({len(batch)} episodes, {min(len(batch), cfg.robots_per_batch)} lanes)"
-        if not run_cell(batch, cfg, policy, on_episode, deadline, label):
+        cell_done = run_cell(batch, cfg, policy, on_episode, deadline, label)
+        _write_recordings(best, recorded, cfg, out)  # after every cell, so a time box keeps them
+        if not cell_done:
             complete = False  # the time box ended inside the cell: its running episodes are unfinished, not kept
             break
     summary = summarize(rows)
@@ -691,6 +723,24 @@ def run(cfg: G1EvalCfg) -> tuple[dict[str, float], bool]:
     write_outputs(out, cfg, rows, summary, complete)
     report_window(rows, cfg.window)
     return summary, complete
+
+
+def _write_recordings(best: dict[str, Any], recorded: dict[str, tuple[bool, float]], cfg: G1EvalCfg, out: Path) -> None:
+    """Write the groups' best walks held in ``best`` (emptied) and remember their ranks in ``recorded``."""
+    import sys
+
+    for group, (rank, lg, row) in list(best.items()):
+        try:
+            _record(lg, row, cfg, out)
+            recorded[group] = rank
+        except ImportError as exc:  # no mcap / foxglove schemas installed: keep the episodes, say why
+            print(f"recording of {group} skipped: {exc}", file=sys.stderr, flush=True)
+        del best[group]
+
+
+def _spec_of(row: dict[str, Any]) -> EpisodeSpec:
+    """The spec fields a recording's path needs, from an episode row."""
+    return EpisodeSpec(terrain=row["terrain"], scenario=row["scenario"], speed=float(row["speed"]), index=0)
 
 
 WINDOW_SUGGEST_MARGIN_M = 0.05
