@@ -14,6 +14,10 @@
 #   4. basalt at the square window (session 16 at the tables' window: 50 of 100, 94 % turned out of it), resuming
 #      session 20's share 0 (started, no episode ended), then rough dry sand (31 % exits, 20 % by turn);
 #   5. the two circle shares cut by earlier time boxes: ppo_rigid 1.0 m/s (23 of 25), clr50 1.0 m/s (24 of 25).
+#   The rows' windows: `python -m gmloco.eval.tables_todo` (../tables/todo_tasks.txt) lists the same rows; its
+#   windows hold the 97.5th percentile of the recorded reach, fall included (basalt 1.45 x 1.45, rough 1.65 x 1.65,
+#   poppy seed / deep sand 1.7 x 0.7 m). Here basalt and rough keep the dry-sand row's square (one window for the
+#   per-terrain rows; their reach exits past its rear came at 2.0-2.5 m/s while stumbling, as on dry sand's 11 %).
 #   Before (here): scripts/gpu/snapshot_src.sh && cp results/mpm_eval/gpu_s20/job_next.sh .devsrc/job.sh &&
 #     rm -rf .devsrc/row && mkdir -p .devsrc/row &&
 #     cp -r results/mpm_eval/gpu_s20/runs/table_td_{dry_sand_sq_share2,basalt_sq_share0}of4 \

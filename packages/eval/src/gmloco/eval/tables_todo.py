@@ -1,0 +1,214 @@
+# SPDX-License-Identifier: Apache-2.0
+"""What the paper's tables still need, written as a task file for the GPU queue (issue 9).
+
+Reads the runs behind the tables (``--run`` / ``--runs-file``, as ``gmloco.eval.paper_tables``) and lists, per
+(policy, terrain, scenario) row:
+
+* **reruns**: rows in which more than ``WINDOW_EXIT_NOTE_PCT`` % of the episodes had a sole leave its sand window
+  early. The rerun takes the window that holds the row's recorded reach (``g1_eval.covering_window`` of the reach
+  that all but half that share of its walks stayed within: the rear or front grown where the soles passed it, a
+  square where the robot turned out of it), one share per speed;
+* **resumes**: run folders of rows short of ``--episodes`` (time boxes), each resumed under its own name (copy the
+  folder to where the queue writes, ``.devsrc/row/`` for ``scripts/gpu/run_queue.sh``).
+
+The task file holds one ``NAME g1_eval_cli-arguments`` line per task (``python -m gmloco.eval.g1_eval_queue
+--tasks FILE``), resumes first (they finish rows), then reruns, most exits first, each with a comment saying why. A
+row can appear in both: the resume completes it at its window, the rerun replaces it. Exits by reach in a stumble
+shortly before a fall may not change a walk's outcome; the rule is the tables' (``WINDOW_EXIT_NOTE_PCT``).
+
+    python -m gmloco.eval.tables_todo --runs-file results/mpm_eval/tables/runs.txt --out /tmp/todo_tasks.txt
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import math
+import re
+import shlex
+from dataclasses import dataclass, fields, replace
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from gmloco.eval.g1_eval import WINDOW_EXIT_MARGIN_M, G1EvalCfg, covering_window, episode_specs, read_episodes
+from gmloco.eval.g1_eval_cli import cli_args
+from gmloco.eval.metrics.locomotion import FailureCfg
+from gmloco.eval.mpm.box_scene import MpmSolverCfg
+from gmloco.eval.mpm.window import SandWindowCfg
+from gmloco.eval.paper_tables import WINDOW_EXIT_NOTE_PCT, runs_file
+
+__all__ = ["TURN_SHARE", "Todo", "cfg_from_summary", "main", "todo"]
+
+TURN_SHARE = 0.1
+"""A row's rerun window is a square when at least this fraction of its early exits came from the robot's turn
+(recorded, or inferred for runs before session 16: soles that never reached past the window's extent) [-]."""
+
+
+@dataclass
+class Todo:
+    """One task of the list: its queue line and why."""
+
+    name: str
+    """Task name = run folder name under the queue's output folder."""
+    line: str
+    """``NAME g1_eval_cli-arguments``."""
+    why: str
+    """What it completes."""
+    resume_from: str | None = None
+    """The run folder to copy beside the queue's output (resumes only)."""
+
+
+def cfg_from_summary(cfg: dict[str, Any]) -> G1EvalCfg:
+    """A run's ``G1EvalCfg`` from its ``summary.json`` ``cfg`` (unknown keys of older runs ignored)."""
+
+    def build(cls: type, d: dict[str, Any]) -> Any:
+        names = {f.name for f in fields(cls)}
+        return cls(**{k: v for k, v in d.items() if k in names})
+
+    top = {k: v for k, v in cfg.items() if k not in ("window", "solver", "failure")}
+    out = build(G1EvalCfg, top)
+    return replace(
+        out,
+        terrains=tuple(out.terrains),
+        scenarios=tuple(out.scenarios),
+        speeds=tuple(float(v) for v in out.speeds),
+        window=build(SandWindowCfg, cfg.get("window", {})),
+        solver=build(MpmSolverCfg, cfg.get("solver", {})),
+        failure=build(FailureCfg, cfg.get("failure", {})),
+    )
+
+
+def _line(name: str, cfg: G1EvalCfg) -> str:
+    args = cli_args(replace(cfg, resume=True, max_minutes=None, device=None))
+    if cfg.shards > 1:
+        args += ["--shard", f"{cfg.shard}/{cfg.shards}"]
+    return f"{name} {shlex.join(args)}"
+
+
+def _slug(text: str) -> str:
+    return re.sub(r"[^A-Za-z0-9_.]+", "_", text).strip("_")
+
+
+def _row_key(label: str, r: dict[str, Any]) -> tuple[str, str, str]:
+    return label, str(r["terrain"]), str(r["scenario"])
+
+
+def todo(runs: list[tuple[str, Path]], episodes: int = 100, exit_pct: float = WINDOW_EXIT_NOTE_PCT) -> list[Todo]:
+    """The tasks that complete the tables of ``runs`` (label, run folder): resumes first, then window reruns.
+
+    Raises:
+        FileNotFoundError: a run folder without ``summary.json`` or ``episodes.jsonl``.
+    """
+    cfgs: dict[Path, G1EvalCfg] = {}
+    rows: dict[tuple[str, str, str], list[dict[str, Any]]] = {}
+    folders: dict[tuple[str, str, str], list[Path]] = {}
+    for label, d in runs:
+        for need in ("summary.json", "episodes.jsonl"):
+            if not (d / need).is_file():
+                raise FileNotFoundError(f"{d}: no {need}; pass g1_eval output folders")
+        cfgs[d] = cfg_from_summary(json.loads((d / "summary.json").read_text())["cfg"])
+        for r in read_episodes(d / "episodes.jsonl"):
+            key = _row_key(label, r)
+            rows.setdefault(key, []).append(r)
+            if d not in folders.setdefault(key, []):
+                folders[key].append(d)
+    resumes, reruns = [], []
+    for key, rs in rows.items():
+        label, terrain, scenario = key
+        early = [r for r in rs if r.get("window_exit_early")]
+        if 100.0 * len(early) / len(rs) > exit_pct:
+            reruns.append((len(early) / len(rs), _rerun(key, rs, early, cfgs[folders[key][0]], episodes, exit_pct)))
+        if len(rs) >= episodes:
+            continue
+        for d in folders[key]:
+            cfg = cfgs[d]
+            want = [s.key for s in episode_specs(cfg) if (s.terrain, s.scenario) == (terrain, scenario)]
+            have = {r["key"] for r in rs}
+            left = sum(k not in have for k in want)
+            if left:
+                why = f"{label}/{terrain}/{scenario}: {len(rs)} of {episodes}; {d.name} has {left} left"
+                resumes.append(Todo(d.name, _line(d.name, cfg), why, str(d)))
+    return resumes + [t for _, tasks in sorted(reruns, key=lambda x: -x[0]) for t in tasks]
+
+
+def _turned(r: dict[str, Any], window: SandWindowCfg) -> bool:
+    """Whether an early exit came from the robot's turn.
+
+    Its recorded cause, or (runs before session 16 recorded none) soles that never reached past the window's extent
+    along the heading.
+    """
+    if r.get("window_exit_cause") is not None:
+        return r["window_exit_cause"] == "turn"
+    reach = [float(v) for k in ("sole_behind_m", "sole_ahead_m", "sole_side_m") if (v := r.get(k)) is not None]
+    if len(reach) < 3 or not all(math.isfinite(v) for v in reach):
+        return True  # nothing known: a square holds a turn and the tables' reach alike
+    b, a, side = (v + WINDOW_EXIT_MARGIN_M for v in reach)
+    half = 0.5 * window.length
+    return b <= half - window.lead and a <= half + window.lead and side <= 0.5 * window.width
+
+
+def _rerun(
+    key: tuple[str, str, str],
+    rs: list[dict[str, Any]],
+    early: list[dict[str, Any]],
+    cfg: G1EvalCfg,
+    episodes: int,
+    exit_pct: float,
+) -> list[Todo]:
+    """One row again at the window holding its reach, one share per speed when the episodes split evenly."""
+    label, terrain, scenario = key
+
+    def most(k: str) -> float:
+        """The reach the rerun's window holds: a high quantile over the row's episodes.
+
+        A lone fall's reach would grow the window for every walk; at most half the exit threshold's share of the
+        walks reaches beyond it.
+        """
+        vals = [float(r[k]) for r in rs if r.get(k) is not None and math.isfinite(float(r[k]))]
+        return float(np.quantile(vals, 1.0 - exit_pct / 200.0)) if vals else 0.0
+
+    turned = sum(_turned(r, cfg.window) for r in early) >= TURN_SHARE * len(early)
+    window = covering_window((most("sole_behind_m"), most("sole_ahead_m"), most("sole_side_m")), cfg.window, turned)
+    n = len(cfg.speeds) if episodes % len(cfg.speeds) == 0 else 1
+    base = replace(cfg, terrains=(terrain,), scenarios=(scenario,), num_episodes=episodes, window=window, shards=n)  # type: ignore[arg-type]
+    stem = _slug(f"{label}_{terrain}_{scenario}_w{window.length:g}x{window.width:g}")
+    why = (f"{label}/{terrain}/{scenario}: {100.0 * len(early) / len(rs):.0f} % early window exits "
+           f"({'turn' if turned else 'reach'}) at {cfg.window.length:g} x {cfg.window.width:g} m (lead "
+           f"{cfg.window.lead:g}); rerun at {window.length:g} x {window.width:g} m (lead {window.lead:g})")  # fmt: skip
+    names = [f"{stem}_share{i}of{n}" if n > 1 else stem for i in range(n)]
+    return [Todo(nm, _line(nm, replace(base, shard=i)), why) for i, nm in enumerate(names)]
+
+
+def main(argv: list[str] | None = None) -> list[Todo]:
+    """Command line: write the task file and print what each task completes."""
+    p = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    p.add_argument("--run", action="append", default=[], help="LABEL=RUN_DIR (repeat)")
+    p.add_argument("--runs-file", type=Path, default=None, help="a file of LABEL=RUN_DIR lines (globs allowed)")
+    p.add_argument("--out", type=Path, required=True, help="the task file to write")
+    p.add_argument("--episodes", type=int, default=100, help="episodes a complete row has (the paper: 100)")
+    p.add_argument("--exit-pct", type=float, default=WINDOW_EXIT_NOTE_PCT,
+                   help="rerun rows with more than this %% of early window exits")  # fmt: skip
+    a = p.parse_args(argv)
+    try:
+        runs = [(lab, Path(d)) for lab, _, d in (r.partition("=") for r in a.run)]
+        runs += runs_file(a.runs_file) if a.runs_file is not None else []
+        if not runs:
+            p.error("give the runs: --run LABEL=RUN_DIR (repeat) and/or --runs-file FILE")
+        tasks = todo(runs, a.episodes, a.exit_pct)
+    except (FileNotFoundError, ValueError) as exc:
+        p.error(str(exc))
+    lines = ["# written by python -m gmloco.eval.tables_todo: resumes first, then window reruns"]
+    for t in tasks:
+        lines += [f"# {t.why}" + (f" (resume: copy {t.resume_from})" if t.resume_from else ""), t.line]
+    a.out.parent.mkdir(parents=True, exist_ok=True)
+    a.out.write_text("\n".join(lines) + "\n")
+    for t in tasks:
+        print(("resume " if t.resume_from else "rerun  ") + t.why)
+    print(f"{len(tasks)} tasks -> {a.out}" if tasks else f"nothing left: the tables are complete -> {a.out}")
+    return tasks
+
+
+if __name__ == "__main__":
+    main()
