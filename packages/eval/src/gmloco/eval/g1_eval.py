@@ -61,6 +61,7 @@ from gmloco.eval.mpm.box_scene import MpmSolverCfg
 from gmloco.eval.mpm.window import SandWindowCfg
 
 __all__ = [
+    "REACH_QUANTILE",
     "WINDOW_EXIT_GRACE_S",
     "WINDOW_EXIT_MARGIN_M",
     "EpisodeSpec",
@@ -744,7 +745,21 @@ def _spec_of(row: dict[str, Any]) -> EpisodeSpec:
 
 
 WINDOW_SUGGEST_MARGIN_M = 0.05
-"""Room a suggested window leaves beyond the soles' largest recorded reach [m]."""
+"""Room a suggested window leaves beyond the soles' recorded reach [m]."""
+REACH_QUANTILE = 0.975
+"""A suggested window holds this quantile of the episodes' reach (a lone fall's reach would grow it for all) [-]."""
+WINDOW_TURN_SHARE = 0.1
+"""A suggested window is a square when at least this fraction of the early exits came from the robot's turn [-]."""
+
+
+def reach_quantile(rows: list[dict[str, Any]], q: float = REACH_QUANTILE) -> tuple[float, float, float]:
+    """The ``q`` quantile over episodes of the soles' reach behind / ahead of / beside the pelvis [m] (NaN: none)."""
+
+    def one(k: str) -> float:
+        vals = [float(v) for r in rows if (v := r.get(k)) is not None and math.isfinite(float(v))]
+        return float(np.quantile(vals, q)) if vals else math.nan
+
+    return one("sole_behind_m"), one("sole_ahead_m"), one("sole_side_m")
 
 
 def covering_window(reach: tuple[float, float, float], window: SandWindowCfg, turned: bool) -> SandWindowCfg:
@@ -789,12 +804,13 @@ def report_window(rows: list[dict[str, Any]], window: SandWindowCfg) -> None:
         why = (f"; in {turned} of them the robot had turned and the soles were within the window's reach along its "
                "heading: the window is a box of the grid's axes and does not turn, so a walk whose heading drifts "
                "needs a square window (--window-width equal to --window-length)") if turned else ""  # fmt: skip
-        cover = covering_window(tuple(reach), window, turned > 0)  # type: ignore[arg-type]
+        q = reach_quantile(rows)
+        cover = covering_window(q, window, turned >= WINDOW_TURN_SHARE * len(early))
         print(f"warning: in {len(early)} of {len(rows)} episodes a sole that needed sand stood outside its sand window "
               f"more than {WINDOW_EXIT_GRACE_S} s before the episode ended (first at {worst['window_exit_s']:.2f} s, "
               f"{worst['key']}): those walks lost their support to the window, not to the sand. Lengthen the window "
               f"or move it back (--window-length, --window-lead, --window-width){why}. A window holding this run's "
-              f"reach: --window-length {cover.length:g} --window-width {cover.width:g} --window-lead {cover.lead:g}",
+              f"reach ({100 * REACH_QUANTILE:g}th percentile): --window-length {cover.length:g} --window-width {cover.width:g} --window-lead {cover.lead:g}",
               file=sys.stderr, flush=True)  # fmt: skip
 
 

@@ -30,20 +30,22 @@ from dataclasses import dataclass, fields, replace
 from pathlib import Path
 from typing import Any
 
-import numpy as np
-
-from gmloco.eval.g1_eval import WINDOW_EXIT_MARGIN_M, G1EvalCfg, covering_window, episode_specs, read_episodes
+from gmloco.eval.g1_eval import (
+    WINDOW_EXIT_MARGIN_M,
+    WINDOW_TURN_SHARE,
+    G1EvalCfg,
+    covering_window,
+    episode_specs,
+    reach_quantile,
+    read_episodes,
+)
 from gmloco.eval.g1_eval_cli import cli_args
 from gmloco.eval.metrics.locomotion import FailureCfg
 from gmloco.eval.mpm.box_scene import MpmSolverCfg
 from gmloco.eval.mpm.window import SandWindowCfg
 from gmloco.eval.paper_tables import WINDOW_EXIT_NOTE_PCT, runs_file
 
-__all__ = ["TURN_SHARE", "Todo", "cfg_from_summary", "main", "todo"]
-
-TURN_SHARE = 0.1
-"""A row's rerun window is a square when at least this fraction of its early exits came from the robot's turn
-(recorded, or inferred for runs before session 16: soles that never reached past the window's extent) [-]."""
+__all__ = ["Todo", "cfg_from_summary", "main", "todo"]
 
 
 @dataclass
@@ -160,17 +162,10 @@ def _rerun(
     """One row again at the window holding its reach, one share per speed when the episodes split evenly."""
     label, terrain, scenario = key
 
-    def most(k: str) -> float:
-        """The reach the rerun's window holds: a high quantile over the row's episodes.
-
-        A lone fall's reach would grow the window for every walk; at most half the exit threshold's share of the
-        walks reaches beyond it.
-        """
-        vals = [float(r[k]) for r in rs if r.get(k) is not None and math.isfinite(float(r[k]))]
-        return float(np.quantile(vals, 1.0 - exit_pct / 200.0)) if vals else 0.0
-
-    turned = sum(_turned(r, cfg.window) for r in early) >= TURN_SHARE * len(early)
-    window = covering_window((most("sole_behind_m"), most("sole_ahead_m"), most("sole_side_m")), cfg.window, turned)
+    # at most half the exit threshold's share of the walks reaches beyond the rerun's window
+    reach = tuple(0.0 if math.isnan(v) else v for v in reach_quantile(rs, 1.0 - exit_pct / 200.0))
+    turned = sum(_turned(r, cfg.window) for r in early) >= WINDOW_TURN_SHARE * len(early)
+    window = covering_window(reach, cfg.window, turned)  # type: ignore[arg-type]
     n = len(cfg.speeds) if episodes % len(cfg.speeds) == 0 else 1
     base = replace(cfg, terrains=(terrain,), scenarios=(scenario,), num_episodes=episodes, window=window, shards=n)  # type: ignore[arg-type]
     stem = _slug(f"{label}_{terrain}_{scenario}_w{window.length:g}x{window.width:g}")
