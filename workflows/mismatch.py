@@ -30,13 +30,14 @@ __all__ = ["main", "run"]
 def _analysis_cfg(section: DictConfig, rate_hz: float = 500.0) -> Any:
     """Return the package's ``AnalysisCfg`` for the stage's section and a recording sampled at ``rate_hz``."""
     from gmloco.deploy.mismatch.pipeline import AnalysisCfg
-    from gmloco.deploy.mismatch.replay import replay_cfg_for_rate
+    from gmloco.deploy.mismatch.replay import parse_ground, replay_cfg_for_rate
 
-    ground, _, material = str(section.ground).partition(":")  # "plane" or "sand[:MATERIAL]"
-    if ground not in ("plane", "sand") or (ground == "plane" and material):
-        raise ValueError(f"mismatch.ground={section.ground!r}: use 'plane', 'sand' or 'sand:<material preset>'")
+    try:
+        ground, material = parse_ground(str(section.ground))
+    except ValueError as exc:
+        raise ValueError(f"mismatch.{exc}") from None
     horizon = None if section.horizon is None else int(section.horizon)
-    replay = replay_cfg_for_rate(rate_hz, ground, material or "dry_sand", horizon)
+    replay = replay_cfg_for_rate(rate_hz, ground, material, horizon)
     cfg = AnalysisCfg(replay=replay, mirror_check=bool(section.mirror_check))
     cfg.attribution.effects = None if section.effects is None else tuple(str(e) for e in section.effects)
     cfg.attribution.n_boot = int(section.n_boot)

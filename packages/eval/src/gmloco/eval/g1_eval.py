@@ -75,6 +75,7 @@ __all__ = [
     "heading_turn_deg",
     "lane_failed",
     "load_policy",
+    "reach_fits",
     "read_episodes",
     "report_window",
     "run",
@@ -465,7 +466,7 @@ def score_episode(spec: EpisodeSpec, cfg: G1EvalCfg, log: dict[str, Any]) -> dic
         "sim_s": log["sim_s"], "frames_per_s": log["frames"] / max(log["sim_s"], 1e-9),
         # the scene's frame at the episode's end and the wall seconds since its first frame, host work included
         # (``sim_s`` is the scene's stepping time: ``G1MpmScene.step`` and, since session 20, every wait for the
-        # frames in flight; before, the waits of the grid-capacity checks went uncounted and rates read ~10 % high)
+        # frames in flight; before, the waits of the grid-capacity checks went uncounted and rates read ~8 % high)
         "end_frame": log["frames"], "elapsed_s": log.get("elapsed_s"),
     }  # fmt: skip
 
@@ -506,10 +507,17 @@ def window_exit_cause(reach: Any, exit_s: float | None, dt: float, window: SandW
     k = min(round(exit_s / dt), len(arr) - 1)
     if not np.isfinite(arr[k]).all():
         return None
-    b, a, s = arr[k] + WINDOW_EXIT_MARGIN_M
+    return "turn" if window.moving and reach_fits(tuple(arr[k]), window) else "reach"
+
+
+def reach_fits(reach: tuple[float, float, float], window: SandWindowCfg) -> bool:
+    """Whether the soles' reach (behind, ahead, beside the pelvis) [m] lies within the window's extent.
+
+    Measured along the robot's heading, less ``WINDOW_EXIT_MARGIN_M``.
+    """
+    b, a, s = (float(v) + WINDOW_EXIT_MARGIN_M for v in reach)
     half = 0.5 * window.length
-    fits = b <= half - window.lead and a <= half + window.lead and s <= 0.5 * window.width
-    return "turn" if window.moving and fits else "reach"
+    return b <= half - window.lead and a <= half + window.lead and s <= 0.5 * window.width
 
 
 def heading_turn_deg(yaw: np.ndarray, alive: int) -> float:
@@ -610,6 +618,10 @@ def _recording_path(out: Path, spec: EpisodeSpec) -> Path:
     return out / "recordings" / f"{spec.terrain}__{spec.scenario}__v{spec.speed:g}.mcap"
 
 
+_UNRECORDED = (False, -1.0)
+"""Rank of a group without a recording: any episode beats it."""
+
+
 def recording_rank(row: dict[str, Any]) -> tuple[bool, float]:
     """How well an episode shows its group's walk: successes first, then the longer time alive."""
     return bool(row.get("success")), float(row.get("alive_s") or 0.0)
@@ -639,7 +651,9 @@ def _record(log: dict[str, Any], row: dict[str, Any], cfg: G1EvalCfg, out: Path)
                                    "end_reason": "completed" if row["success"] else row["reason"]})  # fmt: skip
     side = {"group": spec.group, "key": spec.key, "success": bool(row["success"]), "alive_s": row["alive_s"],
             "reason": row["reason"], "mcap": path.name}  # fmt: skip
-    path.with_suffix(".json").write_text(json.dumps(side) + "\n")
+    tmp = path.with_suffix(".json.tmp")  # tmp + replace: a kill never leaves half a sidecar
+    tmp.write_text(json.dumps(side) + "\n")
+    tmp.replace(path.with_suffix(".json"))
 
 
 def read_episodes(path: Path, repair: bool = False) -> list[dict[str, Any]]:
@@ -687,9 +701,9 @@ def run(cfg: G1EvalCfg) -> tuple[dict[str, float], bool]:
     # each group's recording is its best walk (recording_rank): earlier calls' picks, then this call's best so far
     recorded = _recorded_ranks(out)
     for r in rows:  # runs before session 20 recorded a group's first episode and wrote no sidecar
-        group = f"{r['terrain']}/{r['scenario']}/v{r['speed']:g}"
-        if group not in recorded and _recording_path(out, _spec_of(r)).exists():
-            recorded[group] = recording_rank(r)
+        spec = _spec_of(r)
+        if spec.group not in recorded and _recording_path(out, spec).exists():
+            recorded[spec.group] = recording_rank(r)
     best: dict[str, tuple[tuple[bool, float], dict[str, Any], dict[str, Any]]] = {}
     todo = [s for s in episode_specs(cfg) if s.key not in done]
     policy = load_policy(cfg.policy_path, min(cfg.robots_per_batch, max(len(todo), 1)))
@@ -701,7 +715,8 @@ def run(cfg: G1EvalCfg) -> tuple[dict[str, float], bool]:
         """Score one finished episode, keep it if it is its group's best walk so far, append it to the log."""
         row = score_episode(lg["spec"], cfg, lg)
         group, rank = lg["spec"].group, recording_rank(row)
-        if cfg.record_mcap and rank > max(recorded.get(group, (False, -1.0)), best.get(group, ((False, -1.0),))[0]):
+        held = best[group][0] if group in best else recorded.get(group, _UNRECORDED)
+        if cfg.record_mcap and rank > held:
             best[group] = (rank, lg, row)
         rows.append(row)
         with log_path.open("a") as f:

@@ -41,9 +41,8 @@ def run_rate(episodes: list[dict[str, Any]]) -> dict[str, Any]:
 
     The rate is read from the wall clock (``end_frame / elapsed_s``: frames of the batch over the wall seconds
     since its first frame) of the records that have it (session 19's code on; a run resumed from older records
-    mixes both), else from ``frames_per_s`` (the
-    scene's stepping clock, which until session 20 missed the GPU time waited in the grid-capacity checks and
-    read ~10 % high at 4.4M particles); ``rate_clock`` says which.
+    mixes both), else from ``frames_per_s`` (the scene's stepping clock, which until session 20 missed the GPU
+    time waited in the grid-capacity checks and read ~8 % high at 4.4M particles); ``rate_clock`` says which.
 
     Raises:
         ValueError: no episodes, or an episode without the rate fields (a run older than session 12).

@@ -31,11 +31,11 @@ from pathlib import Path
 from typing import Any
 
 from gmloco.eval.g1_eval import (
-    WINDOW_EXIT_MARGIN_M,
     WINDOW_TURN_SHARE,
     G1EvalCfg,
     covering_window,
     episode_specs,
+    reach_fits,
     reach_quantile,
     read_episodes,
 )
@@ -146,9 +146,7 @@ def _turned(r: dict[str, Any], window: SandWindowCfg) -> bool:
     reach = [float(v) for k in ("sole_behind_m", "sole_ahead_m", "sole_side_m") if (v := r.get(k)) is not None]
     if len(reach) < 3 or not all(math.isfinite(v) for v in reach):
         return True  # nothing known: a square holds a turn and the tables' reach alike
-    b, a, side = (v + WINDOW_EXIT_MARGIN_M for v in reach)
-    half = 0.5 * window.length
-    return b <= half - window.lead and a <= half + window.lead and side <= 0.5 * window.width
+    return reach_fits((reach[0], reach[1], reach[2]), window)
 
 
 def _rerun(

@@ -45,7 +45,7 @@ def main(argv: list[str] | None = None) -> int:
 
     from gmloco.deploy.mismatch.io import read_recording
     from gmloco.deploy.mismatch.pipeline import AnalysisCfg, analyze
-    from gmloco.deploy.mismatch.replay import replay_cfg_for_rate
+    from gmloco.deploy.mismatch.replay import parse_ground, replay_cfg_for_rate
     from gmloco.deploy.mismatch.report import write_report
 
     args = _parser().parse_args(argv)
@@ -60,18 +60,16 @@ def main(argv: list[str] | None = None) -> int:
             "[yellow]--sim given: the simulated log is checked for its contract only; residuals come from replay at the real states (short horizons), which a free-running sim log cannot provide."
         )
         read_recording(args.sim)
-    ground, _, material = args.ground.partition(":")
-    if ground not in ("plane", "sand"):
-        console.print(f"[red]--ground {args.ground!r}: expected 'plane' or 'sand[:MATERIAL]'")
-        return 2
-    if ground == "plane" and material:
-        console.print(f"[red]--ground {args.ground!r}: a material goes with 'sand' only ('sand:{material}')")
+    try:
+        ground, material = parse_ground(args.ground)
+    except ValueError as exc:
+        console.print(f"[red]--{exc}")
         return 2
     if args.horizon is not None and args.horizon < 1:
         console.print(f"[red]--horizon {args.horizon}: at least 1 sample")
         return 2
     # the physics step and the time spans follow the recording's rate (MPM recordings are 50 Hz, a G1 500 Hz)
-    replay = replay_cfg_for_rate(1.0 / rec.dt, ground, material or "dry_sand", args.horizon)
+    replay = replay_cfg_for_rate(1.0 / rec.dt, ground, material, args.horizon)
     cfg = AnalysisCfg(replay=replay)
     if args.effects:
         cfg.attribution.effects = tuple(s.strip() for s in args.effects.split(","))

@@ -31,6 +31,7 @@ __all__ = [
     "Replayer",
     "attitude_rate_residual",
     "channel_names",
+    "parse_ground",
     "replay_cfg_for_rate",
     "sand_replay_cfg",
 ]
@@ -148,6 +149,18 @@ def replay_cfg_for_rate(
         G1SimCfg(timestep=timestep)  # fmt: skip
     return ReplayCfg(horizon=h, stride=max(1, round(h / 10)), substeps=substeps, sim=sim,
                      attitude_half_window=max(1, round(ATTITUDE_HALF_WINDOW_S * rate_hz)))  # fmt: skip
+
+
+def parse_ground(spec: str) -> tuple[str, str]:
+    """``"plane"`` / ``"sand"`` / ``"sand:MATERIAL"`` -> (ground, material; ``dry_sand`` by default).
+
+    Raises:
+        ValueError: any other spelling (a typo must not fall back to the rigid plane), or a material on the plane.
+    """
+    ground, _, material = spec.partition(":")
+    if ground not in ("plane", "sand") or (ground == "plane" and material):
+        raise ValueError(f"ground {spec!r}: use 'plane', 'sand' or 'sand:<material preset>'")
+    return ground, material or "dry_sand"
 
 
 def sand_replay_cfg(material: str = "dry_sand", rate_hz: float = 500.0, horizon: int = 30) -> ReplayCfg:
