@@ -63,3 +63,13 @@ def test_cut_shares_are_resumed_and_window_exits_rerun(tmp_path: Path) -> None:
     main(["--run", f"td={a[1]}", "--run", f"td={b}", "--out", str(out), "--episodes", "25"])
     check_tasks(file_tasks(out, []))
     assert todo([("td", a[0])], episodes=25) == []  # a complete row without exits needs nothing
+
+
+def test_bad_run_arguments_stop_with_the_expected_form(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    """``--run`` without ``LABEL=`` and a folder without summary.json: exit 2 saying what to pass."""
+    with pytest.raises(SystemExit):
+        main(["--run", str(tmp_path), "--out", str(tmp_path / "t.txt")])
+    assert "expected LABEL=RUN_DIR" in capsys.readouterr().err
+    with pytest.raises(SystemExit):
+        main(["--run", f"td={tmp_path}", "--out", str(tmp_path / "t.txt")])
+    assert "no summary.json" in capsys.readouterr().err

@@ -43,7 +43,7 @@ from gmloco.eval.g1_eval_cli import cli_args
 from gmloco.eval.metrics.locomotion import FailureCfg
 from gmloco.eval.mpm.box_scene import MpmSolverCfg
 from gmloco.eval.mpm.window import SandWindowCfg
-from gmloco.eval.paper_tables import WINDOW_EXIT_NOTE_PCT, runs_file
+from gmloco.eval.paper_tables import WINDOW_EXIT_NOTE_PCT, _run_arg, runs_file
 
 __all__ = ["Todo", "cfg_from_summary", "main", "todo"]
 
@@ -177,7 +177,7 @@ def _rerun(
 def main(argv: list[str] | None = None) -> list[Todo]:
     """Command line: write the task file and print what each task completes."""
     p = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    p.add_argument("--run", action="append", default=[], help="LABEL=RUN_DIR (repeat)")
+    p.add_argument("--run", type=_run_arg, action="append", default=[], help="LABEL=RUN_DIR (repeat)")
     p.add_argument("--runs-file", type=Path, default=None, help="a file of LABEL=RUN_DIR lines (globs allowed)")
     p.add_argument("--out", type=Path, required=True, help="the task file to write")
     p.add_argument("--episodes", type=int, default=100, help="episodes a complete row has (the paper: 100)")
@@ -185,7 +185,7 @@ def main(argv: list[str] | None = None) -> list[Todo]:
                    help="rerun rows with more than this %% of early window exits")  # fmt: skip
     a = p.parse_args(argv)
     try:
-        runs = [(lab, Path(d)) for lab, _, d in (r.partition("=") for r in a.run)]
+        runs = list(a.run)
         runs += runs_file(a.runs_file) if a.runs_file is not None else []
         if not runs:
             p.error("give the runs: --run LABEL=RUN_DIR (repeat) and/or --runs-file FILE")
