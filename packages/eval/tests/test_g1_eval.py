@@ -243,6 +243,9 @@ class _LaneScene:
 
     FALLS: ClassVar[dict[int, int]] = {}
     made: ClassVar[list[_LaneScene]] = []
+    TICK: ClassVar[float] = 0.0
+    """Seconds a frame of one lane advances ``now`` (the stand-in clock of the time-box tests)."""
+    now: ClassVar[list[float]] = [0.0]
 
     def __init__(self, cfg: object, policy: object) -> None:
         n = cfg.num_robots  # type: ignore[attr-defined]
@@ -281,6 +284,7 @@ class _LaneScene:
             for name in LOG_FIELDS:
                 getattr(self, name).append(sample.get(name, np.zeros((self.n, 1))))
         self.frame += 1
+        _LaneScene.now[0] += self.TICK * self.n
 
     def retire_robots(self, robots: list[int]) -> None:
         self.retired.append((list(robots), len(self.base_q)))
@@ -305,8 +309,8 @@ def _cell(monkeypatch: pytest.MonkeyPatch, falls: dict[int, int], **kw: object) 
     monkeypatch.setattr(g1_scene, "G1MpmScene", _LaneScene)
     monkeypatch.setattr(_LaneScene, "FALLS", falls)
     monkeypatch.setattr(_LaneScene, "made", [])
-    cfg = replace(G1EvalCfg(), num_episodes=5, speeds=(1.0,), episode_s=0.2, robots_per_batch=2, record_mcap=False,
-                  **kw)  # fmt: skip
+    base = {"num_episodes": 5, "speeds": (1.0,), "episode_s": 0.2, "robots_per_batch": 2, "record_mcap": False}
+    cfg = replace(G1EvalCfg(), **(base | kw))
     return cfg, episode_specs(cfg)
 
 
@@ -318,7 +322,7 @@ def test_a_fallen_lane_takes_the_next_episode(monkeypatch: pytest.MonkeyPatch) -
     """
     cfg, specs = _cell(monkeypatch, {0: 3})
     logs: list[dict] = []
-    assert run_cell(specs, cfg, _Policy(), logs.append)
+    assert run_cell(specs, cfg, _Policy(), logs.append).finished
     assert [lg["spec"].index for lg in logs] == [0, 1, 2, 3, 4]
     assert [len(lg["base_q"]) for lg in logs] == [4, 10, 10, 10, 10]
     scene = _LaneScene.made[0]
@@ -339,7 +343,7 @@ def test_idle_lanes_keep_their_sand_when_asked(monkeypatch: pytest.MonkeyPatch) 
     """retire_idle_lanes=False: the same episodes, no lane retired (the cost of sessions before 19)."""
     cfg, specs = _cell(monkeypatch, {0: 3}, retire_idle_lanes=False)
     logs: list[dict] = []
-    assert run_cell(specs, cfg, _Policy(), logs.append)
+    assert run_cell(specs, cfg, _Policy(), logs.append).finished
     assert [lg["spec"].index for lg in logs] == [0, 1, 2, 3, 4] and _LaneScene.made[0].retired == []
 
 
@@ -364,8 +368,45 @@ def test_the_time_box_keeps_finished_episodes_only(monkeypatch: pytest.MonkeyPat
     """A deadline already passed: the cell stops at its first check (after one policy step), nothing handed out."""
     cfg, specs = _cell(monkeypatch, {})
     logs: list[dict] = []
-    assert not run_cell(specs, cfg, _Policy(), logs.append, deadline=time.perf_counter() - 1.0)
+    out = run_cell(specs, cfg, _Policy(), logs.append, deadline=time.perf_counter() - 1.0)
+    assert (out.finished, out.stopped) == (False, "time_box")
     assert logs == [] and _LaneScene.made[0].frame == 4  # one policy step, then the check
+
+
+def _time_boxed(monkeypatch: pytest.MonkeyPatch, tmp_path: Path, fit: bool) -> tuple[list[str], bool]:
+    """The episodes logged and whether the run completed: 4 standing episodes of 40 frames in up to 4 lanes.
+
+    A frame costs 0.25 s per lane on a stand-in clock; the time box is 30 s.
+    """
+    import gmloco.eval.g1_eval as g1_eval
+
+    cfg, _ = _cell(monkeypatch, {}, num_episodes=4, robots_per_batch=4, max_minutes=0.5, fit_time_box=fit,
+                   out_dir=str(tmp_path))  # fmt: skip
+    monkeypatch.setattr(_LaneScene, "TICK", 0.25)
+    monkeypatch.setattr(_LaneScene, "now", [0.0])
+    monkeypatch.setattr(g1_eval, "time", SimpleNamespace(perf_counter=lambda: _LaneScene.now[0]))
+    monkeypatch.setattr(g1_eval, "FIT_PROBE_S", 4.0)
+    monkeypatch.setattr(g1_eval, "load_policy", lambda path, n=1: _Policy())
+    monkeypatch.setattr(g1_eval, "write_outputs", lambda *a, **k: None)
+    _, complete = g1_eval.run(cfg)
+    log = tmp_path / "episodes.jsonl"
+    return [json.loads(x)["key"] for x in (log.read_text().splitlines() if log.exists() else [])], complete
+
+
+def test_a_cell_that_cannot_end_in_the_time_box_is_refit(monkeypatch: pytest.MonkeyPatch, tmp_path: Path) -> None:
+    """4 lanes need 40 s for the 40 frames, 30 s are left: the cell stops after its 4 s probe and is rebuilt.
+
+    With 2 lanes (predicted 6.6 + 9.35 n s <= 26 s) it ends at 24 s; 6 s then hold no further 40-frame walk.
+    """
+    keys, complete = _time_boxed(monkeypatch, tmp_path, fit=True)
+    assert keys == ["dry_sand/straight/0", "dry_sand/straight/1"] and not complete
+    assert [s.n for s in _LaneScene.made] == [4, 2] and _LaneScene.now[0] == pytest.approx(24.0)
+
+
+def test_without_the_fit_the_time_box_drops_the_whole_cell(monkeypatch: pytest.MonkeyPatch, tmp_path: Path) -> None:
+    """The same run with ``fit_time_box=False``: the 4-lane cell steps until the box and no episode is kept."""
+    keys, complete = _time_boxed(monkeypatch, tmp_path, fit=False)
+    assert keys == [] and not complete and [s.n for s in _LaneScene.made] == [4]
 
 
 def _run_in(cfg: G1EvalCfg, monkeypatch: pytest.MonkeyPatch) -> tuple[dict, bool]:

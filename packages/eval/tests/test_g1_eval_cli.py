@@ -124,7 +124,7 @@ def test_cli_args_give_back_the_config() -> None:
                   robots_per_batch=9, refill=False, retire_idle_lanes=False, cell_capacity_factor=1.25,
                   solver=replace(base.solver, voxel_size=0.04, max_iterations=321, tolerance=1e-6, frame_dt=0.01,
                                  rigid_substeps=2, rheology_solver="jacobi,gs"),
-                  record_mcap=False, resume=False, seed=3)  # fmt: skip
+                  record_mcap=False, resume=False, fit_time_box=False, seed=3)  # fmt: skip
     back = cfg_from_args(_parse([*cli_args(cfg), "--out", "o"]))
     assert back == cfg
     per_cell = cli_args(cfg, cells=False)

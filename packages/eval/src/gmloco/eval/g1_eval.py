@@ -45,6 +45,7 @@ from typing import Any, Literal
 
 import numpy as np
 
+from gmloco.eval.g1_eval_fit import FIT_MARGIN, FIT_PROBE_S, CellCost, cell_seconds, fit_lanes
 from gmloco.eval.g1_eval_policy import load_policy
 from gmloco.eval.metrics.locomotion import (
     FailureCfg,
@@ -163,6 +164,10 @@ class G1EvalCfg:
     """Warp device."""
     max_minutes: float | None = None
     """Stop (resumable) after this much wall time [min]."""
+    fit_time_box: bool = True
+    """With ``max_minutes``: start only walks that can end before it (``g1_eval_fit``): a cell that would not end
+    in the time left if no robot fell is stopped after ~30 s of stepping and rebuilt with the lanes that fit, a later
+    cell of the same (terrain, scenario) is cut before it is built. False: cells run until the time box drops them."""
     resume: bool = True
     """Keep finished episodes in ``episodes.jsonl``; else start fresh."""
 
@@ -307,8 +312,9 @@ def run_cell(
     on_episode: Callable[[dict[str, Any]], None],
     deadline: float | None = None,
     label: str = "",
-) -> bool:
-    """Simulate the episodes of one (terrain, scenario) cell in lanes of one MPM solver; False at the deadline.
+    probe_s: float | None = None,
+) -> CellOutcome:
+    """Simulate the episodes of one (terrain, scenario) cell in lanes of one MPM solver.
 
     ``min(robots_per_batch, len(specs))`` robots start together, one per lane. A lane's episode ends when its
     robot falls (``lane_failed``, checked at every policy step) or after ``episode_s``; its log (policy rate, up
@@ -317,6 +323,11 @@ def run_cell(
     with ``cfg.retire_idle_lanes`` its sand leaves the solve (``G1MpmScene.retire_robots``). The cell ends when
     every lane is idle. At ``deadline`` (``time.perf_counter`` s) the episodes still running are
     dropped, those finished before are already out. A progress line goes to stderr about every 30 s.
+
+    With ``probe_s`` and a deadline, the cell's cost is measured once it has stepped ``probe_s`` seconds
+    (:class:`~gmloco.eval.g1_eval_fit.CellCost`); if its walks would then not all end before the deadline even if
+    no robot fell, it stops at once (``outcome.stopped == "no_fit"``: its running episodes dropped, the caller
+    rebuilds it with the lanes that fit).
     """
     import sys
 
@@ -331,6 +342,7 @@ def run_cell(
     steps = round(cfg.episode_s / (scene.frame_dt * k))
     start, active, done = [0] * n, [True] * n, 0
     last = t_steps = time.perf_counter()
+    cost: CellCost | None = None
     while True:
         if scene.frame % k == 0 and scene.base_q:
             rows = len(scene.base_q)
@@ -365,7 +377,17 @@ def run_cell(
             if deadline is not None and now > deadline:
                 print(f"{label}: time box reached with {done}/{len(specs)} episodes done; {sum(active)} running "
                       "episodes dropped", file=sys.stderr, flush=True)  # fmt: skip
-                return False
+                return CellOutcome(False, "time_box", cost)
+            if cost is None and probe_s is not None and now - t_steps >= probe_s and scene.frame > 0:
+                scene.sync()
+                cost = CellCost(sum(active), (time.perf_counter() - t_steps) / scene.frame, build_s)
+                left = [steps - (rows - start[r]) for r in range(n) if active[r]]
+                need = 60.0 * FIT_MARGIN * cell_minutes_left(left, len(queue), steps, k, 1.0 / cost.frame_s)
+                if deadline is not None and now + need > deadline:
+                    print(f"{label}: its walks need ~{need / 60:.1f} min if none falls, {(deadline - now) / 60:.1f} "
+                          f"min are left: stopped after {scene.frame} frames to refit it into the time box "
+                          f"({sum(active)} running episodes dropped)", file=sys.stderr, flush=True)  # fmt: skip
+                    return CellOutcome(False, "no_fit", cost)
             if now - last > 30.0:
                 scene.sync()
                 check_grid_capacity(scene, solver)
@@ -378,7 +400,19 @@ def run_cell(
         scene.step()
     scene.sync()
     check_grid_capacity(scene, solver)
-    return True
+    return CellOutcome(True, None, cost)
+
+
+@dataclass(frozen=True)
+class CellOutcome:
+    """How :func:`run_cell` ended."""
+
+    finished: bool
+    """Every episode of the cell ended and was handed out."""
+    stopped: Literal["time_box", "no_fit"] | None = None
+    """Why it stopped early: the deadline passed, or its walks would not have ended before it (refit)."""
+    cost: CellCost | None = None
+    """The cell's measured cost (with a probe), for fitting the next cell of its (terrain, scenario)."""
 
 
 def check_grid_capacity(scene: Any, solver: MpmSolverCfg) -> None:
@@ -709,11 +743,15 @@ def run(cfg: G1EvalCfg) -> tuple[dict[str, float], bool]:
     policy = load_policy(cfg.policy_path, min(cfg.robots_per_batch, max(len(todo), 1)))
     t0, complete = time.perf_counter(), True
     deadline = None if cfg.max_minutes is None else t0 + 60.0 * cfg.max_minutes
-    batches = episode_batches(todo, len(todo) if cfg.refill else cfg.robots_per_batch)
+    pending = episode_batches(todo, len(todo) if cfg.refill else cfg.robots_per_batch)
+    costs: dict[tuple[str, str], CellCost] = {}  # measured per (terrain, scenario) in this call
+    ended = set(done)  # episodes in the log, this call's included
+    probe_s = FIT_PROBE_S if deadline is not None and cfg.fit_time_box else None
 
     def on_episode(lg: dict[str, Any]) -> None:
         """Score one finished episode, keep it if it is its group's best walk so far, append it to the log."""
         row = score_episode(lg["spec"], cfg, lg)
+        ended.add(row["key"])
         group, rank = lg["spec"].group, recording_rank(row)
         held = best[group][0] if group in best else recorded.get(group, _UNRECORDED)
         if cfg.record_mcap and rank > held:
@@ -722,14 +760,28 @@ def run(cfg: G1EvalCfg) -> tuple[dict[str, float], bool]:
         with log_path.open("a") as f:
             f.write(json.dumps(row) + "\n")
 
-    for i, batch in enumerate(batches):
+    cells = 0
+    while pending:
+        batch = pending.pop(0)
         if deadline is not None and time.perf_counter() > deadline:
             complete = False
             break
-        label = f"cell {i + 1}/{len(batches)} ({len(batch)} episodes, {min(len(batch), cfg.robots_per_batch)} lanes)"
-        cell_done = run_cell(batch, cfg, policy, on_episode, deadline, label)
+        cell = (batch[0].terrain, batch[0].scenario)
+        if deadline is not None and cfg.fit_time_box and cell in costs:
+            batch = _fit_batch(batch, cfg, costs[cell], deadline - time.perf_counter(), pending)
+            if not batch:
+                complete = False
+                break
+        cells += 1
+        lanes = min(len(batch), cfg.robots_per_batch)
+        label = f"cell {cells} ({batch[0].terrain}/{batch[0].scenario}: {len(batch)} episodes, {lanes} lanes)"
+        outcome = run_cell(batch, cfg, policy, on_episode, deadline, label, probe_s)
         _write_recordings(best, recorded, cfg, out)  # after every cell, so a time box keeps them
-        if not cell_done:
+        if outcome.cost is not None:
+            costs[cell] = outcome.cost
+        if outcome.stopped == "no_fit":  # its unfinished episodes go back, to be cut to what fits
+            pending.insert(0, [s for s in batch if s.key not in ended])
+        elif not outcome.finished:
             complete = False  # the time box ended inside the cell: its running episodes are unfinished, not kept
             break
     summary = summarize(rows)
@@ -739,6 +791,33 @@ def run(cfg: G1EvalCfg) -> tuple[dict[str, float], bool]:
     write_outputs(out, cfg, rows, summary, complete)
     report_window(rows, cfg.window)
     return summary, complete
+
+
+def _fit_batch(
+    batch: list[EpisodeSpec], cfg: G1EvalCfg, cost: CellCost, seconds_left: float, pending: list[list[EpisodeSpec]]
+) -> list[EpisodeSpec]:
+    """``batch`` as it fits into ``seconds_left`` [s] by its cell's ``cost``.
+
+    Whole, or cut to the episodes of the lanes that fit (one episode each, the rest put back at the front of
+    ``pending``), or [] when not even one walk fits.
+    """
+    import sys
+
+    frames = math.ceil(round(cfg.episode_s / cfg.solver.frame_dt, 6))
+    lanes = min(len(batch), cfg.robots_per_batch)
+    waves = math.ceil(len(batch) / lanes)
+    if cell_seconds(cost, lanes, waves * frames) <= seconds_left:
+        return batch
+    n = fit_lanes(cost, frames, seconds_left, lanes)
+    if n == 0:
+        print(f"time box: {seconds_left / 60:.1f} min left, one more {cfg.episode_s:g} s walk of "
+              f"{batch[0].terrain}/{batch[0].scenario} needs ~{cell_seconds(cost, 1, frames) / 60:.1f} min; "
+              f"{len(batch)} episodes left for the next call", file=sys.stderr, flush=True)  # fmt: skip
+        return []
+    print(f"time box: {seconds_left / 60:.1f} min left, fits {n} of {lanes} lanes "
+          f"(~{cell_seconds(cost, n, frames) / 60:.1f} min if none falls)", file=sys.stderr, flush=True)  # fmt: skip
+    pending.insert(0, batch[n:])
+    return batch[:n]
 
 
 def _write_recordings(best: dict[str, Any], recorded: dict[str, tuple[bool, float]], cfg: G1EvalCfg, out: Path) -> None:

@@ -88,7 +88,13 @@ def _parse(argv: list[str] | None) -> argparse.Namespace:
         help="active-cell capacity of the sparse grid as a multiple of the windows' initial cells",
     )
     p.add_argument("--no-mcap", action="store_true")
-    p.add_argument("--max-minutes", type=float, default=None)
+    p.add_argument("--max-minutes", type=float, default=None, help="time box of this call [min] (resumable)")
+    p.add_argument(
+        "--no-fit-time-box",
+        action="store_true",
+        help="with --max-minutes: run every cell as it comes until the time box drops its running episodes "
+        "(default: a cell whose walks would not end in the time left is rebuilt with the lanes that fit)",
+    )
     p.add_argument("--fresh", action="store_true", help="discard episodes.jsonl instead of resuming")
     p.add_argument("--device", default=None)
     p.add_argument("--seed", type=int, default=0)
@@ -151,6 +157,7 @@ def cfg_from_args(a: argparse.Namespace) -> G1EvalCfg:
         bed_depth=a.bed_depth,
         record_mcap=not a.no_mcap,
         max_minutes=a.max_minutes,
+        fit_time_box=not a.no_fit_time_box,
         resume=not a.fresh,
         device=a.device,
         seed=a.seed,
@@ -195,7 +202,8 @@ def cli_args(cfg: G1EvalCfg, cells: bool = True) -> list[str]:
             "--particles-per-voxel", str(w.particles_per_voxel),
             "--cell-capacity-factor", repr(cfg.cell_capacity_factor), "--seed", str(cfg.seed)]  # fmt: skip
     flags = {"--no-refill": not cfg.refill, "--keep-idle-lanes": not cfg.retire_idle_lanes,
-             "--static-bed": not w.moving, "--no-mcap": not cfg.record_mcap, "--fresh": not cfg.resume}  # fmt: skip
+             "--static-bed": not w.moving, "--no-mcap": not cfg.record_mcap, "--fresh": not cfg.resume,
+             "--no-fit-time-box": not cfg.fit_time_box}  # fmt: skip
     return out + [f for f, on in flags.items() if on]
 
 

@@ -1,0 +1,63 @@
+# SPDX-License-Identifier: Apache-2.0
+"""Fitting MPM cells into a time box (issue 9): start only walks that can end before it.
+
+A cell's MPM state (millions of particles) is not checkpointed, so an episode still running at the time box is
+lost with all its frames: session 21 lost two basalt shares whole (25 robots each, walking 6-8 s of their 10 s
+when the box closed; ~27 GPU-minutes). ``g1_eval`` therefore measures what a cell costs in its first stretch
+(:class:`CellCost`: wall seconds per frame with all its lanes walking, and the build) and, when its walks would not
+end before the time box if no robot fell, stops it and rebuilds it with the lanes that do fit (:func:`fit_lanes`);
+later cells of the same (terrain, scenario) are cut to fit before they are built. The prediction assumes no robot
+falls (the worst case): robots that fall end sooner, so a fitted cell ends early rather than late.
+
+Per-frame cost model, from the wall-clock rates of sessions 20-21 (H200, 3 cm voxels, 500 sweeps, idle lanes
+retired): 2.12M particles 0.282 s, 3.08M 0.397 s, 4.24M 0.481 s, 4.42M 0.510 s a frame: linear in the particles,
+0.099 s per million plus ~0.07 s a frame whatever the size, i.e. ~15 % of a full 25-lane square-window frame.
+Lanes of one cell have the same window, so a cell's particles follow its lanes: ``frame_s(n) = frame_s(N) (f + (1 -
+f) n / N)`` with the floor ``f`` = :data:`FRAME_COST_FLOOR`.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+FRAME_COST_FLOOR = 0.15
+"""Share of a measured frame's wall time that does not shrink with fewer lanes [-] (fit above: ~0.07 s of a
+0.51 s frame at 4.42M particles; the rheology sweeps' launches, the robots' MuJoCo step, the coupling)."""
+FIT_MARGIN = 1.1
+"""Predicted stepping time is multiplied by this before it is compared with the time left [-]."""
+FIT_PROBE_S = 30.0
+"""Stepping time after which a cell's frame cost is measured and its fit decided [s] (~55-80 frames at the
+tables' sizes: past the capture's first slow frames, before most falls)."""
+
+
+@dataclass(frozen=True)
+class CellCost:
+    """What one cell's lanes cost, measured on the machine that runs the next cell of its (terrain, scenario)."""
+
+    lanes: int
+    """Lanes (robots) that were walking while it was measured."""
+    frame_s: float
+    """Wall-clock seconds per MPM frame with those lanes walking [s]."""
+    build_s: float
+    """Seconds to build and capture the cell's scene [s] (taken as is for fewer lanes: an upper bound)."""
+
+
+def frame_seconds(cost: CellCost, lanes: int) -> float:
+    """Predicted wall-clock seconds per frame of the same cell with ``lanes`` lanes [s]."""
+    return cost.frame_s * (FRAME_COST_FLOOR + (1.0 - FRAME_COST_FLOOR) * lanes / cost.lanes)
+
+
+def cell_seconds(cost: CellCost, lanes: int, frames: int, build: bool = True) -> float:
+    """Predicted wall-clock seconds of a cell of ``lanes`` lanes stepping ``frames`` frames, margin included [s]."""
+    return (cost.build_s if build else 0.0) + FIT_MARGIN * frames * frame_seconds(cost, lanes)
+
+
+def fit_lanes(cost: CellCost, frames: int, seconds_left: float, most: int) -> int:
+    """The most lanes (0 .. ``most``) whose cell, built now, steps ``frames`` frames before ``seconds_left`` [s].
+
+    0: not even one walk of ``frames`` frames ends in the time left.
+    """
+    n = most
+    while n > 0 and cell_seconds(cost, n, frames) > seconds_left:
+        n -= 1
+    return n

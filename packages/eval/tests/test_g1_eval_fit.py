@@ -1,0 +1,44 @@
+# SPDX-License-Identifier: Apache-2.0
+"""Fitting MPM cells into a time box: the frame-cost model and the lane count it picks."""
+
+from __future__ import annotations
+
+import pytest
+
+from gmloco.eval.g1_eval_fit import FIT_MARGIN, FRAME_COST_FLOOR, CellCost, cell_seconds, fit_lanes, frame_seconds
+
+
+def test_frame_cost_is_linear_in_lanes_above_a_floor() -> None:
+    """All lanes cost the measured frame; none would cost the floor; the cost per lane is constant between."""
+    cost = CellCost(lanes=25, frame_s=0.56, build_s=35.0)
+    assert frame_seconds(cost, 25) == pytest.approx(0.56)
+    assert frame_seconds(cost, 0) == pytest.approx(FRAME_COST_FLOOR * 0.56)
+    steps = [frame_seconds(cost, n + 1) - frame_seconds(cost, n) for n in range(25)]
+    assert steps == pytest.approx([steps[0]] * 25)
+    assert cell_seconds(cost, 25, 100) == pytest.approx(35.0 + FIT_MARGIN * 100 * 0.56)
+    assert cell_seconds(cost, 25, 100, build=False) == pytest.approx(FIT_MARGIN * 100 * 0.56)
+
+
+def test_session_21_basalt_share_would_have_kept_13_walks() -> None:
+    """Session 21's basalt share at 1.0 m/s, which the time box dropped whole, refit.
+
+    25 lanes at 1.79 frames/s (wall clock), built in ~35 s, 799 s left after the build and the 30 s probe, 2000
+    frames a 10 s walk. 25 lanes need ~1265 s; 13 lanes fit (predicted ~756 s), 14 do not; the real 13-lane cell,
+    stepping at its particles' rate, ends within the prediction.
+    """
+    cost = CellCost(lanes=25, frame_s=1 / 1.79, build_s=35.0)
+    assert cell_seconds(cost, 25, 2000) > 799.0
+    n = fit_lanes(cost, 2000, 799.0, 25)
+    assert n == 13 and cell_seconds(cost, 14, 2000) > 799.0 >= cell_seconds(cost, 13, 2000)
+    # sessions 20-21's wall-clock frames: 0.072 s + 0.099 s per million particles, 176,720 particles a lane
+    real_13 = 35.0 + 2000 * (0.072 + 0.099 * 13 * 0.17672)
+    assert real_13 < cell_seconds(cost, 13, 2000) < 799.0
+
+
+def test_nothing_fits_when_one_walk_outlasts_the_time_left() -> None:
+    """0 lanes when a single walk would not end; every lane when the whole cell fits; never more than asked."""
+    cost = CellCost(lanes=10, frame_s=0.4, build_s=20.0)
+    one = cell_seconds(cost, 1, 2000)
+    assert fit_lanes(cost, 2000, one - 1.0, 10) == 0
+    assert fit_lanes(cost, 2000, one, 10) == 1
+    assert fit_lanes(cost, 2000, 1e9, 10) == 10 and fit_lanes(cost, 2000, 1e9, 3) == 3
