@@ -373,15 +373,17 @@ def test_the_time_box_keeps_finished_episodes_only(monkeypatch: pytest.MonkeyPat
     assert logs == [] and _LaneScene.made[0].frame == 4  # one policy step, then the check
 
 
-def _time_boxed(monkeypatch: pytest.MonkeyPatch, tmp_path: Path, fit: bool) -> tuple[list[str], bool]:
+def _time_boxed(
+    monkeypatch: pytest.MonkeyPatch, tmp_path: Path, fit: bool, falls: dict[int, int] | None = None, **kw: object
+) -> tuple[list[str], bool]:
     """The episodes logged and whether the run completed: 4 standing episodes of 40 frames in up to 4 lanes.
 
     A frame costs 0.25 s per lane on a stand-in clock; the time box is 30 s.
     """
     import gmloco.eval.g1_eval as g1_eval
 
-    cfg, _ = _cell(monkeypatch, {}, num_episodes=4, robots_per_batch=4, max_minutes=0.5, fit_time_box=fit,
-                   out_dir=str(tmp_path))  # fmt: skip
+    cfg, _ = _cell(monkeypatch, falls or {}, **({"num_episodes": 4, "robots_per_batch": 4} | kw), max_minutes=0.5,
+                   fit_time_box=fit, out_dir=str(tmp_path))  # fmt: skip
     monkeypatch.setattr(_LaneScene, "TICK", 0.25)
     monkeypatch.setattr(_LaneScene, "now", [0.0])
     monkeypatch.setattr(g1_eval, "time", SimpleNamespace(perf_counter=lambda: _LaneScene.now[0]))
@@ -407,6 +409,20 @@ def test_without_the_fit_the_time_box_drops_the_whole_cell(monkeypatch: pytest.M
     """The same run with ``fit_time_box=False``: the 4-lane cell steps until the box and no episode is kept."""
     keys, complete = _time_boxed(monkeypatch, tmp_path, fit=False)
     assert keys == [] and not complete and [s.n for s in _LaneScene.made] == [4]
+
+
+def test_a_freed_lane_takes_no_walk_that_cannot_end(monkeypatch: pytest.MonkeyPatch, tmp_path: Path) -> None:
+    """Refill stops when a whole walk would no longer end before the time box.
+
+    6 episodes in 2 lanes (a frame 0.5 s), 30 s: episodes 0-1 fall at once and 2-3 take their lanes before the 4 s
+    probe; those end at ~24 s, when a 40-frame walk (22 s with the margin) no longer fits, so 4-5 are left for the
+    next call and the run stops at 24 s. Without the fit they start and are dropped at the box (30 s).
+    """
+    for fit, end in ((True, 24.0), (False, 30.0)):
+        keys, complete = _time_boxed(monkeypatch, tmp_path / str(fit), fit, {0: 1, 1: 1}, num_episodes=6,
+                                     robots_per_batch=2)  # fmt: skip
+        assert [k[-1] for k in keys] == ["0", "1", "2", "3"] and not complete
+        assert len(_LaneScene.made) == 1 and _LaneScene.now[0] == pytest.approx(end, abs=2.0)
 
 
 def _run_in(cfg: G1EvalCfg, monkeypatch: pytest.MonkeyPatch) -> tuple[dict, bool]:

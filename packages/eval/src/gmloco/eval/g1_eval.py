@@ -165,9 +165,10 @@ class G1EvalCfg:
     max_minutes: float | None = None
     """Stop (resumable) after this much wall time [min]."""
     fit_time_box: bool = True
-    """With ``max_minutes``: start only walks that can end before it (``g1_eval_fit``): a cell that would not end
-    in the time left if no robot fell is stopped after ~30 s of stepping and rebuilt with the lanes that fit, a later
-    cell of the same (terrain, scenario) is cut before it is built. False: cells run until the time box drops them."""
+    """With ``max_minutes``: start only walks that can end before it (``g1_eval_fit``): a cell whose running walks
+    would not end in the time left if no robot fell is stopped after ~30 s of stepping and rebuilt with the lanes that
+    fit, a later cell of the same (terrain, scenario) gets those lanes before it is built, and a freed lane takes
+    the next episode only if a whole walk still fits. False: cells run until the time box drops them."""
     resume: bool = True
     """Keep finished episodes in ``episodes.jsonl``; else start fresh."""
 
@@ -325,9 +326,10 @@ def run_cell(
     dropped, those finished before are already out. A progress line goes to stderr about every 30 s.
 
     With ``probe_s`` and a deadline, the cell's cost is measured once it has stepped ``probe_s`` seconds
-    (:class:`~gmloco.eval.g1_eval_fit.CellCost`); if its walks would then not all end before the deadline even if
-    no robot fell, it stops at once (``outcome.stopped == "no_fit"``: its running episodes dropped, the caller
-    rebuilds it with the lanes that fit).
+    (:class:`~gmloco.eval.g1_eval_fit.CellCost`); if its running walks would then not all end before the deadline
+    even if no robot fell, it stops at once (``outcome.stopped == "no_fit"``: its running episodes dropped, the
+    caller rebuilds it with the lanes that fit). After that a freed lane takes the next episode only if a whole walk
+    would end before the deadline at the measured cost; the episodes it leaves are for the next call.
     """
     import sys
 
@@ -361,10 +363,10 @@ def run_cell(
                 log = _lane_log(scene, r, start[r], rows, lane_spec[r], terrain, build_s, n)
                 on_episode(log | {"elapsed_s": time.perf_counter() - t_steps})
                 done += 1
-                if queue:
+                if queue and _walk_fits(cost, steps * k, deadline):
                     lane_spec[r], start[r] = queue.pop(0), rows
                     resets.append(r)
-                else:
+                else:  # no episode left, or none that could end before the deadline (then left for the next call)
                     active[r] = False
                     retired.append(r)
             scene.reset_robots(resets, [command(lane_spec[r], cfg) for r in resets],
@@ -382,7 +384,7 @@ def run_cell(
                 scene.sync()
                 cost = CellCost(sum(active), (time.perf_counter() - t_steps) / scene.frame, build_s)
                 left = [steps - (rows - start[r]) for r in range(n) if active[r]]
-                need = 60.0 * FIT_MARGIN * cell_minutes_left(left, len(queue), steps, k, 1.0 / cost.frame_s)
+                need = 60.0 * FIT_MARGIN * cell_minutes_left(left, 0, steps, k, 1.0 / cost.frame_s)
                 if deadline is not None and now + need > deadline:
                     print(f"{label}: its walks need ~{need / 60:.1f} min if none falls, {(deadline - now) / 60:.1f} "
                           f"min are left: stopped after {scene.frame} frames to refit it into the time box "
@@ -400,7 +402,18 @@ def run_cell(
         scene.step()
     scene.sync()
     check_grid_capacity(scene, solver)
+    if queue:
+        print(f"{label}: {len(queue)} episodes not started: they could not end before the time box",
+              file=sys.stderr, flush=True)  # fmt: skip
+        return CellOutcome(False, "time_box", cost)
     return CellOutcome(True, None, cost)
+
+
+def _walk_fits(cost: CellCost | None, frames: int, deadline: float | None) -> bool:
+    """Whether a walk of ``frames`` frames started now ends before ``deadline`` at ``cost`` (True: not measured)."""
+    if cost is None or deadline is None:
+        return True
+    return time.perf_counter() + FIT_MARGIN * frames * cost.frame_s <= deadline
 
 
 @dataclass(frozen=True)
@@ -766,16 +779,21 @@ def run(cfg: G1EvalCfg) -> tuple[dict[str, float], bool]:
         if deadline is not None and time.perf_counter() > deadline:
             complete = False
             break
-        cell = (batch[0].terrain, batch[0].scenario)
+        cell, cell_cfg = (batch[0].terrain, batch[0].scenario), cfg
         if deadline is not None and cfg.fit_time_box and cell in costs:
-            batch = _fit_batch(batch, cfg, costs[cell], deadline - time.perf_counter(), pending)
-            if not batch:
+            lanes = _fit_lanes(batch, cfg, costs[cell], deadline - time.perf_counter())
+            if lanes == 0:
                 complete = False
                 break
+            cell_cfg = replace(cfg, robots_per_batch=lanes)
+            if not cfg.refill:  # lanes do not take further episodes: the rest waits for the next batch
+                batch, rest = batch[:lanes], batch[lanes:]
+                if rest:
+                    pending.insert(0, rest)
         cells += 1
-        lanes = min(len(batch), cfg.robots_per_batch)
+        lanes = min(len(batch), cell_cfg.robots_per_batch)
         label = f"cell {cells} ({batch[0].terrain}/{batch[0].scenario}: {len(batch)} episodes, {lanes} lanes)"
-        outcome = run_cell(batch, cfg, policy, on_episode, deadline, label, probe_s)
+        outcome = run_cell(batch, cell_cfg, policy, on_episode, deadline, label, probe_s)
         _write_recordings(best, recorded, cfg, out)  # after every cell, so a time box keeps them
         if outcome.cost is not None:
             costs[cell] = outcome.cost
@@ -793,31 +811,26 @@ def run(cfg: G1EvalCfg) -> tuple[dict[str, float], bool]:
     return summary, complete
 
 
-def _fit_batch(
-    batch: list[EpisodeSpec], cfg: G1EvalCfg, cost: CellCost, seconds_left: float, pending: list[list[EpisodeSpec]]
-) -> list[EpisodeSpec]:
-    """``batch`` as it fits into ``seconds_left`` [s] by its cell's ``cost``.
+def _fit_lanes(batch: list[EpisodeSpec], cfg: G1EvalCfg, cost: CellCost, seconds_left: float) -> int:
+    """Lanes for ``batch`` whose first walks all end within ``seconds_left`` [s] at its cell's ``cost`` (0: none).
 
-    Whole, or cut to the episodes of the lanes that fit (one episode each, the rest put back at the front of
-    ``pending``), or [] when not even one walk fits.
+    A lane's later walks (refill) start only if they too can end (``run_cell``).
     """
     import sys
 
     frames = math.ceil(round(cfg.episode_s / cfg.solver.frame_dt, 6))
     lanes = min(len(batch), cfg.robots_per_batch)
-    waves = math.ceil(len(batch) / lanes)
-    if cell_seconds(cost, lanes, waves * frames) <= seconds_left:
-        return batch
+    if cell_seconds(cost, lanes, frames) <= seconds_left:
+        return lanes
     n = fit_lanes(cost, frames, seconds_left, lanes)
     if n == 0:
         print(f"time box: {seconds_left / 60:.1f} min left, one more {cfg.episode_s:g} s walk of "
               f"{batch[0].terrain}/{batch[0].scenario} needs ~{cell_seconds(cost, 1, frames) / 60:.1f} min; "
               f"{len(batch)} episodes left for the next call", file=sys.stderr, flush=True)  # fmt: skip
-        return []
-    print(f"time box: {seconds_left / 60:.1f} min left, fits {n} of {lanes} lanes "
-          f"(~{cell_seconds(cost, n, frames) / 60:.1f} min if none falls)", file=sys.stderr, flush=True)  # fmt: skip
-    pending.insert(0, batch[n:])
-    return batch[:n]
+    else:
+        print(f"time box: {seconds_left / 60:.1f} min left, fits {n} of {lanes} lanes "
+              f"(~{cell_seconds(cost, n, frames) / 60:.1f} min if none falls)", file=sys.stderr, flush=True)  # fmt: skip
+    return n
 
 
 def _write_recordings(best: dict[str, Any], recorded: dict[str, tuple[bool, float]], cfg: G1EvalCfg, out: Path) -> None:

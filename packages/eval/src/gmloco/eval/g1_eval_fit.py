@@ -4,10 +4,11 @@
 A cell's MPM state (millions of particles) is not checkpointed, so an episode still running at the time box is
 lost with all its frames: session 21 lost two basalt shares whole (25 robots each, walking 6-8 s of their 10 s
 when the box closed; ~27 GPU-minutes). ``g1_eval`` therefore measures what a cell costs in its first stretch
-(:class:`CellCost`: wall seconds per frame with all its lanes walking, and the build) and, when its walks would not
-end before the time box if no robot fell, stops it and rebuilds it with the lanes that do fit (:func:`fit_lanes`);
-later cells of the same (terrain, scenario) are cut to fit before they are built. The prediction assumes no robot
-falls (the worst case): robots that fall end sooner, so a fitted cell ends early rather than late.
+(:class:`CellCost`: wall seconds per frame with all its lanes walking, and the build) and, when its running walks
+would not end before the time box if no robot fell, stops it and rebuilds it with the lanes that do fit
+(:func:`fit_lanes`); later cells of the same (terrain, scenario) get those lanes before they are built, and a lane
+whose robot fell takes the next episode only while a whole walk still fits. The prediction assumes no robot falls
+(the worst case): robots that fall end sooner, so a fitted cell ends early rather than late.
 
 Per-frame cost model, from the wall-clock rates of sessions 20-21 (H200, 3 cm voxels, 500 sweeps, idle lanes
 retired): 2.12M particles 0.282 s, 3.08M 0.397 s, 4.24M 0.481 s, 4.42M 0.510 s a frame: linear in the particles,
