@@ -20,6 +20,7 @@ from gmloco.eval.g1_eval import (
     cell_minutes_left,
     episode_batches,
     episode_specs,
+    exit_in_fall,
     run_cell,
     score_episode,
     summarize,
@@ -187,10 +188,10 @@ def test_episode_specs_batches_summary_and_tables() -> None:
     assert math.isclose(m["dry_sand/straight/v1/vel_error"], 0.1) and m["poppy_seed/straight/v2/num_episodes"] == 1
     # table: dry sand success 1/3 = 33.3 %, velocity error mean(0, 0.1, 0.2) = 0.1 m/s, sinkage 0.5 cm, swing apex
     # mean(0, 2, 4) = 2 cm, lift 6 cm (episodes without a finished swing, NaN, are left out of the mean); one of
-    # the three episodes had a sole outside its sand window early: 33.3 %, not by a turn: 0 %
+    # the three episodes had a sole outside its sand window early: 33.3 %, not by a turn: 0 %, not with a fall: 0 %
     t = table_terrains(rows, "p")
     assert t[0][:4] == ["p", "dry_sand", "straight", 3]
-    np.testing.assert_allclose(t[0][4:5] + t[0][7:], [100 / 3, 0.1, 0.0, 0.0, 0.5, 2.0, 6.0, 100 / 3, 0.0])
+    np.testing.assert_allclose(t[0][4:5] + t[0][7:], [100 / 3, 0.1, 0.0, 0.0, 0.5, 2.0, 6.0, 100 / 3, 0.0, 0.0])
     assert math.isclose(m["all/window_exit_early"], 1 / 3)
     assert t[0][5] < 100 / 3 < t[0][6]  # the 95 % interval of 1 success in 3 episodes holds the rate
     header, body = table_speeds(rows)
@@ -593,6 +594,19 @@ def test_a_window_exit_is_blamed_on_a_turn_or_on_the_reach() -> None:
     del log["sole_out"]
     row = score_episode(spec, cfg, log)
     assert row["window_exit_cause"] is None and not row["window_exit_turn"]
+
+
+def test_an_exit_shortly_before_a_fall_came_with_the_fall() -> None:
+    """An early exit 0.3 s before a tilt or a base-height fall is part of the fall.
+
+    One 1 s before, one before a timeout, or none is not.
+    """
+    row = {"window_exit_early": True, "window_exit_s": 2.7, "alive_s": 3.0, "reason": "tilt", "success": False}
+    assert exit_in_fall(row) and exit_in_fall(row | {"reason": "base_height"})
+    assert not exit_in_fall(row | {"window_exit_s": 2.0})
+    assert not exit_in_fall(row | {"reason": "timeout", "alive_s": 10.0, "window_exit_s": 9.5})
+    assert not exit_in_fall(row | {"reason": "success"}) and not exit_in_fall(row | {"window_exit_early": False})
+    assert not exit_in_fall({"window_exit_early": True, "reason": "tilt"})  # no times recorded
 
 
 def test_heading_turn_wraps_around() -> None:

@@ -73,3 +73,22 @@ def test_bad_run_arguments_stop_with_the_expected_form(tmp_path: Path, capsys: p
     with pytest.raises(SystemExit):
         main(["--run", f"td={tmp_path}", "--out", str(tmp_path / "t.txt")])
     assert "no summary.json" in capsys.readouterr().err
+
+
+def test_rows_whose_exits_came_with_the_fall_are_not_rerun(tmp_path: Path) -> None:
+    """Exits that came with the fall do not call for a rerun; ``fall_exits`` counts them.
+
+    40 % reach exits 0.3 s before a tilt, 5 % 2 s before: noted, not rerun (5 % is at the tables' threshold); with
+    ``fall_exits`` all 45 % count and the row is rerun.
+    """
+    cfg = replace(G1EvalCfg(), policy_path="p.onnx", terrains=("poppy_seed",))
+    d = _run(tmp_path / "c", cfg, 100, reason="tilt")
+    rows = [json.loads(x) for x in (d / "episodes.jsonl").read_text().splitlines()]
+    for k, r in enumerate(rows[:45]):
+        r.update(window_exit_early=True, window_exit_cause="reach", window_exit_s=2.7 if k < 40 else 1.0)
+    (d / "episodes.jsonl").write_text("".join(json.dumps(r) + "\n" for r in rows))
+    notes: list[str] = []
+    assert todo([("td", d)], notes=notes) == []
+    assert len(notes) == 1 and "40 of its 45 early window exits came within 0.75 s before the fall" in notes[0]
+    reruns = todo([("td", d)], fall_exits=True)
+    assert len(reruns) == 4 and "45 % early window exits (reach)" in reruns[0].why

@@ -520,6 +520,26 @@ def score_episode(spec: EpisodeSpec, cfg: G1EvalCfg, log: dict[str, Any]) -> dic
 
 WINDOW_EXIT_GRACE_S = 0.25
 """A sole leaving the sand window this close to an episode's end (the fall under way) does not flag it [s]."""
+FALL_EXIT_S = 0.75
+"""An early window exit this close before the episode's fall counts as part of the fall [s]: the trailing sole of
+a stumble. Session 21 reran the poppy-seed and deep-sand rows, whose exits (54 % and 37 % of their walks) came
+0.26-0.72 s before the fall, at a window no sole left: the rows and their times alive did not change (0 of 100
+each; Mann-Whitney p = 0.94 / 0.91; ``results/mpm_eval/gpu_s21/README.md``)."""
+
+
+FALL_REASONS = ("tilt", "base_height")
+"""Episode end reasons that are falls (``metrics.locomotion.episode_outcome``; not "timeout" or "success")."""
+
+
+def exit_in_fall(row: dict[str, Any]) -> bool:
+    """Whether an episode's early window exit came within ``FALL_EXIT_S`` before its fall (not a timeout).
+
+    The walk was then already lost when its sole left the sand.
+    """
+    if not row.get("window_exit_early") or row.get("reason") not in FALL_REASONS:
+        return False
+    exit_s, alive = row.get("window_exit_s"), row.get("alive_s")
+    return exit_s is not None and alive is not None and float(alive) - float(exit_s) <= FALL_EXIT_S
 
 
 def window_exit_time(sole_out: Any, dt: float, alive: int) -> float | None:

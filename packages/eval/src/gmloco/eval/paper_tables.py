@@ -130,7 +130,8 @@ def combine(
     out_dir.mkdir(parents=True, exist_ok=True)
     exits = _window_exit_rows(terrains)
     turns = _window_turn_rows(terrains, exits)
-    note = _mixed_note(first, mixed) + _window_exit_note(exits, turns)
+    falls = _window_turn_rows(terrains, exits, "window_exit_fall_pct")
+    note = _mixed_note(first, mixed) + _window_exit_note(exits, turns, falls)
     write_table(out_dir / "table_terrains", (*TERRAIN_COLUMNS, "complete"), terrains, note)
     write_table(out_dir / "table_speeds", ["policy", *table_speeds([], all_speeds)[0]], speeds, note)
     if transition:
@@ -255,35 +256,51 @@ def _window_exit_rows(rows: list[list[Any]]) -> dict[str, float]:
     return {f"{r[0]}/{r[1]}/{r[2]}": round(float(r[k]), 1) for r in rows if float(r[k]) > WINDOW_EXIT_NOTE_PCT}
 
 
-def _window_turn_rows(rows: list[list[Any]], exits: dict[str, float]) -> dict[str, float]:
-    """Key -> % of episodes that left the window early because the robot turned.
+def _window_turn_rows(
+    rows: list[list[Any]], exits: dict[str, float], column: str = "window_exit_turn_pct"
+) -> dict[str, float]:
+    """Key -> % of episodes that left the window early because the robot turned (or another ``column``'s share).
 
     Only ``exits`` rows that recorded why (runs from session 16 on).
     """
     from gmloco.eval.tables_mpm import TERRAIN_COLUMNS
 
-    k = TERRAIN_COLUMNS.index("window_exit_turn_pct")
+    k = TERRAIN_COLUMNS.index(column)
     return {key: round(float(r[k]), 1) for r in rows
             if (key := f"{r[0]}/{r[1]}/{r[2]}") in exits and math.isfinite(float(r[k]))}  # fmt: skip
 
 
-def _window_exit_note(exits: dict[str, float], turns: dict[str, float] | None = None) -> str:
-    """Markdown note naming the rows whose soles left the sand early ("" when none), with the share by turns."""
+def _window_exit_note(
+    exits: dict[str, float], turns: dict[str, float] | None = None, falls: dict[str, float] | None = None
+) -> str:
+    """Markdown note naming the rows whose soles left the sand early ("" when none).
+
+    With the share of each row's exits by the robot's turn and the share that came with the fall.
+    """
+    from gmloco.eval.g1_eval import FALL_EXIT_S
+
     if not exits:
         return ""
-    turns = turns or {}
+    turns, falls = turns or {}, falls or {}
 
     def why(key: str) -> str:
         if key not in turns:
             return ""
         return f" ({turns[key]:.0f} % by the robot's turn: give it a square window)" if turns[key] > 0 else " (reach)"
 
-    lines = [f"- `{key}`: {pct:.0f} % of episodes{why(key)}" for key, pct in exits.items()]
+    def fall(key: str) -> str:
+        if key not in falls:
+            return ""
+        return f"; {falls[key]:.0f} % within {FALL_EXIT_S:g} s before their fall"
+
+    lines = [f"- `{key}`: {pct:.0f} % of episodes{why(key)}{fall(key)}" for key, pct in exits.items()]
     return (
         "\nSoles left the sand window more than 0.25 s before the episode ended (the robot stepped where no sand "
         "was simulated), so these rows' times alive and falls may depend on the window; rerun them with a window "
         "that covers the reach printed by the run (`--window-length`, `--window-width`, `--window-lead`), or, where "
-        "the robot turned out of it (the window does not turn), with a square one (length = width):\n\n"
+        "the robot turned out of it (the window does not turn), with a square one (length = width). Exits within "
+        f"{FALL_EXIT_S:g} s before a fall came with it (a stumble's trailing sole): rerun at a window no sole left, "
+        "session 21's poppy-seed and deep-sand rows did not change (`results/mpm_eval/gpu_s21/README.md`):\n\n"
         + "\n".join(lines)
         + "\n"
     )

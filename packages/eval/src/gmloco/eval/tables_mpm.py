@@ -6,7 +6,8 @@
   per-terrain and contact-model tables;
   ``window_exit_pct``: episodes whose soles left the sand window early, a validity check, NaN for older runs;
   ``window_exit_turn_pct``: those of them that left it because the robot turned (the window does not turn), NaN for
-  runs before session 16;
+  runs before session 16; ``window_exit_fall_pct``: those of them whose exit came within ``g1_eval.FALL_EXIT_S``
+  before the fall (a stumble's trailing sole: the walk was already lost);
   several policies' ``episodes.jsonl`` concatenated give the ablation rows).
 * ``table_speeds``: success rate per commanded forward speed (rows terrain x scenario).
 * ``table_ablation`` and ``table_per_terrain``: the same numbers in the paper's two layouts, built from several
@@ -44,7 +45,7 @@ __all__ = [
 TERRAIN_COLUMNS = ("policy", "terrain", "scenario", "episodes", "success_rate_pct", "success_lo95_pct",
                    "success_hi95_pct", "vel_error_mps",
                    "yaw_error_radps", "path_error_m", "mean_sinkage_cm", "swing_apex_cm", "swing_lift_cm",
-                   "window_exit_pct", "window_exit_turn_pct")  # fmt: skip
+                   "window_exit_pct", "window_exit_turn_pct", "window_exit_fall_pct")  # fmt: skip
 """Columns of ``table_terrains``."""
 
 
@@ -78,6 +79,14 @@ def _cells(rows: list[dict[str, Any]]) -> dict[tuple[str, str], list[dict[str, A
     return out
 
 
+def _exit_in_fall_pct(rows: list[dict[str, Any]]) -> float:
+    """% of episodes whose early window exit came with their fall (``g1_eval.exit_in_fall``; NaN: not checked)."""
+    from gmloco.eval.g1_eval import exit_in_fall
+
+    checked = [r for r in rows if r.get("window_exit_early") is not None]
+    return 100.0 * sum(exit_in_fall(r) for r in checked) / len(checked) if checked else float("nan")
+
+
 def table_terrains(rows: list[dict[str, Any]], policy: str) -> list[list[Any]]:
     """Rows of ``table_terrains`` (``TERRAIN_COLUMNS``), one per (terrain, scenario)."""
     out = []
@@ -87,7 +96,8 @@ def table_terrains(rows: list[dict[str, Any]], policy: str) -> list[list[Any]]:
                     _mean(rs, "vel_error"),
                     _mean(rs, "yaw_error"), _mean(rs, "path_error"), 100.0 * _mean(rs, "mean_sinkage"),
                     100.0 * _mean(rs, "swing_apex"), 100.0 * _mean(rs, "swing_lift"),
-                    100.0 * _mean(rs, "window_exit_early"), 100.0 * _mean(rs, "window_exit_turn")])  # fmt: skip
+                    100.0 * _mean(rs, "window_exit_early"), 100.0 * _mean(rs, "window_exit_turn"),
+                    _exit_in_fall_pct(rs)])  # fmt: skip
     return out
 
 

@@ -13,8 +13,9 @@ Reads the runs behind the tables (``--run`` / ``--runs-file``, as ``gmloco.eval.
 
 The task file holds one ``NAME g1_eval_cli-arguments`` line per task (``python -m gmloco.eval.g1_eval_queue
 --tasks FILE``), resumes first (they finish rows), then reruns, most exits first, each with a comment saying why. A
-row can appear in both: the resume completes it at its window, the rerun replaces it. Exits by reach in a stumble
-shortly before a fall may not change a walk's outcome; the rule is the tables' (``WINDOW_EXIT_NOTE_PCT``).
+row can appear in both: the resume completes it at its window, the rerun replaces it. Exits within
+``g1_eval.FALL_EXIT_S`` before a fall (a stumble's trailing sole) are not counted (``--fall-exits`` counts them):
+session 21 reran two rows made of such exits at a window no sole left and neither changed.
 
     python -m gmloco.eval.tables_todo --runs-file results/mpm_eval/tables/runs.txt --out /tmp/todo_tasks.txt
 """
@@ -31,10 +32,12 @@ from pathlib import Path
 from typing import Any
 
 from gmloco.eval.g1_eval import (
+    FALL_EXIT_S,
     WINDOW_TURN_SHARE,
     G1EvalCfg,
     covering_window,
     episode_specs,
+    exit_in_fall,
     reach_fits,
     reach_quantile,
     read_episodes,
@@ -97,8 +100,18 @@ def _row_key(label: str, r: dict[str, Any]) -> tuple[str, str, str]:
     return label, str(r["terrain"]), str(r["scenario"])
 
 
-def todo(runs: list[tuple[str, Path]], episodes: int = 100, exit_pct: float = WINDOW_EXIT_NOTE_PCT) -> list[Todo]:
+def todo(
+    runs: list[tuple[str, Path]],
+    episodes: int = 100,
+    exit_pct: float = WINDOW_EXIT_NOTE_PCT,
+    fall_exits: bool = False,
+    notes: list[str] | None = None,
+) -> list[Todo]:
     """The tasks that complete the tables of ``runs`` (label, run folder): resumes first, then window reruns.
+
+    A row is rerun when more than ``exit_pct`` % of its episodes left the window early, not counting exits that
+    came with the fall (``g1_eval.exit_in_fall``) unless ``fall_exits``; a row left out for that is said in
+    ``notes``.
 
     Raises:
         FileNotFoundError: a run folder without ``summary.json`` or ``episodes.jsonl``.
@@ -120,8 +133,14 @@ def todo(runs: list[tuple[str, Path]], episodes: int = 100, exit_pct: float = WI
     for key, rs in rows.items():
         label, terrain, scenario = key
         early = [r for r in rs if r.get("window_exit_early")]
-        if 100.0 * len(early) / len(rs) > exit_pct:
+        deciding = early if fall_exits else [r for r in early if not exit_in_fall(r)]
+        if 100.0 * len(deciding) / len(rs) > exit_pct:
             reruns.append((len(early) / len(rs), _rerun(key, rs, early, cfgs[folders[key][0]], episodes, exit_pct)))
+        elif 100.0 * len(early) / len(rs) > exit_pct and notes is not None:
+            notes.append(f"{label}/{terrain}/{scenario}: not rerun: {len(early) - len(deciding)} of its "
+                         f"{len(early)} early window exits came within {FALL_EXIT_S:g} s before the fall "
+                         f"({len(deciding)} others, {100.0 * len(deciding) / len(rs):.0f} % of {len(rs)}; "
+                         "--fall-exits lists it)")  # fmt: skip
         if len(rs) >= episodes:
             continue
         for d in folders[key]:
@@ -183,16 +202,22 @@ def main(argv: list[str] | None = None) -> list[Todo]:
     p.add_argument("--episodes", type=int, default=100, help="episodes a complete row has (the paper: 100)")
     p.add_argument("--exit-pct", type=float, default=WINDOW_EXIT_NOTE_PCT,
                    help="rerun rows with more than this %% of early window exits")  # fmt: skip
+    p.add_argument("--fall-exits", action="store_true",
+                   help=f"count exits within {FALL_EXIT_S:g} s before a fall too (default: they came with the fall)")  # fmt: skip
     a = p.parse_args(argv)
     try:
         runs = list(a.run)
         runs += runs_file(a.runs_file) if a.runs_file is not None else []
         if not runs:
             p.error("give the runs: --run LABEL=RUN_DIR (repeat) and/or --runs-file FILE")
-        tasks = todo(runs, a.episodes, a.exit_pct)
+        notes: list[str] = []
+        tasks = todo(runs, a.episodes, a.exit_pct, a.fall_exits, notes)
     except (FileNotFoundError, ValueError) as exc:
         p.error(str(exc))
     lines = ["# written by python -m gmloco.eval.tables_todo: resumes first, then window reruns"]
+    lines += [f"# {n}" for n in notes]
+    for n in notes:
+        print("skip   " + n)
     for t in tasks:
         lines += [f"# {t.why}" + (f" (resume: copy {t.resume_from})" if t.resume_from else ""), t.line]
     a.out.parent.mkdir(parents=True, exist_ok=True)
