@@ -9,8 +9,10 @@
 #   2. the two circle shares cut by earlier time boxes: ppo_rigid 1.0 m/s (23 of 25), clr50 1.0 m/s (24 of 25):
 #      ~3-5 min each (two or one lanes);
 #   3. rough dry sand at the square window (session 17 at the tables' window: 31 % early exits, 20 % by turn);
-#   4. the clr50 student on dry sand at the reach window (22 % reach exits at the tables' window; its walks fall in
-#      ~2 s, a share takes ~3 min): session 21 showed such exits did not change poppy seed's or deep sand's rows.
+#   4. the clr50 student on dry sand at the reach window (22 % early exits at the tables' window, 18 of them within
+#      0.75 s before the fall; its walks fall in ~2 s, a share takes ~3 min): a check, on a third policy, of the rule
+#      session 21 drew from poppy seed and deep sand (exits that come with the fall leave a row unchanged), by which
+#      tables_todo no longer lists this rerun.
 #   The 10 s retire-lanes A/B (session 20's job_next.sh) is left out: the time-box fit would cut it unevenly.
 #   `python -m gmloco.eval.tables_todo` (../tables/todo_tasks.txt) lists the same rows; its windows hold the 97.5th
 #   percentile of the recorded reach (basalt 1.45 x 1.45, rough 1.65 x 1.65); here basalt and rough keep the
