@@ -67,6 +67,7 @@ def eval_cfg(cfg: DictConfig) -> G1EvalCfg:
         ),
         robots_per_batch=int(s.robots_per_batch),
         retire_idle_lanes=bool(s.retire_idle_lanes),
+        fit_time_box=bool(s.fit_time_box),
         cell_capacity_factor=float(s.cell_capacity_factor),
         record_mcap=bool(s.record_mcap),
         solver=replace(

@@ -313,6 +313,10 @@ class EvalMpmCfg(StageCfg):
     retire_idle_lanes: bool = True
     """Take a lane's sand out of the MPM solve once its robot has no episode left (a cell's tail then carries only
     the sand of the robots still walking); False keeps it in (the runs up to session 18)."""
+    fit_time_box: bool = True
+    """With ``max_minutes``: start only walks that can end before the time box (a cell too big for the time left is
+    rebuilt with the lanes that fit, a freed lane takes a new walk only while one can end); False: cells run until
+    the box drops their running episodes (the runs up to session 21)."""
     cell_capacity_factor: float = 1.5
     """Grid capacity = factor x particles / particles-per-cell (fixed capacity: CUDA graph); 0 = unbounded.
     The rheology solver sweeps the whole capacity, so its cost grows with the factor: 1.5 gave 1.46x the

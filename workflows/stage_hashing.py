@@ -37,8 +37,8 @@ VOLATILE_KEYS = frozenset(
 )
 """Top-level keys that never change a stage's result (where it runs, how long, how it is tracked)."""
 
-VOLATILE_STAGE_KEYS = frozenset({"out_dir", "max_minutes", "resume"})
-"""Keys of a stage section that never change its result."""
+VOLATILE_STAGE_KEYS = frozenset({"out_dir", "max_minutes", "resume", "fit_time_box"})
+"""Keys of a stage section that never change its result (``fit_time_box``: which walks one time box starts)."""
 
 
 def _relocate(obj: Any, roots: Sequence[tuple[str, str]]) -> Any:

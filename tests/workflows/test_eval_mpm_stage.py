@@ -23,11 +23,12 @@ def test_section_settings_reach_the_eval_cfg(compose: Callable[..., DictConfig])
         "eval_mpm.robots_per_batch=50",
         "eval_mpm.max_iterations=400",
         "eval_mpm.retire_idle_lanes=false",
+        "eval_mpm.fit_time_box=false",
     )
     out = eval_mpm.eval_cfg(cfg)
     assert (out.window.length, out.window.width, out.window.lead, out.window.moving) == (0.8, 0.5, -0.1, True)
     assert (out.bed_depth, out.robots_per_batch, out.solver.max_iterations) == (0.25, 50, 400)
-    assert out.retire_idle_lanes is False
+    assert out.retire_idle_lanes is False and out.fit_time_box is False
     assert out.policy_path.endswith("policy.onnx")
 
 
@@ -39,7 +40,7 @@ def test_default_section_matches_the_eval_defaults(compose: Callable[..., DictCo
     base = G1EvalCfg()
     assert out.window == base.window
     assert (out.bed_depth, out.cell_capacity_factor) == (base.bed_depth, base.cell_capacity_factor)
-    assert out.retire_idle_lanes == base.retire_idle_lanes
+    assert (out.retire_idle_lanes, out.fit_time_box) == (base.retire_idle_lanes, base.fit_time_box)
     assert out.solver == base.solver
 
 
