@@ -16,7 +16,9 @@
 #   The 10 s retire-lanes A/B (session 20's job_next.sh) is left out: the time-box fit would cut it unevenly.
 #   `python -m gmloco.eval.tables_todo` (../tables/todo_tasks.txt) lists the same rows; its windows hold the 97.5th
 #   percentile of the recorded reach (basalt 1.45 x 1.45, rough 1.65 x 1.65); here basalt and rough keep the
-#   dry-sand row's square (one window for the per-terrain rows).
+#   dry-sand row's square (one window for the per-terrain rows): of rough's 31 early exits 16 came with the fall
+#   (g1_eval.exit_in_fall) and 13 by turn, which the square holds, leaving 2 (2 %); basalt's walks stay upright and
+#   trail their soles 0.27-0.4 m (its exits were turns).
 #   Before (here): scripts/gpu/snapshot_src.sh && cp results/mpm_eval/gpu_s21/job_next.sh .devsrc/job.sh &&
 #     rm -rf .devsrc/row && mkdir -p .devsrc/row &&
 #     cp -r results/mpm_eval/gpu_s18/runs/table_{ppo_rigid,clr50}_dry_sand_circle_share0of4 .devsrc/row/
