@@ -19,7 +19,7 @@ import numpy as np
 
 from gmloco.eval.g1_eval import read_episodes
 from gmloco.eval.g1_eval_fit import FRAME_COST_FLOOR, CellCost, frame_seconds
-from gmloco.eval.run_rates import running_rates
+from gmloco.eval.run_rates import has_wall_clock, running_rates, scenes
 
 HERE = Path(__file__).resolve().parent
 SESSIONS = ("gpu_s20", "gpu_s21")
@@ -30,14 +30,8 @@ def points() -> list[dict[str, float]]:
     pooled: dict[tuple[int, int], list[float]] = {}
     for session in SESSIONS:
         for path in sorted((HERE / session / "runs").glob("*/episodes.jsonl")):
-            scenes: list[list[dict]] = []
-            for e in read_episodes(path):
-                if scenes and scenes[-1][0].get("build_s") == e.get("build_s"):
-                    scenes[-1].append(e)
-                else:
-                    scenes.append([e])
-            for scene in scenes:
-                if not all(e.get("elapsed_s") is not None for e in scene):
+            for scene in scenes(read_episodes(path)):
+                if not all(has_wall_clock(e) for e in scene):
                     continue
                 lanes = int(scene[0]["batch_size"])
                 rates = running_rates(scene)

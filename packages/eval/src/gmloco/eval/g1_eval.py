@@ -45,7 +45,7 @@ from typing import Any, Literal
 
 import numpy as np
 
-from gmloco.eval.g1_eval_fit import FIT_MARGIN, FIT_PROBE_S, CellCost, cell_seconds, fit_lanes
+from gmloco.eval.g1_eval_fit import FIT_PROBE_S, CellCost, cell_seconds, fit_lanes
 from gmloco.eval.g1_eval_policy import load_policy
 from gmloco.eval.metrics.locomotion import (
     FailureCfg,
@@ -383,8 +383,8 @@ def run_cell(
             if cost is None and probe_s is not None and now - t_steps >= probe_s and scene.frame > 0:
                 scene.sync()
                 cost = CellCost(sum(active), (time.perf_counter() - t_steps) / scene.frame, build_s)
-                left = [steps - (rows - start[r]) for r in range(n) if active[r]]
-                need = 60.0 * FIT_MARGIN * cell_minutes_left(left, 0, steps, k, 1.0 / cost.frame_s)
+                longest = max(steps - (rows - start[r]) for r in range(n) if active[r])
+                need = cell_seconds(cost, cost.lanes, longest * k, build=False)  # its running walks, none falling
                 if deadline is not None and now + need > deadline:
                     print(f"{label}: its walks need ~{need / 60:.1f} min if none falls, {(deadline - now) / 60:.1f} "
                           f"min are left: stopped after {scene.frame} frames to refit it into the time box "
@@ -413,7 +413,7 @@ def _walk_fits(cost: CellCost | None, frames: int, deadline: float | None) -> bo
     """Whether a walk of ``frames`` frames started now ends before ``deadline`` at ``cost`` (True: not measured)."""
     if cost is None or deadline is None:
         return True
-    return time.perf_counter() + FIT_MARGIN * frames * cost.frame_s <= deadline
+    return time.perf_counter() + cell_seconds(cost, cost.lanes, frames, build=False) <= deadline
 
 
 @dataclass(frozen=True)

@@ -129,8 +129,8 @@ def combine(
         transition += [[label, *r] for r in table_transition(rows)]
     out_dir.mkdir(parents=True, exist_ok=True)
     exits = _window_exit_rows(terrains)
-    turns = _window_turn_rows(terrains, exits)
-    falls = _window_turn_rows(terrains, exits, "window_exit_fall_pct")
+    turns = _window_share_rows(terrains, exits, "window_exit_turn_pct")
+    falls = _window_share_rows(terrains, exits, "window_exit_fall_pct")
     note = _mixed_note(first, mixed) + _window_exit_note(exits, turns, falls)
     write_table(out_dir / "table_terrains", (*TERRAIN_COLUMNS, "complete"), terrains, note)
     write_table(out_dir / "table_speeds", ["policy", *table_speeds([], all_speeds)[0]], speeds, note)
@@ -256,12 +256,11 @@ def _window_exit_rows(rows: list[list[Any]]) -> dict[str, float]:
     return {f"{r[0]}/{r[1]}/{r[2]}": round(float(r[k]), 1) for r in rows if float(r[k]) > WINDOW_EXIT_NOTE_PCT}
 
 
-def _window_turn_rows(
-    rows: list[list[Any]], exits: dict[str, float], column: str = "window_exit_turn_pct"
-) -> dict[str, float]:
-    """Key -> % of episodes that left the window early because the robot turned (or another ``column``'s share).
+def _window_share_rows(rows: list[list[Any]], exits: dict[str, float], column: str) -> dict[str, float]:
+    """Key -> a ``column`` of the ``exits`` rows that recorded it (runs from session 16 on).
 
-    Only ``exits`` rows that recorded why (runs from session 16 on).
+    ``window_exit_turn_pct``: % of episodes that left the window early because the robot turned;
+    ``window_exit_fall_pct``: % whose early exit came within ``g1_eval.FALL_EXIT_S`` before their fall.
     """
     from gmloco.eval.tables_mpm import TERRAIN_COLUMNS
 

@@ -52,7 +52,7 @@ def run_rate(episodes: list[dict[str, Any]]) -> dict[str, Any]:
     missing = {"frames_per_s", "batch_size", "particles", "build_s"} - set(episodes[0])
     if missing:
         raise ValueError(f"episode {episodes[0].get('key')!r} lacks {sorted(missing)}: not a batched g1_eval record")
-    timed = [e for e in episodes if _has_wall_clock(e) and e["elapsed_s"] > 0]
+    timed = [e for e in episodes if has_wall_clock(e) and e["elapsed_s"] > 0]
     wall = bool(timed)
     fps = (
         statistics.median(e["end_frame"] / e["elapsed_s"] for e in timed)
@@ -86,14 +86,8 @@ def running_rates(episodes: list[dict[str, Any]], min_s: float = MIN_PIECE_S) ->
     Successive ends closer than ``min_s`` of wall time are merged into one stretch, labelled with its
     frame-weighted mean count of robots walking (rounded); a last stretch shorter than that is dropped.
     """
-    scenes: list[list[dict[str, Any]]] = []
-    for e in episodes:
-        if scenes and scenes[-1][0].get("build_s") == e.get("build_s"):
-            scenes[-1].append(e)
-        else:
-            scenes.append([e])
     out: dict[int, tuple[float, float]] = {}
-    for scene in scenes:
+    for scene in scenes(episodes):
         lanes = scene[0].get("batch_size")
         if lanes is None or len(scene) != lanes or "sim_s" not in scene[0]:
             continue
@@ -109,14 +103,25 @@ def running_rates(episodes: list[dict[str, Any]], min_s: float = MIN_PIECE_S) ->
     return dict(sorted(out.items(), reverse=True))
 
 
-def _has_wall_clock(e: dict[str, Any]) -> bool:
+def scenes(episodes: list[dict[str, Any]]) -> list[list[dict[str, Any]]]:
+    """A run's episode records split by the scene that ran them (consecutive records with one ``build_s``)."""
+    out: list[list[dict[str, Any]]] = []
+    for e in episodes:
+        if out and out[-1][0].get("build_s") == e.get("build_s"):
+            out[-1].append(e)
+        else:
+            out.append([e])
+    return out
+
+
+def has_wall_clock(e: dict[str, Any]) -> bool:
     """Whether an episode record carries ``elapsed_s`` / ``end_frame`` (session 19 on)."""
     return e.get("elapsed_s") is not None and e.get("end_frame") is not None
 
 
 def _clock(e: dict[str, Any]) -> tuple[float, float]:
     """(wall s, frame) of an episode's end: ``elapsed_s`` / ``end_frame`` where recorded, else from ``sim_s``."""
-    if _has_wall_clock(e):
+    if has_wall_clock(e):
         return float(e["elapsed_s"]), float(e["end_frame"])
     return float(e["sim_s"]), float(e["sim_s"] * e["frames_per_s"])
 
@@ -159,7 +164,7 @@ def session_rates(folder: str | Path) -> dict[str, Any]:
         if not eps:
             continue
         episodes[run.name] = eps
-        clock = "elapsed_s" if _has_wall_clock(eps[0]) else "sim_s (in-step: reads fast near episode ends)"
+        clock = "elapsed_s" if has_wall_clock(eps[0]) else "sim_s (in-step: reads fast near episode ends)"
         runs[run.name] = run_rate(eps) | {"task_minutes": minutes.get(run.name), "retire_idle_lanes": retire_setting(run),
                                           "by_running": _by_running(eps), "by_running_clock": clock}  # fmt: skip
     rows = {}

@@ -60,16 +60,12 @@ def main(argv: list[str] | None = None) -> int:
             "[yellow]--sim given: the simulated log is checked for its contract only; residuals come from replay at the real states (short horizons), which a free-running sim log cannot provide."
         )
         read_recording(args.sim)
-    try:
+    try:  # the physics step and the time spans follow the recording's rate (MPM recordings are 50 Hz, a G1 500 Hz)
         ground, material = parse_ground(args.ground)
-    except ValueError as exc:
+        replay = replay_cfg_for_rate(1.0 / rec.dt, ground, material, args.horizon)
+    except ValueError as exc:  # a misspelt --ground or a --horizon below 1 sample
         console.print(f"[red]--{exc}")
         return 2
-    if args.horizon is not None and args.horizon < 1:
-        console.print(f"[red]--horizon {args.horizon}: at least 1 sample")
-        return 2
-    # the physics step and the time spans follow the recording's rate (MPM recordings are 50 Hz, a G1 500 Hz)
-    replay = replay_cfg_for_rate(1.0 / rec.dt, ground, material, args.horizon)
     cfg = AnalysisCfg(replay=replay)
     if args.effects:
         cfg.attribution.effects = tuple(s.strip() for s in args.effects.split(","))
