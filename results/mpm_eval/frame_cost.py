@@ -1,7 +1,7 @@
 # SPDX-License-Identifier: Apache-2.0
 """Wall-clock cost of one MPM frame against the particles in the solve, and the time-box fit's model of it (issue 9).
 
-Reads every run of sessions 20-21 whose episodes carry the wall clock (``elapsed_s``, ``end_frame``), takes each
+Reads every run of sessions 20-22 whose episodes carry the wall clock (``elapsed_s``, ``end_frame``), takes each
 scene's stretch with all its lanes walking (``gmloco.eval.run_rates.running_rates``) and pools the frames and seconds
 per built size (particles, lanes). Fits ``frame_s = a + b * particles`` and compares it with the model
 ``gmloco.eval.g1_eval_fit`` uses to fit cells into a time box: a measured full cell's frame, scaled by lanes above
@@ -22,7 +22,7 @@ from gmloco.eval.g1_eval_fit import FRAME_COST_FLOOR, CellCost, frame_seconds
 from gmloco.eval.run_rates import has_wall_clock, running_rates, scenes
 
 HERE = Path(__file__).resolve().parent
-SESSIONS = ("gpu_s20", "gpu_s21")
+SESSIONS = ("gpu_s20", "gpu_s21", "gpu_s22")
 
 
 def points() -> list[dict[str, float]]:
@@ -83,7 +83,8 @@ def main() -> None:
                     xytext=(4, -10), fontsize=7)  # fmt: skip
     ax.set_xlabel("particles in the solve [million]")
     ax.set_ylabel("wall-clock seconds per MPM frame")
-    ax.set_title("H200, 3 cm, 500 sweeps, 5 ms frames (sessions 20-21)", fontsize=9)
+    span = f"{SESSIONS[0].removeprefix('gpu_s')}-{SESSIONS[-1].removeprefix('gpu_s')}"
+    ax.set_title(f"H200, 3 cm, 500 sweeps, 5 ms frames (sessions {span})", fontsize=9)
     ax.set_xlim(0, None)
     ax.set_ylim(0, None)
     ax.legend(fontsize=7, loc="upper left")

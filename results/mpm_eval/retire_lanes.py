@@ -30,7 +30,7 @@ from gmloco.eval.run_rates import retire_setting, running_rates
 HERE = Path(__file__).resolve().parent
 BINS = ((25, 25), (10, 24), (4, 9), (1, 3))
 """Robots walking (of 25 lanes), inclusive ranges."""
-SESSIONS = ("gpu_s18", "gpu_s19", "gpu_s20", "gpu_s21")
+SESSIONS = ("gpu_s18", "gpu_s19", "gpu_s20", "gpu_s21", "gpu_s22")
 SERIES = (("off", "step clock", "tab:gray"), ("on", "step clock", "tab:olive"), ("on", "wall clock", "tab:green"))
 """(retire setting, clock, colour) of the figure's bars, left to right."""
 
