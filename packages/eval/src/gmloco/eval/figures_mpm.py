@@ -149,9 +149,10 @@ def fig_per_terrain(runs: list[tuple[str, list[dict[str, Any]]]], path: str | Pa
         xk = x + (k - 0.5 * (len(runs) - 1)) * width
         ax0.bar(xk, rate, width, yerr=np.vstack([rate - ci[:, 0], ci[:, 1] - rate]), capsize=2, label=label)
         ax1.bar(xk, sink, width, label=label)
-        for xi, ri, ni in zip(xk, rate, n, strict=True):
+        for xi, hi, ni in zip(xk, ci[:, 1], n, strict=True):  # above the interval; upright where bars are narrow
             if ni:
-                ax0.text(xi, min(float(np.nan_to_num(ri)) + 3.0, 100.0), str(int(ni)), ha="center", fontsize=6)
+                ax0.text(xi, min(float(np.nan_to_num(hi)) + 1.5, 96.0), str(int(ni)), ha="center", va="bottom",
+                         fontsize=6, rotation=90 if width < 0.3 else 0)  # fmt: skip
     for ax in (ax0, ax1):
         ax.set_xticks(x, [t.replace("_", " ") for t in terrains], fontsize=8, rotation=20)
     ax0.set(ylabel="success rate [%] (95 % interval)", ylim=(0, 105))
