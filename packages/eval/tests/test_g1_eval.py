@@ -375,13 +375,22 @@ def test_the_time_box_keeps_finished_episodes_only(monkeypatch: pytest.MonkeyPat
 
 
 def _time_boxed(
-    monkeypatch: pytest.MonkeyPatch, tmp_path: Path, fit: bool, falls: dict[int, int] | None = None, **kw: object
+    monkeypatch: pytest.MonkeyPatch,
+    tmp_path: Path,
+    fit: bool,
+    falls: dict[int, int] | None = None,
+    prior_lane_s: float = 0.0,
+    **kw: object,
 ) -> tuple[list[str], bool]:
     """The episodes logged and whether the run completed: 4 standing episodes of 40 frames in up to 4 lanes.
 
-    A frame costs 0.25 s per lane on a stand-in clock; the time box is 30 s.
+    A frame costs 0.25 s per lane on a stand-in clock; the time box is 30 s. The pre-build prior prices a frame at
+    ``prior_lane_s`` per lane, built at once (0: every cell fits until its probe has measured it).
     """
     import gmloco.eval.g1_eval as g1_eval
+    from gmloco.eval.g1_eval_fit import CellCost
+
+    monkeypatch.setattr(g1_eval, "prior_cost", lambda per_lane, n, sweeps: CellCost(n, prior_lane_s * n, 0.0))
 
     cfg, _ = _cell(monkeypatch, falls or {}, **({"num_episodes": 4, "robots_per_batch": 4} | kw), max_minutes=0.5,
                    fit_time_box=fit, out_dir=str(tmp_path))  # fmt: skip
@@ -424,6 +433,44 @@ def test_a_freed_lane_takes_no_walk_that_cannot_end(monkeypatch: pytest.MonkeyPa
                                      robots_per_batch=2)  # fmt: skip
         assert [k[-1] for k in keys] == ["0", "1", "2", "3"] and not complete
         assert len(_LaneScene.made) == 1 and _LaneScene.now[0] == pytest.approx(end, abs=2.0)
+
+
+def test_a_share_started_near_the_time_box_builds_only_the_lanes_the_prior_fits(
+    monkeypatch: pytest.MonkeyPatch, tmp_path: Path
+) -> None:
+    """Priced right before the build (0.25 s per lane a frame), 2 of the 4 lanes fit the 30 s: no 4-lane probe.
+
+    44 frames with the margin at 0.25 (0.32 + 0.92 n) s <= 30 s holds for n = 2; the 2-lane cell's own probe agrees
+    and it ends at 20 s; the next two 40-frame walks (22 s with the margin) do not fit the 10 s left.
+    """
+    keys, complete = _time_boxed(monkeypatch, tmp_path, fit=True, prior_lane_s=0.25)
+    assert keys == ["dry_sand/straight/0", "dry_sand/straight/1"] and not complete
+    assert [s.n for s in _LaneScene.made] == [2] and _LaneScene.now[0] == pytest.approx(20.0)
+
+
+def test_a_share_whose_walk_cannot_end_is_not_built(monkeypatch: pytest.MonkeyPatch, tmp_path: Path) -> None:
+    """Priced at 1 s per lane a frame, one lane's 40-frame walk needs ~55 s of the 30 s left: nothing is built.
+
+    The run stops before its first build, its episodes left for the next call.
+    """
+    keys, complete = _time_boxed(monkeypatch, tmp_path, fit=True, prior_lane_s=1.0)
+    assert keys == [] and not complete and _LaneScene.made == [] and _LaneScene.now[0] == 0.0
+
+
+def test_the_prior_prices_the_cell_build_cell_scene_builds() -> None:
+    """The prior counts the batch's window as the scene sizes it: the circle's square, the terrain's depth."""
+    from gmloco.eval.g1_eval import _prior_cost
+    from gmloco.eval.g1_eval_fit import PRIOR_FRAME_S_AT_ZERO, PRIOR_FRAME_S_PER_MILLION
+
+    cfg = replace(G1EvalCfg(), robots_per_batch=25, scenarios=("straight", "circle"))
+    specs = episode_specs(cfg)
+    straight = [s for s in specs if s.scenario == "straight"]
+    circle = [s for s in specs if s.scenario == "circle"]
+    per_lane = 94 * 40 * 20  # 1.4 x 0.6 m at 1.5 cm spacing, 30 cm deep
+    cost = _prior_cost(straight, cfg)
+    assert cost.lanes == 25
+    assert cost.frame_s == pytest.approx(PRIOR_FRAME_S_AT_ZERO + PRIOR_FRAME_S_PER_MILLION * 25 * per_lane / 1e6)
+    assert _prior_cost(circle, cfg).frame_s > cost.frame_s  # the square window holds 94 x 94 columns
 
 
 def _run_in(cfg: G1EvalCfg, monkeypatch: pytest.MonkeyPatch) -> tuple[dict, bool]:

@@ -5,7 +5,16 @@ from __future__ import annotations
 
 import pytest
 
-from gmloco.eval.g1_eval_fit import FIT_MARGIN, FRAME_COST_FLOOR, CellCost, cell_seconds, fit_lanes, frame_seconds
+from gmloco.eval.g1_eval_fit import (
+    FIT_MARGIN,
+    FRAME_COST_FLOOR,
+    PRIOR_BUILD_S,
+    CellCost,
+    cell_seconds,
+    fit_lanes,
+    frame_seconds,
+    prior_cost,
+)
 
 
 def test_frame_cost_is_linear_in_lanes_above_a_floor() -> None:
@@ -55,3 +64,19 @@ def test_model_tracks_the_frames_timed_at_fewer_lanes(lanes: int, measured_s: fl
     predicted = frame_seconds(CellCost(lanes=25, frame_s=0.5493, build_s=0.0), lanes)
     assert 0.99 * measured_s <= predicted <= 1.10 * measured_s
     assert FIT_MARGIN * predicted > measured_s
+
+
+def test_the_prior_reads_the_measured_square_window_frame_and_errs_fast() -> None:
+    """25 lanes of the square window (176,720 particles each) price within 1 % of session 22's 0.549 s frame.
+
+    Fewer rheology sweeps scale the particle term down, more leave it as at 500 (a slower solve is left to the
+    probe); the build is the fastest measured.
+    """
+    full = prior_cost(176_720, 25)
+    assert full.lanes == 25 and full.build_s == PRIOR_BUILD_S
+    assert full.frame_s == pytest.approx(0.5493, rel=0.01)
+    assert prior_cost(176_720, 25, sweeps=1000).frame_s == pytest.approx(full.frame_s)
+    half = prior_cost(176_720, 25, sweeps=250).frame_s
+    assert half == pytest.approx(0.040 + 0.5 * (full.frame_s - 0.040))
+    # session 22's rough shares, 6.2 min left: the prior builds 5 lanes where the probe-and-refit kept 3
+    assert fit_lanes(full, 2000, 6.2 * 60, 25) == 5

@@ -7,7 +7,10 @@ when the box closed; ~27 GPU-minutes). ``g1_eval`` therefore measures what a cel
 (:class:`CellCost`: wall seconds per frame with all its lanes walking, and the build) and, when its running walks
 would not end before the time box if no robot fell, stops it and rebuilds it with the lanes that do fit
 (:func:`fit_lanes`); later cells of the same (terrain, scenario) get those lanes before they are built, and a lane
-whose robot fell takes the next episode only while a whole walk still fits. The prediction assumes no robot falls
+whose robot fell takes the next episode only while a whole walk still fits. Before anything of a (terrain,
+scenario) is measured, its first cell is sized by :func:`prior_cost` (an H200's frame-cost line): a share started
+near the time box then builds the lanes that can end, or nothing, instead of probing a full cell first (session 22
+spent ~70 s on each of four such probes and ~1.1 min on each of four shares in which no walk fitted). The prediction assumes no robot falls
 (the worst case): robots that fall end sooner, so a fitted cell ends early rather than late.
 
 Per-frame cost model, from the wall-clock frames of sessions 20-22 (H200, 3 cm voxels, 500 sweeps, all lanes
@@ -33,6 +36,16 @@ FIT_MARGIN = 1.1
 FIT_PROBE_S = 30.0
 """Stepping time after which a cell's frame cost is measured and its fit decided [s] (~55-80 frames at the
 tables' sizes: past the capture's first slow frames, before most falls)."""
+
+
+PRIOR_FRAME_S_AT_ZERO = 0.040
+"""Wall seconds of a frame that do not grow with the particles, on an H200 at 500 sweeps [s] (frame-cost fit)."""
+PRIOR_FRAME_S_PER_MILLION = 0.116
+"""Wall seconds of a frame per million particles, on an H200 at 500 sweeps [s] (frame-cost fit, sessions 20-22)."""
+PRIOR_SWEEPS = 500
+"""Rheology sweeps the prior was measured at; fewer scale its particle term down, more leave it (optimistic)."""
+PRIOR_BUILD_S = 25.0
+"""Seconds to build and capture a cell, the fastest measured (25-41 s on H200s, sessions 19-22) [s]."""
 
 
 @dataclass(frozen=True)
@@ -66,3 +79,20 @@ def fit_lanes(cost: CellCost, frames: int, seconds_left: float, most: int) -> in
     while n > 0 and cell_seconds(cost, n, frames) > seconds_left:
         n -= 1
     return n
+
+
+def prior_cost(particles_per_lane: int, lanes: int, sweeps: int = PRIOR_SWEEPS) -> CellCost:
+    """A cell's cost before any of its kind was measured: an H200's frame-cost line [s].
+
+    Meant to err fast: the build is the fastest measured, the particle term is scaled down for fewer rheology
+    sweeps and not up for more, so a slower device cuts no lane by it (its cells are cut by their probe instead).
+    A device much faster than an H200 would see lanes cut near the time box that would have fit.
+
+    Args:
+        particles_per_lane: Particles of one lane's sand window.
+        lanes: Lanes (robots) of the cell.
+        sweeps: The solver's rheology sweeps (``max_iterations``).
+    """
+    per_million = PRIOR_FRAME_S_PER_MILLION * min(1.0, sweeps / PRIOR_SWEEPS)
+    frame_s = PRIOR_FRAME_S_AT_ZERO + per_million * particles_per_lane * lanes / 1e6
+    return CellCost(lanes=lanes, frame_s=frame_s, build_s=PRIOR_BUILD_S)
