@@ -32,7 +32,7 @@ def test_session_21_basalt_share_would_have_kept_14_walks() -> None:
     """Session 21's basalt share at 1.0 m/s, which the time box dropped whole, refit.
 
     25 lanes at 1.79 frames/s (wall clock), built in ~35 s, 799 s left after the build and the 30 s probe, 2000
-    frames a 10 s walk. 25 lanes need ~1264 s; 14 lanes fit (predicted ~777 s), 15 do not; the real 14-lane cell,
+    frames a 10 s walk. 25 lanes need ~1264 s; 14 lanes fit (predicted ~767 s), 15 do not; the real 14-lane cell,
     stepping at its particles' rate (``results/mpm_eval/frame_cost.json``), ends within the prediction.
     """
     cost = CellCost(lanes=25, frame_s=1 / 1.79, build_s=35.0)
