@@ -287,15 +287,13 @@ def build_cell_scene(specs: list[EpisodeSpec], cfg: G1EvalCfg, policy: Any) -> t
     (``cell_capacity_factor``); ``policy`` is reloaded for the lane count if it was built for another.
     """
     from gmloco.eval.mpm.g1_scene import G1MpmScene, G1MpmSceneCfg
-    from gmloco.eval.mpm.window_terrain import terrain_cfg
 
-    terrain = terrain_cfg(specs[0].terrain, depth=cfg.bed_depth)
     n = min(cfg.robots_per_batch, len(specs))
-    window, lane = _window_and_lanes(specs, cfg)
+    terrain, window, lane, per_lane = _cell_sand(specs, cfg)
     solver = cfg.solver
     if cfg.cell_capacity_factor > 0 and solver.grid_type != "dense":
         per_cell = window.particles_per_voxel**3
-        est = _window_particles(window, terrain.depth, solver.voxel_size) * n
+        est = per_lane * n
         solver = replace(solver, max_active_cell_count=int(cfg.cell_capacity_factor * est / per_cell) + 64)
     scene_cfg = G1MpmSceneCfg(terrain=terrain, window=window, num_robots=n, lane_spacing=lane, solver=solver,
                               commands=tuple(command(s, cfg) for s in specs[:n]),
@@ -460,6 +458,15 @@ def _lane_log(
         "robot_mass": scene.robot_mass, "particles": scene.particle_count, "batch_size": n, "build_s": build_s,
         "sim_s": scene.wall_time, "frames": scene.frame, "depth": terrain.depth,
     }  # fmt: skip
+
+
+def _cell_sand(specs: list[EpisodeSpec], cfg: G1EvalCfg) -> tuple[Any, SandWindowCfg, float, int]:
+    """A cell's terrain, sand window, lane spacing [m] and particles per lane, as ``build_cell_scene`` builds it."""
+    from gmloco.eval.mpm.window_terrain import terrain_cfg
+
+    terrain = terrain_cfg(specs[0].terrain, depth=cfg.bed_depth)
+    window, lane = _window_and_lanes(specs, cfg)
+    return terrain, window, lane, _window_particles(window, terrain.depth, cfg.solver.voxel_size)
 
 
 def _window_particles(window: SandWindowCfg, depth: float, voxel: float) -> int:
@@ -836,13 +843,8 @@ def run(cfg: G1EvalCfg) -> tuple[dict[str, float], bool]:
 
 def _prior_cost(batch: list[EpisodeSpec], cfg: G1EvalCfg) -> CellCost:
     """``g1_eval_fit.prior_cost`` of ``batch``'s cell as ``build_cell_scene`` would build it."""
-    from gmloco.eval.mpm.window_terrain import terrain_cfg
-
-    depth = terrain_cfg(batch[0].terrain, depth=cfg.bed_depth).depth
-    window, _ = _window_and_lanes(batch, cfg)
-    lanes = min(cfg.robots_per_batch, len(batch))
-    per_lane = _window_particles(window, depth, cfg.solver.voxel_size)
-    return prior_cost(per_lane, lanes, cfg.solver.max_iterations)
+    per_lane = _cell_sand(batch, cfg)[3]
+    return prior_cost(per_lane, min(cfg.robots_per_batch, len(batch)), cfg.solver.max_iterations)
 
 
 def _fit_lanes(
@@ -857,9 +859,9 @@ def _fit_lanes(
 
     frames = math.ceil(round(cfg.episode_s / cfg.solver.frame_dt, 6))
     lanes = min(len(batch), cfg.robots_per_batch)
-    if cell_seconds(cost, lanes, frames) <= seconds_left:
-        return lanes
     n = fit_lanes(cost, frames, seconds_left, lanes)
+    if n == lanes:
+        return n
     basis = " by the H200 frame-cost prior" if prior else ""
     if n == 0:
         print(f"time box: {seconds_left / 60:.1f} min left, one more {cfg.episode_s:g} s walk of "
