@@ -1,7 +1,7 @@
 # SPDX-License-Identifier: Apache-2.0
 """Wall-clock cost of one MPM frame against the particles in the solve, and the time-box fit's model of it (issue 9).
 
-Reads every run of sessions 20-22 whose episodes carry the wall clock (``elapsed_s``, ``end_frame``), takes each
+Reads every run of sessions 20-23 whose episodes carry the wall clock (``elapsed_s``, ``end_frame``), takes each
 scene's stretch with all its lanes walking (``gmloco.eval.run_rates.running_rates``) and pools the frames and seconds
 per built size (particles, lanes). Fits ``frame_s = a + b * particles`` and compares it with the model
 ``gmloco.eval.g1_eval_fit`` uses to fit cells into a time box: a measured full cell's frame, scaled by lanes above
@@ -22,7 +22,7 @@ from gmloco.eval.g1_eval_fit import FRAME_COST_FLOOR, CellCost, frame_seconds
 from gmloco.eval.run_rates import has_wall_clock, running_rates, scenes
 
 HERE = Path(__file__).resolve().parent
-SESSIONS = ("gpu_s20", "gpu_s21", "gpu_s22")
+SESSIONS = ("gpu_s20", "gpu_s21", "gpu_s22", "gpu_s23")
 
 
 def points() -> list[dict[str, float]]:

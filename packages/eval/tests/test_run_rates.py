@@ -145,3 +145,18 @@ def test_run_rate_reads_the_wall_clock_where_records_have_it() -> None:
     old = [{k: v for k, v in e.items() if k not in ("end_frame", "elapsed_s")} for e in eps]
     r = run_rate(old)
     assert r["rate_clock"] == "sim_s" and r["solver_frames_per_s_median"] == pytest.approx(2.0)
+
+
+def test_run_rate_of_a_resumed_run_is_its_widest_batches() -> None:
+    """A run resumed across sessions: 3 episodes of a 3-lane refit batch, then 22 of a 22-lane one.
+
+    The rate is the 22-lane batch's (2.0 frames/s x 22 lanes = 44 robot-frames/s), not its median frame rate
+    times the first record's 3 lanes; the narrow batch is listed apart.
+    """
+    narrow = [_episode(k, 6.0, 10.0, True) | {"batch_size": 3} for k in range(3)]
+    wide = [_episode(3, 2.0, 10.0, True) | {"batch_size": 22, "key": f"dry_sand/straight/{k}"} for k in range(3, 25)]
+    r = run_rate(narrow + wide)
+    assert r["lanes"] == 22 and r["episodes"] == 25 and r["other_lanes"] == {"3": 3}
+    assert r["solver_frames_per_s_median"] == pytest.approx(2.0)
+    assert r["robot_frames_per_s_all_lanes"] == pytest.approx(44.0)
+    assert run_rate(wide)["other_lanes"] == {}

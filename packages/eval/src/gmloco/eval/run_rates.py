@@ -44,14 +44,26 @@ def run_rate(episodes: list[dict[str, Any]]) -> dict[str, Any]:
     mixes both), else from ``frames_per_s`` (the scene's stepping clock, which until session 20 missed the GPU
     time waited in the grid-capacity checks and read ~8 % high at 4.4M particles); ``rate_clock`` says which.
 
+    A run resumed across sessions can hold batches of different widths (the time-box fit refits a late cell to
+    the lanes that fit): the rate is that of its widest batches (most lanes), and ``other_lanes`` maps each
+    narrower width to its episodes (``episodes`` counts them all), so a 3-lane batch's rate is never multiplied by 22 lanes.
+
     Raises:
         ValueError: no episodes, or an episode without the rate fields (a run older than session 12).
     """
     if not episodes:
         raise ValueError("no episodes: a run that finished none has no rate")
-    missing = {"frames_per_s", "batch_size", "particles", "build_s"} - set(episodes[0])
-    if missing:
-        raise ValueError(f"episode {episodes[0].get('key')!r} lacks {sorted(missing)}: not a batched g1_eval record")
+    for e in episodes:
+        missing = {"frames_per_s", "batch_size", "particles", "build_s"} - set(e)
+        if missing:
+            raise ValueError(f"episode {e.get('key')!r} lacks {sorted(missing)}: not a batched g1_eval record")
+    widest = max(e["batch_size"] for e in episodes)
+    other: dict[str, int] = {}
+    for e in episodes:
+        if e["batch_size"] != widest:
+            other[str(e["batch_size"])] = other.get(str(e["batch_size"]), 0) + 1
+    total = len(episodes)
+    episodes = [e for e in episodes if e["batch_size"] == widest]
     timed = [e for e in episodes if has_wall_clock(e) and e["elapsed_s"] > 0]
     wall = bool(timed)
     fps = (
@@ -61,7 +73,7 @@ def run_rate(episodes: list[dict[str, Any]]) -> dict[str, Any]:
     )
     lanes = episodes[0]["batch_size"]
     rf = fps * lanes
-    return {"episodes": len(episodes), "particles": episodes[0]["particles"], "lanes": lanes,
+    return {"episodes": total, "particles": episodes[0]["particles"], "lanes": lanes, "other_lanes": other,
             "rate_clock": "elapsed_s" if wall else "sim_s",
             "solver_frames_per_s_median": round(fps, 3), "robot_frames_per_s_all_lanes": round(rf, 1),
             "min_per_100_walking_episodes": round(ROW_ROBOT_FRAMES / rf / 60, 1), "build_s": round(episodes[0]["build_s"], 1)}  # fmt: skip
