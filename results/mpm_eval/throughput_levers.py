@@ -84,6 +84,10 @@ def cases() -> list[dict]:
     row = s22["rows"]["table_td_basalt_sq"]  # every robot walks the 10 s: a clean walking row
     add(f"s22: basalt row, square window, 4 GPUs: {row['wall_minutes']} min incl. build (as a rate)", "4x H200",
         100 * 10.0 / 0.005 / (row["wall_minutes"] * 60), "accepted", "gpu_s22/throughput.json", gpus=4)  # fmt: skip
+    s23 = _load("gpu_s23/throughput.json")
+    for run, how in (("retire_ab10_keep", "idle lanes kept"), ("retire_ab10_on", "idle lanes retired")):
+        add(f"s23: 25 lanes, 10 s at 1.5 m/s, {how} (side by side)", "H200",
+            s23["runs"][run]["robot_frames_per_s_all_lanes"], "accepted", "gpu_s23/throughput.json")  # fmt: skip
     return out
 
 

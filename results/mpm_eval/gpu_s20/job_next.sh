@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Prepared in session 20 for the next session (issue 9); NOT yet run. Any lent machine of one to four H200s:
+# Prepared in session 20 (issue 9); ran in session 21, unchanged (results: ../gpu_s21/). Any machine of 1-4 H200s:
 # `python -m gmloco.eval.g1_eval_queue --tasks` runs one evaluation per GPU from the task file below, in order, each
 # time-boxed to END and resumable. A row is four shares (--shard I/4: one speed each); at the square window a share
 # whose robots walk the full 10 s takes ~17-19 min on an H200 (session 20), one whose robots all fall ~6 min.

@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Prepared in session 21 for the next session (issue 9); NOT yet run. Any lent machine of one to four H200s:
+# Prepared in session 21 (issue 9); ran in session 22, unchanged (results: ../gpu_s22/). Any machine of 1-4 H200s:
 # `python -m gmloco.eval.g1_eval_queue --tasks` runs one evaluation per GPU from the task file below, in order, each
 # time-boxed to END and resumable. A row is four shares (--shard I/4: one speed each). Since session 21 every cell is
 # fitted into the time box (g1_eval fit_time_box): a share that cannot end in the time left if no robot falls is

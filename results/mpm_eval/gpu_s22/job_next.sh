@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Prepared in session 22 for the next session (issue 9); NOT yet run. Any lent machine of one to four H200s:
+# Prepared in session 22 (issue 9); ran in session 23, unchanged (results: ../gpu_s23/). Any machine of 1-4 H200s:
 # `python -m gmloco.eval.g1_eval_queue --tasks` runs one evaluation per GPU from the task file below, in order, each
 # time-boxed to END, resumable, and fitted into the time box (g1_eval fit_time_box).
 #   1. rough dry sand at the square window, session 22's four shares resumed (3 / 5 / 4 / 4 of 25 kept): share 0
