@@ -61,10 +61,16 @@ def cases() -> list[dict]:
     row = s18["rows"]["table_td_dry_sand_x4"]
     add(f"s18: the same row on 4 GPUs at once: {row['wall_minutes']} min incl. build (as a rate)", "4x H200",
         100 * 10.0 / 0.005 / (row["wall_minutes"] * 60), "accepted", "gpu_s18/throughput.json", gpus=4)  # fmt: skip
+
+    def retire_ab(session: str, seconds: int, runs: tuple[str, str]) -> None:
+        """A side-by-side retire-lanes A/B (kept run, retired run) of ``session``: two cases."""
+        data = _load(f"gpu_{session}/throughput.json")
+        for run, how in zip(runs, ("idle lanes kept", "idle lanes retired"), strict=True):
+            add(f"{session}: 25 lanes, {seconds} s at 1.5 m/s, {how} (side by side)", "H200",
+                data["runs"][run]["robot_frames_per_s_all_lanes"], "accepted", f"gpu_{session}/throughput.json")  # fmt: skip
+
+    retire_ab("s19", 6, ("retire_ab_keep", "retire_ab_on"))
     s19 = _load("gpu_s19/throughput.json")
-    for run, how in (("retire_ab_keep", "idle lanes kept"), ("retire_ab_on", "idle lanes retired")):
-        add(f"s19: 25 lanes, 6 s at 1.5 m/s, {how} (side by side)", "H200",
-            s19["runs"][run]["robot_frames_per_s_all_lanes"], "accepted", "gpu_s19/throughput.json")  # fmt: skip
     row = s19["rows"]["table_td_transition_sq"]
     add(f"s19: transition row, square 1.4 x 1.4 m window, 4 GPUs: {row['wall_minutes']} min (as a rate)", "4x H200",
         100 * 10.0 / 0.005 / (row["wall_minutes"] * 60), "accepted", "gpu_s19/throughput.json", gpus=4)  # fmt: skip
@@ -84,10 +90,7 @@ def cases() -> list[dict]:
     row = s22["rows"]["table_td_basalt_sq"]  # every robot walks the 10 s: a clean walking row
     add(f"s22: basalt row, square window, 4 GPUs: {row['wall_minutes']} min incl. build (as a rate)", "4x H200",
         100 * 10.0 / 0.005 / (row["wall_minutes"] * 60), "accepted", "gpu_s22/throughput.json", gpus=4)  # fmt: skip
-    s23 = _load("gpu_s23/throughput.json")
-    for run, how in (("retire_ab10_keep", "idle lanes kept"), ("retire_ab10_on", "idle lanes retired")):
-        add(f"s23: 25 lanes, 10 s at 1.5 m/s, {how} (side by side)", "H200",
-            s23["runs"][run]["robot_frames_per_s_all_lanes"], "accepted", "gpu_s23/throughput.json")  # fmt: skip
+    retire_ab("s23", 10, ("retire_ab10_keep", "retire_ab10_on"))
     return out
 
 

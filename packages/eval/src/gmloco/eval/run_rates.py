@@ -24,6 +24,7 @@ from __future__ import annotations
 import argparse
 import json
 import statistics
+from collections import Counter
 from pathlib import Path
 from typing import Any
 
@@ -57,11 +58,9 @@ def run_rate(episodes: list[dict[str, Any]]) -> dict[str, Any]:
         missing = {"frames_per_s", "batch_size", "particles", "build_s"} - set(e)
         if missing:
             raise ValueError(f"episode {e.get('key')!r} lacks {sorted(missing)}: not a batched g1_eval record")
-    widest = max(e["batch_size"] for e in episodes)
-    other: dict[str, int] = {}
-    for e in episodes:
-        if e["batch_size"] != widest:
-            other[str(e["batch_size"])] = other.get(str(e["batch_size"]), 0) + 1
+    widths = Counter(e["batch_size"] for e in episodes)
+    widest = max(widths)
+    other = {str(w): n for w, n in widths.items() if w != widest}
     total = len(episodes)
     episodes = [e for e in episodes if e["batch_size"] == widest]
     timed = [e for e in episodes if has_wall_clock(e) and e["elapsed_s"] > 0]
