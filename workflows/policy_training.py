@@ -103,7 +103,7 @@ def teacher_cfg(section: DictConfig) -> Any:
         encoder_hidden_dims=tuple(int(d) for d in section.encoder_hidden_dims),
         latent_dim=int(section.latent_dim),
         kl_weight=float(section.kl_weight),
-        vae_learning_rate=None if section.vae_learning_rate is None else float(section.vae_learning_rate),
+        decoder_learning_rate=None if section.decoder_learning_rate is None else float(section.decoder_learning_rate),
         ppo=ppo_cfg(section),
     )
 

@@ -217,8 +217,8 @@ class TrainTeacherCfg(PolicyTrainingCfg):
     """Terrain latent size z of the VAE teacher (ours; the paper does not give it)."""
     kl_weight: float = 1.0e-4
     """beta, weight of the teacher's KL term (ours; see ``TeacherCfg.kl_weight``)."""
-    vae_learning_rate: float | None = 1.0e-3
-    """Fixed Adam learning rate of the teacher's encoder and decoder (null: the policy's adaptive rate)."""
+    decoder_learning_rate: float | None = 1.0e-3
+    """Fixed Adam learning rate of the teacher's eta decoder (null: the adaptive rate; the encoder always follows it)."""
     warm_start_ppo: str | None = None
     """vae_teacher: a vanilla-PPO checkpoint of the same task (e.g. ``artifacts/ppo_rft3d/checkpoint.pt``) whose
     actor and critic start a fresh teacher run; null: from scratch."""

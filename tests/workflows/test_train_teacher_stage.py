@@ -32,12 +32,12 @@ def test_warm_start_vae_lr_and_beta_reach_the_run(
     cfg = compose(
         "+exp=gm_loco",
         "train_teacher.warm_start_ppo=artifacts/ppo_rft3d/checkpoint.pt",
-        "train_teacher.vae_learning_rate=0.002",
+        "train_teacher.decoder_learning_rate=0.002",
     )
     train_teacher.run(cfg)
     assert seen["warm_start_ppo"] == "artifacts/ppo_rft3d/checkpoint.pt"
     algorithm = seen["rsl_rl_overrides"]["algorithm"]
-    assert algorithm["vae_learning_rate"] == 0.002 and algorithm["kl_weight"] == 1.0e-4
+    assert algorithm["decoder_learning_rate"] == 0.002 and algorithm["kl_weight"] == 1.0e-4
 
 
 def test_no_warm_start_by_default(compose: Callable[..., DictConfig], monkeypatch: pytest.MonkeyPatch) -> None:

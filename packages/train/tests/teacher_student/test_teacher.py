@@ -4,7 +4,6 @@
 from __future__ import annotations
 
 from collections.abc import Callable
-from dataclasses import replace
 from types import SimpleNamespace
 
 import numpy as np
@@ -121,22 +120,3 @@ def test_teacher_ppo_refuses_a_plain_mlp_actor(
     }
     with pytest.raises(TypeError, match="TeacherActor"):
         TeacherPPO.construct_algorithm(toy_env.get_observations(), toy_env, cfg, "cpu")
-
-
-def test_teacher_vae_heads_keep_a_fixed_learning_rate_under_the_adaptive_schedule(
-    toy_env: VecEnv, teacher_cfg: TeacherCfg, groups: ObsGroupsCfg, runner_cfg: Callable[[dict], dict]
-) -> None:
-    """Encoder and decoder sit in their own Adam group; the KL-adaptive rate moves only the policy's group."""
-    ppo = replace(teacher_cfg.ppo, schedule="adaptive", desired_kl=1e-12)  # every mini-batch lowers the rate
-    cfg = replace(teacher_cfg, vae_learning_rate=3e-3, ppo=ppo)
-    alg = _build(toy_env, cfg, groups, runner_cfg)
-    heads = {id(p) for m in (alg.actor.encoder, alg.actor.decoder) for p in m.parameters()}
-    policy_group, vae_group = alg.optimizer.param_groups
-    assert {id(p) for p in vae_group["params"]} == heads and not heads & {id(p) for p in policy_group["params"]}
-    n_params = sum(1 for _ in alg.actor.parameters()) + sum(1 for _ in alg.critic.parameters())
-    assert len(policy_group["params"]) + len(vae_group["params"]) == n_params
-    for _ in range(3):
-        _rollout(alg, toy_env, 4)
-        alg.update()
-    assert vae_group["lr"] == 3e-3
-    assert policy_group["lr"] == alg.learning_rate < ppo.learning_rate

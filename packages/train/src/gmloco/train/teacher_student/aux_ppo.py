@@ -38,11 +38,35 @@ class AuxLossPPO(PPO):
             raise NotImplementedError(f"{type(self).__name__} supports feed-forward models only.")
         super().__init__(actor, critic, storage, **kwargs)  # type: ignore[arg-type]
 
+    def save(self) -> dict:
+        """Return rsl-rl's checkpoint dict plus the adaptive ``learning_rate``, so a resumed run continues from it."""
+        return super().save() | {"learning_rate": self.learning_rate}
+
     def load(self, loaded_dict: dict, load_cfg: dict | None, strict: bool) -> bool:
-        """Load a checkpoint; one saved without ``optimizer_state_dict`` (a slim artifact) starts a fresh optimizer."""
+        """Load a checkpoint and its adaptive learning rate.
+
+        A checkpoint without ``optimizer_state_dict`` (a slim artifact), or whose optimizer groups no longer match
+        this algorithm's (a checkpoint of an earlier parameter grouping), starts a fresh optimizer. The saved
+        ``learning_rate`` is restored either way: a fresh Adam's first steps move every weight by about the rate,
+        so resuming at the schedule's initial rate would jolt a trained policy.
+        """
+        if "optimizer_state_dict" in loaded_dict and not self._optimizer_matches(loaded_dict["optimizer_state_dict"]):
+            print(f"[{type(self).__name__}] checkpoint optimizer groups differ from this run's: fresh optimizer")
+            loaded_dict = {k: v for k, v in loaded_dict.items() if k != "optimizer_state_dict"}
         if "optimizer_state_dict" not in loaded_dict:
             load_cfg = {"actor": True, "critic": True, "iteration": True} | (load_cfg or {}) | {"optimizer": False}
-        return super().load(loaded_dict, load_cfg, strict)
+        out = super().load(loaded_dict, load_cfg, strict)
+        if "learning_rate" in loaded_dict:
+            self.learning_rate = float(loaded_dict["learning_rate"])
+            for group in self.optimizer.param_groups:
+                if not group.get("fixed_lr", False):
+                    group["lr"] = self.learning_rate
+        return out
+
+    def _optimizer_matches(self, state: dict) -> bool:
+        """Whether a saved optimizer state has this optimizer's number of groups and of parameters per group."""
+        saved = [len(g["params"]) for g in state.get("param_groups", [])]
+        return saved == [len(g["params"]) for g in self.optimizer.param_groups]
 
     def policy_loss_weight(self) -> float:
         """Return w_PPO, the weight of the actor's PPO terms (1 for plain PPO)."""

@@ -49,7 +49,7 @@ class TeacherPPO(AuxLossPPO):
         eta_index: int = -1,
         kl_weight: float = 1e-3,
         reconstruction_weight: float = 1.0,
-        vae_learning_rate: float | None = 1e-3,
+        decoder_learning_rate: float | None = 1e-3,
         **kwargs: object,
     ) -> None:
         """Initialise PPO and the VAE loss weights.
@@ -62,7 +62,9 @@ class TeacherPPO(AuxLossPPO):
             eta_index: Column of eta in that group.
             kl_weight: beta, weight of the KL term.
             reconstruction_weight: Weight of (eta - psi(z))^2 (1 in the paper).
-            vae_learning_rate: Fixed Adam learning rate of the encoder and decoder (None: the policy's adaptive one).
+            decoder_learning_rate: Fixed Adam learning rate of the eta decoder (None: the policy's adaptive one).
+                The encoder always follows the policy's KL-adaptive rate: its latent feeds the actor, so it is part
+                of the policy the KL measures.
             **kwargs: rsl-rl PPO arguments.
 
         Raises:
@@ -75,8 +77,8 @@ class TeacherPPO(AuxLossPPO):
         self.eta_index = eta_index
         self.kl_weight = kl_weight
         self.reconstruction_weight = reconstruction_weight
-        if vae_learning_rate is not None:
-            self.split_fixed_lr_group([actor.encoder, actor.decoder], vae_learning_rate)
+        if decoder_learning_rate is not None:
+            self.split_fixed_lr_group([actor.decoder], decoder_learning_rate)
 
     def auxiliary_loss(self, batch: RolloutStorage.Batch) -> tuple[torch.Tensor, dict[str, float]]:
         """Return ``w_rec * (eta - psi(z))^2 + beta * KL`` on the latent of the preceding actor forward."""
