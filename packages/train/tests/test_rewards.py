@@ -92,7 +92,7 @@ def test_curriculum_scale_compresses_stages_and_ramps() -> None:
     assert steps == [0, 24_000, 36_000]
     assert cur["ramp_track_lin_vel_xy_exp"].params["num_steps"] == 36_000
     paper = make_curriculum_cfg(g1_granular_task("rft3d"), make_rewards_cfg(task))
-    assert paper["ramp_track_heading_exp"].params["num_steps"] == 360_000
+    assert paper["ramp_track_yaw_target_exp"].params["num_steps"] == 360_000
 
 
 def test_clearance_penalty_is_zero_for_still_feet_and_grows_with_the_miss() -> None:

@@ -167,6 +167,16 @@ class GranularTaskCfg:
     early, results/mpm_eval/gpu_s9/README.md). With ``foot_faces="box"`` it trained ``artifacts/gm_loco_teacher_td``,
     whose student is the first policy to walk 10 s on MPM sand (results/mpm_eval/gpu_s10/README.md); the weight
     is that run's, not tuned against others."""
+    yaw_command: Literal["yaw_target", "heading_envs"] = "yaw_target"
+    """Heading command. ``"yaw_target"`` (GM-Loco's code): every env holds a yaw target that integrates the
+    commanded w_z (``mdp.commands.YawTargetVelocityCommand``), rewarded by ``track_yaw_target_exp`` (weight 4), and
+    the observed w_z carries ``heading_stiffness`` times the heading error. ``"heading_envs"`` (mjlab's task, the
+    committed policies up to ``gm_loco_teacher_td``): 30 % of envs steer toward a random heading, the rest get no
+    heading feedback, and a straight command drifts (11-74 degrees in 10 s measured on MPM and in the training
+    simulator)."""
+    heading_stiffness: float = 1.0
+    """k of the observed yaw-rate command w_z + k * e_psi under ``yaw_command="yaw_target"`` [1/s] (mjlab's heading
+    envs use 0.5); part of a policy's deploy contract."""
     reward_weights: dict[str, float] = field(default_factory=dict)
     """Overrides of reward term weights by name (see ``mdp.rewards``)."""
     play: bool = False

@@ -22,6 +22,7 @@ import numpy as np
 import torch
 
 from gmloco.train.config import ContactModelName, SandFloorCfg, TerrainName
+from gmloco.train.mdp.commands import hold_twist
 
 __all__ = ["EvalCfg", "RolloutCriteriaCfg", "evaluate_policy"]
 
@@ -196,7 +197,7 @@ def _rollout(
     term = env.command_manager.get_term("twist")
     env.reset()
     # Commands are never resampled (resampling time 1e9 s); backfill the history with the fixed command.
-    term.vel_command_b[:] = commands
+    hold_twist(term, commands)
     n = env.num_envs
     obs = env.observation_manager.compute(update_history=True, env_ids=torch.arange(n, device=env.device))
     alive = torch.ones(n, dtype=torch.bool, device=env.device)

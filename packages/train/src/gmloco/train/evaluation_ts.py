@@ -40,6 +40,7 @@ import torch
 
 from gmloco.train.config import ContactModelName, TerrainName
 from gmloco.train.evaluation import RolloutCriteriaCfg, accumulate_tracking, tracking_stats
+from gmloco.train.mdp.commands import hold_twist
 from gmloco.train.teacher_student.heldout import DEFAULT_HELD_OUT, HeldOutRegionCfg, r2_score
 
 __all__ = [
@@ -203,7 +204,7 @@ def _start(runner: Any, commands: torch.Tensor) -> Any:
 
     env = runner.env.unwrapped
     env.reset()
-    env.command_manager.get_term("twist").vel_command_b[:] = commands
+    hold_twist(env.command_manager.get_term("twist"), commands)
     ids = torch.arange(env.num_envs, device=env.device)
     env.observation_manager.reset(ids)  # history back-filled with the commanded frame, not the reset one
     obs = env.observation_manager.compute(update_history=True, env_ids=ids)

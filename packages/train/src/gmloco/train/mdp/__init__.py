@@ -34,6 +34,7 @@ from gmloco.train.mdp.rewards import (
     track_ang_vel_z_exp,
     track_heading_exp,
     track_lin_vel_xy_exp,
+    track_yaw_target_exp,
     undesired_contacts,
     variable_posture_l1,
 )
@@ -73,6 +74,7 @@ __all__ = [
     "track_ang_vel_z_exp",
     "track_heading_exp",
     "track_lin_vel_xy_exp",
+    "track_yaw_target_exp",
     "undesired_contacts",
     "variable_posture_l1",
 ]

@@ -46,6 +46,7 @@ __all__ = [
     "track_ang_vel_z_exp",
     "track_heading_exp",
     "track_lin_vel_xy_exp",
+    "track_yaw_target_exp",
     "undesired_contacts",
     "variable_posture_l1",
 ]
@@ -135,6 +136,19 @@ def track_heading_exp(
     heading = env.scene[asset_cfg.name].data.heading_w
     err = wrap_to_pi(term.heading_target - heading)  # type: ignore[attr-defined]
     return _exp_kernel(torch.square(err), std) * term.is_heading_env.float()  # type: ignore[attr-defined]
+
+
+def track_yaw_target_exp(
+    env: ManagerBasedRlEnv, std: float, command_name: str, asset_cfg: SceneEntityCfg = _ROBOT
+) -> torch.Tensor:
+    """Track the yaw target of a :class:`~gmloco.train.mdp.commands.YawTargetVelocityCommand`, exp kernel.
+
+    GM-Loco's "track yaw quat" term (weight 4), in every env: exp(-e_psi^2 / std^2) with e_psi the wrapped heading
+    error [rad].
+    """
+    del asset_cfg  # the command term keeps the error against the robot's heading
+    term = env.command_manager.get_term(command_name)
+    return _exp_kernel(torch.square(term.yaw_error), std)  # type: ignore[attr-defined]
 
 
 # Base motion.

@@ -28,6 +28,7 @@ from gmloco.train.config import (
     flat_sand_terrain,
     rough_sand_terrain,
 )
+from gmloco.train.mdp.commands import YawTargetVelocityCommandCfg
 from gmloco.train.sand import FEET_FLOOR_SENSOR, SAND_FLOOR_BODY, add_sand_floor
 from gmloco.train.tasks.g1_granular.events_cfg import make_events_cfg
 from gmloco.train.tasks.g1_granular.observations_cfg import make_observations_cfg
@@ -92,19 +93,22 @@ def _scene(task: GranularTaskCfg, num_envs: int) -> SceneCfg:
 
 
 def _command(task: GranularTaskCfg) -> UniformVelocityCommandCfg:
-    """Mjlab velocity command with GM-Loco's initial ranges."""
+    """Twist command with GM-Loco's initial ranges: a yaw target for every env, or mjlab's heading envs."""
+    ranges = UniformVelocityCommandCfg.Ranges(lin_vel_x=(-1.0, 1.0), lin_vel_y=(-0.5, 0.5), ang_vel_z=(-0.5, 0.5))
+    common = {
+        "entity_name": "robot",
+        "resampling_time_range": (3.0, 8.0),
+        "rel_standing_envs": 0.1,
+        "rel_forward_envs": 0.2,
+        "debug_vis": False,
+    }
+    if task.yaw_command == "yaw_target":
+        return YawTargetVelocityCommandCfg(
+            **common, rel_heading_envs=0.0, heading_stiffness=task.heading_stiffness, ranges=ranges
+        )
+    ranges.heading = (-math.pi, math.pi)
     return UniformVelocityCommandCfg(
-        entity_name="robot",
-        resampling_time_range=(3.0, 8.0),
-        rel_standing_envs=0.1,
-        rel_heading_envs=0.3,
-        rel_forward_envs=0.2,
-        heading_command=True,
-        heading_control_stiffness=0.5,
-        debug_vis=False,
-        ranges=UniformVelocityCommandCfg.Ranges(
-            lin_vel_x=(-1.0, 1.0), lin_vel_y=(-0.5, 0.5), ang_vel_z=(-0.5, 0.5), heading=(-math.pi, math.pi)
-        ),
+        **common, rel_heading_envs=0.3, heading_command=True, heading_control_stiffness=0.5, ranges=ranges
     )
 
 

@@ -30,16 +30,27 @@ def _posture_stds() -> dict[str, dict[str, float]]:
     return {k: params[k] for k in ("std_standing", "std_walking", "std_running")}
 
 
-def _tracking_terms() -> dict[str, RewardTermCfg]:
-    """Velocity and heading tracking (exp kernels)."""
+def _tracking_terms(task: GranularTaskCfg) -> dict[str, RewardTermCfg]:
+    """Velocity and heading tracking (exp kernels); the heading term follows ``task.yaw_command``."""
     std = math.sqrt(0.5)
+    heading = (
+        {
+            "track_yaw_target_exp": RewardTermCfg(
+                func=mdp.track_yaw_target_exp, weight=4.0, params={"std": std, "command_name": CMD}
+            )
+        }
+        if task.yaw_command == "yaw_target"
+        else {
+            "track_heading_exp": RewardTermCfg(
+                func=mdp.track_heading_exp, weight=4.0, params={"std": std, "command_name": CMD}
+            )
+        }
+    )
     return {
         "track_lin_vel_xy_exp": RewardTermCfg(
             func=mdp.track_lin_vel_xy_exp, weight=4.0, params={"std": std, "command_name": CMD}
         ),
-        "track_heading_exp": RewardTermCfg(
-            func=mdp.track_heading_exp, weight=4.0, params={"std": std, "command_name": CMD}
-        ),
+        **heading,
         "track_ang_vel_z_exp": RewardTermCfg(
             func=mdp.track_ang_vel_z_exp, weight=1.0, params={"std": std, "command_name": CMD}
         ),
@@ -133,7 +144,7 @@ def _feet_terms(task: GranularTaskCfg) -> dict[str, RewardTermCfg]:
 
 def make_rewards_cfg(task: GranularTaskCfg) -> dict[str, RewardTermCfg]:
     """Return the reward terms with ``task.reward_weights`` overrides applied (weight 0 drops a term)."""
-    rewards = {**_tracking_terms(), **_base_terms(), **_joint_terms(), **_feet_terms(task)}
+    rewards = {**_tracking_terms(task), **_base_terms(), **_joint_terms(), **_feet_terms(task)}
     unknown = set(task.reward_weights) - set(rewards)
     if unknown:
         raise KeyError(f"Unknown reward terms in reward_weights: {sorted(unknown)}")
@@ -164,7 +175,7 @@ def make_curriculum_cfg(task: GranularTaskCfg, rewards: dict[str, RewardTermCfg]
     ramp_steps = round(task.reward_ramp_steps * task.curriculum_scale)
     if ramp_steps > 0:
         std = ("std", math.sqrt(1.0), math.sqrt(0.1))
-        for name in ("track_lin_vel_xy_exp", "track_heading_exp", "track_ang_vel_z_exp"):
+        for name in ("track_lin_vel_xy_exp", "track_heading_exp", "track_yaw_target_exp", "track_ang_vel_z_exp"):
             if name not in rewards:
                 continue
             w = rewards[name].weight
