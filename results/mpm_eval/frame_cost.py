@@ -1,7 +1,7 @@
 # SPDX-License-Identifier: Apache-2.0
 """Wall-clock cost of one MPM frame against the particles in the solve, and the time-box fit's model of it (issue 9).
 
-Reads every run of sessions 20-23 whose episodes carry the wall clock (``elapsed_s``, ``end_frame``), takes each
+Reads every run of the square- and reach-window rows (``FOLDERS``) whose episodes carry the wall clock (``elapsed_s``, ``end_frame``), takes each
 scene's stretch with all its lanes walking (``gmloco.eval.run_rates.running_rates``) and pools the frames and seconds
 per built size (particles, lanes). Fits ``frame_s = a + b * particles`` and compares it with the model
 ``gmloco.eval.g1_eval_fit`` uses to fit cells into a time box: a measured full cell's frame, scaled by lanes above
@@ -22,14 +22,19 @@ from gmloco.eval.g1_eval_fit import FRAME_COST_FLOOR, CellCost, frame_seconds
 from gmloco.eval.run_rates import has_wall_clock, running_rates, scenes
 
 HERE = Path(__file__).resolve().parent
-SESSIONS = ("gpu_s20", "gpu_s21", "gpu_s22", "gpu_s23")
+FOLDERS = (  # the row folders whose episodes carry the wall clock
+    "table_rows/dry_sand_square_window",
+    "table_rows/poppy_seed_deep_sand_reach",
+    "table_rows/basalt_rough_square_window",
+    "table_rows/last_rows_retire_lanes",
+)
 
 
 def points() -> list[dict[str, float]]:
     """One point per built size: particles, lanes, frames, seconds and seconds per frame (all lanes walking)."""
     pooled: dict[tuple[int, int], list[float]] = {}
-    for session in SESSIONS:
-        for path in sorted((HERE / session / "runs").glob("*/episodes.jsonl")):
+    for folder in FOLDERS:
+        for path in sorted((HERE / folder / "runs").glob("*/episodes.jsonl")):
             for scene in scenes(read_episodes(path)):
                 if not all(has_wall_clock(e) for e in scene):
                     continue
@@ -60,7 +65,7 @@ def main() -> None:
     per_lane = full["particles"] / full["lanes"] / 1e6
     model = {n: frame_seconds(cost, n) for n in range(1, int(full["lanes"]) + 1)}
     doc = {
-        "sessions": SESSIONS,
+        "folders": FOLDERS,
         "clock": "wall (elapsed_s, end_frame); all lanes of a scene walking",
         "points": [{k: round(v, 4) for k, v in p.items()} for p in pts],
         "fit": {"frame_s_at_zero": round(float(a), 4), "frame_s_per_million_particles": round(float(b), 4)},
@@ -83,8 +88,7 @@ def main() -> None:
                     xytext=(4, -10), fontsize=7)  # fmt: skip
     ax.set_xlabel("particles in the solve [million]")
     ax.set_ylabel("wall-clock seconds per MPM frame")
-    span = f"{SESSIONS[0].removeprefix('gpu_s')}-{SESSIONS[-1].removeprefix('gpu_s')}"
-    ax.set_title(f"H200, 3 cm, 500 sweeps, 5 ms frames (sessions {span})", fontsize=9)
+    ax.set_title("H200, 3 cm, 500 sweeps, 5 ms frames (runs with the wall clock)", fontsize=9)
     ax.set_xlim(0, None)
     ax.set_ylim(0, None)
     ax.legend(fontsize=7, loc="upper left")

@@ -30,7 +30,14 @@ from gmloco.eval.run_rates import retire_setting, running_rates
 HERE = Path(__file__).resolve().parent
 BINS = ((25, 25), (10, 24), (4, 9), (1, 3))
 """Robots walking (of 25 lanes), inclusive ranges."""
-SESSIONS = ("gpu_s18", "gpu_s19", "gpu_s20", "gpu_s21", "gpu_s22", "gpu_s23")
+FOLDERS = (  # the row folders, oldest code first
+    "table_rows/ablation_circles",
+    "table_rows/transition_course",
+    "table_rows/dry_sand_square_window",
+    "table_rows/poppy_seed_deep_sand_reach",
+    "table_rows/basalt_rough_square_window",
+    "table_rows/last_rows_retire_lanes",
+)
 SERIES = (
     ("off", "step clock", "tab:gray"),
     ("on", "step clock", "tab:olive"),
@@ -47,8 +54,8 @@ def pooled() -> dict[str, dict[str, dict[str, float]]]:
     are pooled apart.
     """
     out: dict[str, dict[str, dict[str, float]]] = {}
-    for session in SESSIONS:
-        for run in sorted((HERE / session / "runs").iterdir()):
+    for folder in FOLDERS:
+        for run in sorted((HERE / folder / "runs").iterdir()):
             path = run / "episodes.jsonl"
             if not path.is_file():
                 continue
@@ -63,8 +70,8 @@ def pooled() -> dict[str, dict[str, dict[str, float]]]:
                 cell = out.setdefault(key, {}).setdefault(f"{lo}-{hi}", {"frames": 0.0, "seconds": 0.0, "runs": []})
                 cell["frames"] += frames
                 cell["seconds"] += secs
-                if f"{session}/{run.name}" not in cell["runs"]:
-                    cell["runs"].append(f"{session}/{run.name}")
+                if f"{folder}/{run.name}" not in cell["runs"]:
+                    cell["runs"].append(f"{folder}/{run.name}")
     for bins in out.values():
         for cell in bins.values():
             cell["frames_per_s"] = round(cell["frames"] / cell["seconds"], 3)

@@ -34,63 +34,78 @@ def cases() -> list[dict]:
                     "x_target": round(rf / TARGET_RF_S, 3), "source": source})  # fmt: skip
 
     s12 = {
-        json.loads(line)["case"]: json.loads(line) for line in (HERE / "gpu_s12/sweep.jsonl").read_text().splitlines()
+        json.loads(line)["case"]: json.loads(line)
+        for line in (HERE / "convergence/accepted_setting/sweep.jsonl").read_text().splitlines()
     }
     add("s12: 5 cm / 1000 sweeps, 1.8 x 0.6 m, 32 lanes", "H100", s12["td_v0.05_it1000_r32"]["robot_frames_per_s"], "rejected",
-        "gpu_s12/sweep.jsonl")  # fmt: skip
-    s12best = _load("gpu_s12/throughput.json")
+        "convergence/accepted_setting/sweep.jsonl")  # fmt: skip
+    s12best = _load("convergence/accepted_setting/throughput.json")
     add("s12: accepted setting, grid reserve 3.0x, 64 lanes", "H200", s12best["robot_frames_per_s"], "accepted",
-        "gpu_s12/throughput.json")  # fmt: skip
-    for c in _load("gpu_s13/throughput.json")["cases"]:
-        add(f"s13: {c['label']}", "H200", c["robot_frames_per_s"], "accepted", "gpu_s13/throughput.json")
-    cost = _load("gpu_s15/cost.json")["cases"]
+        "convergence/accepted_setting/throughput.json")  # fmt: skip
+    for c in _load("convergence/grid_capacity_solvers/throughput.json")["cases"]:
+        add(
+            f"s13: {c['label']}",
+            "H200",
+            c["robot_frames_per_s"],
+            "accepted",
+            "convergence/grid_capacity_solvers/throughput.json",
+        )
+    cost = _load("window_study/window_behind_pelvis/cost.json")["cases"]
     for key, verdict in (("cost/r32_l1.4_w0.6_d0.3", "accepted"), ("cost/r32_l1.0_w0.5_d0.3", "rejected"),
                          ("cost/r32_l0.8_w0.5_d0.25", "rejected"), ("cost/r64_l0.8_w0.5_d0.25", "rejected")):  # fmt: skip
-        add(f"s15: {cost[key]['label']}", "H100", cost[key]["robot_frames_per_s"], verdict, "gpu_s15/cost.json")
-    for name, c in _load("gpu_s16/throughput.json")["rows"].items():
+        add(
+            f"s15: {cost[key]['label']}",
+            "H100",
+            cost[key]["robot_frames_per_s"],
+            verdict,
+            "window_study/window_behind_pelvis/cost.json",
+        )
+    for name, c in _load("table_rows/per_terrain/throughput.json")["rows"].items():
         if name in ("table_td_poppy_seed", "table_td_dry_sand_deep", "table_clr50_dry_sand_l1.4"):
             add(f"s16: row {name.removeprefix('table_')}, 50 lanes (shared host)", "H100",
-                c["robot_frames_per_s_all_lanes"], "accepted", "gpu_s16/throughput.json")  # fmt: skip
-    for c in sorted(_load("gpu_s17/throughput.json")["lanes_case"].values(), key=lambda v: v["lanes"]):
+                c["robot_frames_per_s_all_lanes"], "accepted", "table_rows/per_terrain/throughput.json")  # fmt: skip
+    for c in sorted(
+        _load("table_rows/rough_circles_lanes/throughput.json")["lanes_case"].values(), key=lambda v: v["lanes"]
+    ):
         add(f"s17: {c['lanes']} lanes, 0.3 s (side by side)", "H100", c["robot_frames_per_s_all_lanes"], "accepted",
-            "gpu_s17/throughput.json")  # fmt: skip
-    s18 = _load("gpu_s18/throughput.json")
+            "table_rows/rough_circles_lanes/throughput.json")  # fmt: skip
+    s18 = _load("table_rows/ablation_circles/throughput.json")
     shares = [s18["runs"][f"table_td_dry_sand_x4_share{i}of4"]["robot_frames_per_s_all_lanes"] for i in range(4)]
     add("s18: td dry-sand row, 25 lanes per GPU (median of 4 shares)", "H200", statistics.median(shares), "accepted",
-        "gpu_s18/throughput.json")  # fmt: skip
+        "table_rows/ablation_circles/throughput.json")  # fmt: skip
     row = s18["rows"]["table_td_dry_sand_x4"]
     add(f"s18: the same row on 4 GPUs at once: {row['wall_minutes']} min incl. build (as a rate)", "4x H200",
-        100 * 10.0 / 0.005 / (row["wall_minutes"] * 60), "accepted", "gpu_s18/throughput.json", gpus=4)  # fmt: skip
+        100 * 10.0 / 0.005 / (row["wall_minutes"] * 60), "accepted", "table_rows/ablation_circles/throughput.json", gpus=4)  # fmt: skip
 
-    def retire_ab(session: str, seconds: int, runs: tuple[str, str]) -> None:
-        """A side-by-side retire-lanes A/B (kept run, retired run) of ``session``: two cases."""
-        data = _load(f"gpu_{session}/throughput.json")
+    def retire_ab(label: str, folder: str, seconds: int, runs: tuple[str, str]) -> None:
+        """A side-by-side retire-lanes A/B (kept run, retired run) of the row folder ``folder``: two cases."""
+        data = _load(f"{folder}/throughput.json")
         for run, how in zip(runs, ("idle lanes kept", "idle lanes retired"), strict=True):
-            add(f"{session}: 25 lanes, {seconds} s at 1.5 m/s, {how} (side by side)", "H200",
-                data["runs"][run]["robot_frames_per_s_all_lanes"], "accepted", f"gpu_{session}/throughput.json")  # fmt: skip
+            add(f"{label}: 25 lanes, {seconds} s at 1.5 m/s, {how} (side by side)", "H200",
+                data["runs"][run]["robot_frames_per_s_all_lanes"], "accepted", f"{folder}/throughput.json")  # fmt: skip
 
-    retire_ab("s19", 6, ("retire_ab_keep", "retire_ab_on"))
-    s19 = _load("gpu_s19/throughput.json")
+    retire_ab("s19", "table_rows/transition_course", 6, ("retire_ab_keep", "retire_ab_on"))
+    s19 = _load("table_rows/transition_course/throughput.json")
     row = s19["rows"]["table_td_transition_sq"]
     add(f"s19: transition row, square 1.4 x 1.4 m window, 4 GPUs: {row['wall_minutes']} min (as a rate)", "4x H200",
-        100 * 10.0 / 0.005 / (row["wall_minutes"] * 60), "accepted", "gpu_s19/throughput.json", gpus=4)  # fmt: skip
-    s20 = _load("gpu_s20/throughput.json")
+        100 * 10.0 / 0.005 / (row["wall_minutes"] * 60), "accepted", "table_rows/transition_course/throughput.json", gpus=4)  # fmt: skip
+    s20 = _load("table_rows/dry_sand_square_window/throughput.json")
     shares = [s20["runs"][f"table_td_dry_sand_sq_share{i}of4"]["robot_frames_per_s_all_lanes"] for i in (0, 1, 3)]
     add("s20: td dry-sand row, square 1.4 x 1.4 m window, 25 lanes (median of 3 shares)", "H200",
-        statistics.median(shares), "accepted", "gpu_s20/throughput.json")  # fmt: skip
-    s21 = _load("gpu_s21/throughput.json")
+        statistics.median(shares), "accepted", "table_rows/dry_sand_square_window/throughput.json")  # fmt: skip
+    s21 = _load("table_rows/poppy_seed_deep_sand_reach/throughput.json")
     shares = [s21["runs"][f"table_td_poppy_seed_reach_share{i}of4"]["robot_frames_per_s_all_lanes"] for i in range(4)]
     add("s21: td poppy-seed row, reach 1.7 x 0.8 m window, 25 lanes (median of 4 shares)", "H200",
-        statistics.median(shares), "accepted", "gpu_s21/throughput.json")  # fmt: skip
+        statistics.median(shares), "accepted", "table_rows/poppy_seed_deep_sand_reach/throughput.json")  # fmt: skip
     # its rows (8.1 / 5.7 min on 2 GPUs) are not rates of 10 s walks: their robots fall within ~1-2 s
-    s22 = _load("gpu_s22/throughput.json")
+    s22 = _load("table_rows/basalt_rough_square_window/throughput.json")
     shares = [s22["runs"][f"table_td_basalt_sq_share{i}of4"]["robot_frames_per_s_all_lanes"] for i in range(4)]
     add("s22: td basalt row, square 1.4 x 1.4 m window, 25 lanes (median of 4 shares)", "H200",
-        statistics.median(shares), "accepted", "gpu_s22/throughput.json")  # fmt: skip
+        statistics.median(shares), "accepted", "table_rows/basalt_rough_square_window/throughput.json")  # fmt: skip
     row = s22["rows"]["table_td_basalt_sq"]  # every robot walks the 10 s: a clean walking row
     add(f"s22: basalt row, square window, 4 GPUs: {row['wall_minutes']} min incl. build (as a rate)", "4x H200",
-        100 * 10.0 / 0.005 / (row["wall_minutes"] * 60), "accepted", "gpu_s22/throughput.json", gpus=4)  # fmt: skip
-    retire_ab("s23", 10, ("retire_ab10_keep", "retire_ab10_on"))
+        100 * 10.0 / 0.005 / (row["wall_minutes"] * 60), "accepted", "table_rows/basalt_rough_square_window/throughput.json", gpus=4)  # fmt: skip
+    retire_ab("s23", "table_rows/last_rows_retire_lanes", 10, ("retire_ab10_keep", "retire_ab10_on"))
     return out
 
 

@@ -22,8 +22,8 @@ from gmloco.eval.tables_mpm import wilson_interval
 
 HERE = Path(__file__).resolve().parent
 ROWS = {
-    "tables' 1.4 x 0.6 m window (session 18)": "gpu_s18/runs/table_td_dry_sand_x4_share*",
-    "square 1.4 x 1.4 m window (session 20)": "gpu_s20/runs/table_td_dry_sand_sq_share*",
+    "tables' 1.4 x 0.6 m window (session 18)": "table_rows/ablation_circles/runs/table_td_dry_sand_x4_share*",
+    "square 1.4 x 1.4 m window (session 20)": "table_rows/dry_sand_square_window/runs/table_td_dry_sand_sq_share*",
 }
 SPEEDS = (1.0, 1.5, 2.0, 2.5)
 

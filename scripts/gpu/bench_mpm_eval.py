@@ -6,7 +6,7 @@ One time-boxed, resumable call; one JSON out.
 Superseded for issue 9's numbers (session 12): this benchmark steps 10 ms frames x 2 rigid steps with 50 rheology
 iterations by default, numerics the convergence check has since rejected (``docs/mpm_eval.md``). The cost of the
 accepted setting (3 cm, 500 iterations, 5 ms frames) is measured with ``g1_eval_cli`` itself on short episodes
-(``results/mpm_eval/gpu_s12/sweep.jsonl``). Kept for its naive / window / multi comparison (``BENCHMARKS.md``).
+(``results/mpm_eval/convergence/accepted_setting/sweep.jsonl``). Kept for its naive / window / multi comparison (``BENCHMARKS.md``).
 
     source scripts/gpu/env.sh
     python scripts/gpu/bench_mpm_eval.py --out $OUT/bench --max-minutes 8.5

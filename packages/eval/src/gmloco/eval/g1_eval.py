@@ -122,7 +122,7 @@ class G1EvalCfg:
     """Fraction of the commanded path that may be left when time runs out and still count as finished [-]."""
     bed_depth: float = 0.30
     """Sand depth of the flat and rough terrains [m] (the deep terrain has its own 0.30 m); a loaded sole of a
-    walking G1 reaches 20-30 cm on MPM sand (``results/mpm_eval/gpu_s11``)."""
+    walking G1 reaches 20-30 cm on MPM sand (``results/mpm_eval/convergence/batched_cuts``)."""
     window: SandWindowCfg = field(default_factory=lambda: SandWindowCfg(length=1.4, width=0.6))
     """Sand window of each robot (``moving=False``: a static bed covering the course, the naive baseline). 1.4 m
     walks as 1.8 m does, 0.6 m wide as 1.0 m does (``docs/mpm_eval.md``); a 1.0 x 0.5 m window was rejected. The
@@ -143,7 +143,7 @@ class G1EvalCfg:
     cell_capacity_factor: float = 1.5
     """Grid capacity = factor x particles / particles-per-cell (fixed capacity: CUDA graph); 0 = unbounded.
     The rheology solver sweeps the whole capacity, so its cost grows with the factor: 1.5 gave 1.46x the
-    robot-frames/s of 3.0 (H200, 32 robots, results/mpm_eval/gpu_s13); an overflow stops the cell with an error."""
+    robot-frames/s of 3.0 (H200, 32 robots, results/mpm_eval/convergence/grid_capacity_solvers); an overflow stops the cell with an error."""
     solver: MpmSolverCfg = field(
         default_factory=lambda: MpmSolverCfg(voxel_size=0.03, frame_dt=0.005, rigid_substeps=1, max_iterations=500)
     )
@@ -533,7 +533,7 @@ FALL_EXIT_S = 0.75
 """An early window exit this close before the episode's fall counts as part of the fall [s]: the trailing sole of
 a stumble. Session 21 reran the poppy-seed and deep-sand rows, whose exits (54 % and 37 % of their walks) came
 0.26-0.72 s before the fall, at a window no sole left: the rows and their times alive did not change (0 of 100
-each; Mann-Whitney p = 0.94 / 0.91; ``results/mpm_eval/gpu_s21/README.md``)."""
+each; Mann-Whitney p = 0.94 / 0.91; ``results/mpm_eval/table_rows/poppy_seed_deep_sand_reach/README.md``)."""
 
 
 FALL_REASONS = ("tilt", "base_height")

@@ -299,7 +299,7 @@ def _window_exit_note(
         "that covers the reach printed by the run (`--window-length`, `--window-width`, `--window-lead`), or, where "
         "the robot turned out of it (the window does not turn), with a square one (length = width). Exits within "
         f"{FALL_EXIT_S:g} s before a fall came with it (a stumble's trailing sole): rerun at a window no sole left, "
-        "session 21's poppy-seed and deep-sand rows did not change (`results/mpm_eval/gpu_s21/README.md`):\n\n"
+        "session 21's poppy-seed and deep-sand rows did not change (`results/mpm_eval/table_rows/poppy_seed_deep_sand_reach/README.md`):\n\n"
         + "\n".join(lines)
         + "\n"
     )

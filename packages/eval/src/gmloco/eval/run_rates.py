@@ -16,7 +16,7 @@ leave it (``runs/<task>/episodes.jsonl``, ``logs/queue.json``) into one ``throug
   scene the lanes step together with a known number of robots left, so the records give the rate of a frame with
   25, 24, ... 1 robots, with or without idle lanes retired (``retire_idle_lanes`` from the run's ``summary.json``).
 
-    python -m gmloco.eval.run_rates results/mpm_eval/gpu_s18 [--out results/mpm_eval/gpu_s18/throughput.json]
+    python -m gmloco.eval.run_rates results/mpm_eval/table_rows/ablation_circles [--out results/mpm_eval/table_rows/ablation_circles/throughput.json]
 """
 
 from __future__ import annotations
@@ -163,7 +163,9 @@ def session_rates(folder: str | Path) -> dict[str, Any]:
     """
     root = Path(folder)
     if not (root / "runs").is_dir():
-        raise FileNotFoundError(f"{root}: no runs/ folder; pass a session folder such as results/mpm_eval/gpu_s18")
+        raise FileNotFoundError(
+            f"{root}: no runs/ folder; pass a session folder such as results/mpm_eval/table_rows/ablation_circles"
+        )
     qpath = root / "logs" / "queue.json"
     queue = json.loads(qpath.read_text()) if qpath.is_file() else {}
     minutes = _task_minutes(queue)

@@ -9,7 +9,7 @@ implicitly against the box's mass and inertia (the body is a *dynamic* collider,
 are the new sand wrench, applied over the next frame, which ends the box at the velocity MPM solved for. Newton's
 ``example_mpm_twoway_coupling`` instead removes the lagged wrench's velocity change (``"rewind"``): MPM then
 re-solves an impact the box has already received and returns it a second time (a landing box bounces back,
-restitution ~1; ``results/box_intrusion/cpu_s5/``).
+restitution ~1; ``results/box_intrusion/coupling_lag_cpu/``).
 
 Batching: given a list of media, the scene holds one walled bed per medium ("region"), side by side in one MPM
 solve, each with its own box. Regions are separated by their walls and a gap of several voxels, so no grid node
