@@ -2,18 +2,18 @@
 """What retiring idle lanes buys, read from the runs' own records -> ``retire_lanes.{json,png}`` (issue 9).
 
 A batch of 25 robots steps together until its last robot's episode ends; a fallen robot's lane is idle from then
-on. Since session 18 an idle lane's sand leaves the MPM solve (``G1EvalCfg.retire_idle_lanes``); before, it was
+on. Since the ablation-circle runs an idle lane's sand leaves the MPM solve (``G1EvalCfg.retire_idle_lanes``); before, it was
 stepped to the end. ``gmloco.eval.run_rates.running_rates`` splits each complete batch's wall time by how many
 robots were still walking. This script pools those stretches, per setting (particles reserved) and per retire
 setting, into bins of robots walking, and draws the solver rate [MPM frames/s] against them.
 
-Caveat written on the figure: sessions 18-19's records time a scene by ``sim_s``, the wall time inside its step,
+Caveat written on the figure: the ablation-circle runs to the transition-course runs records time a scene by ``sim_s``, the wall time inside its step,
 which misses the frames in flight while ended episodes are scored (up to three frames per end). Bins where many
 episodes end (10-24, 4-9) therefore read fast whichever the setting (19 ends within 44 frames took 1.9 s
-by that clock in session 19's transition share 3 at ~2 frames/s); the 25-robot bin has no ends
+by that clock in the transition-course runs' transition share 3 at ~2 frames/s); the 25-robot bin has no ends
 and the 1-3 tail few; the grid check every 30 s also waits outside the step, so every bin reads ~8 % high at
-4.42M particles. Runs from session 19's code on also record ``elapsed_s`` (the wall clock since the batch's first
-frame), which ``running_rates`` uses instead; session 20's code counts the waits as stepping time
+4.42M particles. Runs from the transition-course runs' code on also record ``elapsed_s`` (the wall clock since the batch's first
+frame), which ``running_rates`` uses instead; the square-window runs' code counts the waits as stepping time
 (``G1MpmScene.sync``).
 
     python results/mpm_eval/retire_lanes.py
@@ -50,7 +50,7 @@ SERIES = (
 def pooled() -> dict[str, dict[str, dict[str, float]]]:
     """``{"<particles> particles, retire on|off, wall|step clock": {"lo-hi": {frames, seconds, frames_per_s, runs}}}``.
 
-    Records with ``elapsed_s`` (session 20 on) are timed by the wall clock, older ones by the step clock; the two
+    Records with ``elapsed_s`` (the square-window runs on) are timed by the wall clock, older ones by the step clock; the two
     are pooled apart.
     """
     out: dict[str, dict[str, dict[str, float]]] = {}
@@ -111,9 +111,9 @@ def figure(data: dict, path: Path) -> None:
         ax.set_ylim(0, 1.5 * max(c["frames_per_s"] for k, b in data.items() if k.startswith(size) for c in b.values()))
         ax.legend(loc="upper left", fontsize=7, ncol=2)
     fig.suptitle("Retiring idle lanes (issue 9; H200, 3 cm, 500 sweeps; labels: rate, wall seconds pooled)\n"
-                 "step clock (sessions 18-19) missed the frames in flight at each grid check (every 30 s, every "
-                 "episode end): it reads high, most where episodes end; wall clock (session 20 on) does not; "
-                 "1.88M wall clock: session 23's 10 s A/B, side by side",
+                 "step clock (the ablation-circle runs to the transition-course runs) missed the frames in flight at each grid check (every 30 s, every "
+                 "episode end): it reads high, most where episodes end; wall clock (the square-window runs on) does not; "
+                 "1.88M wall clock: the last-row runs' 10 s A/B, side by side",
                  fontsize=9)  # fmt: skip
     fig.tight_layout()
     fig.savefig(path, dpi=130)

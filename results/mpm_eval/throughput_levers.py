@@ -1,11 +1,11 @@
 # SPDX-License-Identifier: Apache-2.0
 """Every throughput lever measured for issue 9, against the 10-minute target -> ``throughput_levers.{json,png}``.
 
-Reads the sessions' committed measurements (robot-frames/s of the MPM evaluation: MPM frames per second x robots
+Reads the studies' committed measurements (robot-frames/s of the MPM evaluation: MPM frames per second x robots
 stepping in one solver) and marks each case by the convergence check's verdict on its physics: ``accepted`` (the
 setting the tables use, or a change that leaves the physics alone: grid reserve, lanes, solver variant) or
 ``rejected`` (a cheaper setting whose walks differ). The target: 100 ten-second walking episodes (5 ms frames) in
-10 minutes = 333 robot-frames/s. A row split over several GPUs (session 18) is drawn as the rate its wall-clock
+10 minutes = 333 robot-frames/s. A row split over several GPUs (the ablation-circle runs) is drawn as the rate its wall-clock
 stands for (100 x 10 s / wall-clock), apart from the one-GPU cases.
 
     python results/mpm_eval/throughput_levers.py
@@ -26,7 +26,7 @@ def _load(rel: str) -> dict:
 
 
 def cases() -> list[dict]:
-    """(label, GPU, robot-frames/s, verdict, source) of every measured case, oldest session first."""
+    """(label, GPU, robot-frames/s, verdict, source) of every measured case, oldest study first."""
     out = []
 
     def add(label: str, gpu: str, rf: float, verdict: str, source: str, gpus: int = 1) -> None:

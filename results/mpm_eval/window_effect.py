@@ -1,8 +1,8 @@
 # SPDX-License-Identifier: Apache-2.0
 """What the sand window did to the td student's dry-sand row -> ``window_effect.{json,png}`` (issue 9).
 
-The same policy on the same sand, scored twice: session 18 at the tables' 1.4 x 0.6 m window (it does not turn with
-the robot, so walks whose heading drifts step out of its side) and session 20 at the square 1.4 x 1.4 m window
+The same policy on the same sand, scored twice: the ablation-circle runs at the tables' 1.4 x 0.6 m window (it does not turn with
+the robot, so walks whose heading drifts step out of its side) and the square-window runs at the square 1.4 x 1.4 m window
 (which holds the tables' reach at any heading). Per speed: success with its 95 % Wilson interval, and how the
 walks that left the window early ended. Fisher's exact test compares the two windows per speed and over
 1.0-1.5 m/s (above, both score 0).
@@ -22,8 +22,8 @@ from gmloco.eval.tables_mpm import wilson_interval
 
 HERE = Path(__file__).resolve().parent
 ROWS = {
-    "tables' 1.4 x 0.6 m window (session 18)": "table_rows/ablation_circles/runs/table_td_dry_sand_x4_share*",
-    "square 1.4 x 1.4 m window (session 20)": "table_rows/dry_sand_square_window/runs/table_td_dry_sand_sq_share*",
+    "tables' 1.4 x 0.6 m window (the ablation-circle runs)": "table_rows/ablation_circles/runs/table_td_dry_sand_x4_share*",
+    "square 1.4 x 1.4 m window (the square-window runs)": "table_rows/dry_sand_square_window/runs/table_td_dry_sand_sq_share*",
 }
 SPEEDS = (1.0, 1.5, 2.0, 2.5)
 

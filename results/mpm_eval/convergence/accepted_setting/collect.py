@@ -1,5 +1,5 @@
 # SPDX-License-Identifier: Apache-2.0
-"""Gather session 12's device chunks into this folder (issue 9).
+"""Gather the accepted-setting runs' device chunks into this folder (issue 9).
 
     python results/mpm_eval/convergence/accepted_setting/collect.py DEVICE:CHUNKS_DIR [DEVICE:CHUNKS_DIR ...]
 

@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
-# Prepared in session 12 for the next GPU session (issue 9); NOT yet run.
-# The first 100-episode table row at the accepted setting (the defaults of g1_eval_cli since session 12: 3 cm, 500
+# Prepared in the accepted-setting runs for a later GPU run (issue 9); NOT yet run.
+# The first 100-episode table row at the accepted setting (the defaults of g1_eval_cli since the accepted-setting runs: 3 cm, 500
 # iterations, 5 ms frames x 1, bed 30 cm, window 1.4 x 0.6 m): the td student on dry sand, straight, speeds cycled
 # 1.0 / 1.5 / 2.0 / 2.5 m/s (25 each), one MCAP recording per speed. Run job_next_checks.sh first: if it rejects
 # the 0.6 m window width against 1.0 m, add --window-width 1.0 below (~1.7x the cells: ~30 lanes per machine).

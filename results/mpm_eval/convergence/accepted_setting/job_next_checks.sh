@@ -1,8 +1,8 @@
 #!/usr/bin/env bash
-# Prepared in session 12 for the next GPU session (issue 9); NOT yet run. ~15-23 minutes on an H200; run it before
+# Prepared in the accepted-setting runs for a later GPU run (issue 9); NOT yet run. ~15-23 minutes on an H200; run it before
 # job_next.sh (the table run), whose window width depends on (1).
-# (1) The window width at the accepted setting (3 cm, 500 iterations, 1.4 m long): 1.0 m against session 12's
-#     0.6 m runs (results/mpm_eval/convergence/accepted_setting/runs/td_v0.03_it500_d0.3_l1.4_r8_5s{,_seed1}: 16 episodes). Session 11
+# (1) The window width at the accepted setting (3 cm, 500 iterations, 1.4 m long): 1.0 m against the accepted-setting runs'
+#     0.6 m runs (results/mpm_eval/convergence/accepted_setting/runs/td_v0.03_it500_d0.3_l1.4_r8_5s{,_seed1}: 16 episodes). The batched-cuts runs
 #     accepted 0.6 m at 250 iterations on time alive, success and sinkage; with the tracking errors in the check
 #     that pair is rejected on the yaw error. 8 robots x 5 s, seeds 0 and 1 (16 episodes, ~5 min each). Then here:
 #       python -m gmloco.eval.convergence --reference <the two 1.0 m runs> \

@@ -1,5 +1,5 @@
 # SPDX-License-Identifier: Apache-2.0
-"""Gather session 11's device chunks into this folder (issue 9).
+"""Gather the batched-cuts runs' device chunks into this folder (issue 9).
 
     python results/mpm_eval/convergence/batched_cuts/collect.py CHUNKS_DIR [CHUNKS_DIR ...]
 

@@ -1,11 +1,11 @@
 #!/usr/bin/env bash
-# Prepared in session 11 for the next GPU session (issue 9); run as is in session 12 on an H100 (results: ../accepted_setting/).
+# Prepared in the batched-cuts runs for a later GPU run (issue 9); run as is in the accepted-setting runs on an H100 (results: ../accepted_setting/).
 # The iteration axis of the convergence check at 3 cm, on the accepted window (1.8 x 0.6 m, 30 cm bed), 5 s
 # episodes of the td student at 1.0 m/s, 8 robots per run (one batch each), 5 ms frames, one rigid step:
 #   it250 (reference, Newton's default cap), it500, it1000 (1000 = cap; the captured loop stops at the 1e-4
 #   tolerance, so the cost is what the frames need: on the CPU at 5 cm a frame needs ~600, ../rheology_iterations_cpu/README.md).
 # Also 5 cm at 1000: on the CPU the walk at 5 cm stopped falling from 500 iterations on (../rheology_iterations_cpu/README.md), and
-# 5 cm has 4.6x fewer voxels than 3 cm. Last, 1000 iterations with 10 ms frames x 2 rigid steps: session 10 rejected 10 ms frames at 50 iterations, an
+# 5 cm has 4.6x fewer voxels than 3 cm. Last, 1000 iterations with 10 ms frames x 2 rigid steps: the touchdown-lift study rejected 10 ms frames at 50 iterations, an
 # unconverged solve; converged, they would halve the frames per episode.
 # Then: python -m gmloco.eval.convergence --reference <it1000> --candidate <it500> (and it250), and the frames/s of
 # each run is the cost of that iteration setting. Budget ~5 min of kernel compilation first (no warp cache carried).

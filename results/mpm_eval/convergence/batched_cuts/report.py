@@ -1,5 +1,5 @@
 # SPDX-License-Identifier: Apache-2.0
-"""Session 11's tables and figure from ``runs/`` and ``sweep.jsonl`` (issue 9).
+"""The batched-cuts runs' tables and figure from ``runs/`` and ``sweep.jsonl`` (issue 9).
 
     python results/mpm_eval/convergence/batched_cuts/report.py   ->  report.md, fig_alive.png, fig_cost.png
 

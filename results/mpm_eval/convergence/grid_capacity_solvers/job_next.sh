@@ -1,11 +1,11 @@
 #!/usr/bin/env bash
-# Prepared in session 13 for the next GPU session (issue 9); NOT yet run. One H200 machine per part, ~25 min each.
-#   part a: (1) the voxel check that session 13 left open: 2 cm at 1000 rheology iterations, 8 robots x 5 s
+# Prepared in the grid-capacity runs for a later GPU run (issue 9); NOT yet run. One H200 machine per part, ~25 min each.
+#   part a: (1) the voxel check that the grid-capacity runs left open: 2 cm at 1000 rheology iterations, 8 robots x 5 s
 #           (~9 min), then  python -m gmloco.eval.convergence --reference <2 cm / 1000> --candidate
 #           results/mpm_eval/convergence/accepted_setting/runs/td_v0.03_it500_d0.3_l1.4_r8_5s{,_seed1}  (and the 2 cm / 500 run of
 #           ./runs as a second candidate: do iterations or the voxel move the sinkage?);
 #           (2) the contact-model ablation's first row: ppo_rft3d, dry sand, straight, 1.0-2.5 m/s, 100 episodes
-#           (69 done in session 13: copy results/mpm_eval/convergence/grid_capacity_solvers/runs/table_ppo_rft3d_dry_sand to
+#           (69 done in the grid-capacity runs: copy results/mpm_eval/convergence/grid_capacity_solvers/runs/table_ppo_rft3d_dry_sand to
 #           .devsrc/row/ before the launch and it resumes).
 #   part b: the rows of ppo_rigid and the clr50 student (same cell). Policies that fall within ~3 s cost ~1/4 of a
 #           walking policy's row (lanes refill as robots fall), ~8 min each on an H200.

@@ -3,7 +3,7 @@
 
     uv run python results/mpm_eval/convergence/rheology_iterations_cpu/iteration_series.py   ->  iteration_series.md, fig_iteration_series.png
 
-Session 10's CPU walks at 50 / 100 / 250 iterations (``../../probes/touchdown_lift/probe_td_cpu.jsonl``, 10 s) and this session's
+The touchdown-lift study's CPU walks at 50 / 100 / 250 iterations (``../../probes/touchdown_lift/probe_td_cpu.jsonl``, 10 s) and this study's
 at 500 and 1000 (``probe_iters_cpu_i*.jsonl``, 5 s), then 3 s at 1000 iterations commanded 1.5 m/s and with the
 delivered clr50 student at 1.0 m/s; all ``policy_probe.py --window eval --vx 1.0 --voxel 0.05
 --frame-dt 0.005 --substeps 1 --handover predict --depth 0.3`` (the it-672 td student unless named); the rows and the figure

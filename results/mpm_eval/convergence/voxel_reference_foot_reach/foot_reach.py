@@ -7,7 +7,7 @@ logged base pose and joint angles, and expressed in the pelvis' yaw frame (x for
 is below ``--near`` above the sand surface (z = 0) count: those are the ones that need sand under them. Prints,
 per recording, the reach behind / ahead of the pelvis and sideways, the share of those corners outside each window
 and the first time one was (compare with the recording's length: a fall ends it), and writes ``foot_reach.json``
-and ``fig_foot_reach.png`` with the edges of the windows. (Since session 14 every ``g1_eval`` episode records the
+and ``fig_foot_reach.png`` with the edges of the windows. (Since the voxel-reference runs every ``g1_eval`` episode records the
 same check against its own window, ``window_exit_s``; this script covers the runs recorded before.)
 
     uv run python results/mpm_eval/convergence/voxel_reference_foot_reach/foot_reach.py --runs results/mpm_eval/convergence/grid_capacity_solvers/runs/table_td_dry_sand

@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
-# Prepared in session 14 for the next GPU session (issue 9); NOT yet run. One machine, ~25 min.
-#   (1) The window check at 1.5 m/s that session 14 left undecided, with the window moved back: the soles trail
+# Prepared in the voxel-reference runs for a later GPU run (issue 9); NOT yet run. One machine, ~25 min.
+#   (1) The window check at 1.5 m/s that the voxel-reference runs left undecided, with the window moved back: the soles trail
 #       the pelvis by up to 0.55-0.75 m and lead it by 0.2 m at most (foot_reach.py), so 1.0 x 0.5 m centred 0.1 m
 #       BEHIND the pelvis (lead -0.1: x from -0.6 to +0.4 m) against 1.4 x 0.6 m (lead 0.2: -0.5 to +0.9 m).
 #       The td student, 16 robots x 5 s at 3 cm / 500, each run to the end (~3.5 + ~2.5 min on an H100), then
@@ -12,7 +12,7 @@
 #       .devsrc/row/<name> and it continues from its episodes.jsonl).
 #   part b (a second machine): the rows of ppo_rigid and the clr50 student again (falling policies, ~8 min each),
 #       at the window part a accepted (pass its flags as the third argument; none = the default window). Start
-#       them fresh: do not carry session 14's folders of these rows (another window) under .devsrc/row/.
+#       them fresh: do not carry the voxel-reference runs' folders of these rows (another window) under .devsrc/row/.
 # Usage (in ~/src, after the wheels and the Warp cache): bash job_next.sh END_EPOCH [a|b] ["WINDOW FLAGS"]
 END=$1
 PART=${2:-a}
@@ -51,7 +51,7 @@ if python3 -c "import json,sys; sys.exit(json.load(open('$HOME/chunks/verdict_wi
 else
   WIN=""; log "small window not accepted at 1.5 m/s: the row uses the default window"
 fi
-# (1b) Cheaper still, at 1.0 m/s (8 robots x 5 s, ~2 min each; compare each against session 12's 1.4 x 0.6 runs
+# (1b) Cheaper still, at 1.0 m/s (8 robots x 5 s, ~2 min each; compare each against the accepted-setting runs' 1.4 x 0.6 runs
 #      results/mpm_eval/convergence/accepted_setting/runs/td_v0.03_it500_d0.3_l1.4_r8_5s{,_seed1} on the CPU afterwards):
 #      a 0.8 m window (x from -0.5 to +0.3 m), a 25 cm bed (20 cm was rejected: +36 % sinkage), and both at once
 #      (0.10 m^3 of sand per robot against 0.15 at 1.0 x 0.5 x 0.3 m: ~1.5x cheaper again if it passes). A 0.4 m

@@ -1,5 +1,5 @@
 # SPDX-License-Identifier: Apache-2.0
-"""GPU probe (session 5): 3D-RFT G of two 10 cm plates in MPM sand at several ``mpm:friction`` values.
+"""GPU probe (the dig-in probes): 3D-RFT G of two 10 cm plates in MPM sand at several ``mpm:friction`` values.
 
 The horizontal plate is pushed straight down (G_z), the vertical plate dragged along +x (G_x); 0.6 x 0.6 x 0.3 m
 bed, 2 cm voxels, 1000 iterations, samples at 6-16 cm (the 36-plate fit's numerics). Each argument after the

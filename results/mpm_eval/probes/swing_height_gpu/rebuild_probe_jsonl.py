@@ -1,5 +1,5 @@
 # SPDX-License-Identifier: Apache-2.0
-"""Rebuild the probe records of session 7 from the probes' stdout (their ``--log`` path was lost on the machine).
+"""Rebuild the probe records of the swing-height probes from the probes' stdout (their ``--log`` path was lost on the machine).
 
 ``policy_probe.py`` prints every logged row and the run's summary dict; this reads them back into the record shape
 that ``--log`` would have held (``particles`` and ``mass`` were not printed: None). Run from the repository root:
@@ -18,7 +18,7 @@ SETTINGS = dict(vx_cmd=1.0, window="eval", rigid=False, depth=0.3, voxel=0.03, i
                 frame_dt=0.005, substeps=1, effective_mass=None, grid="sparse", handover="predict")  # fmt: skip
 POLICIES = {
     "old": "artifacts/gm_loco_student/policy.onnx",
-    "new": "artifacts/gm_loco_student_clr50 (it 419, CPU export of the session-7 machine-1 checkpoint)",
+    "new": "artifacts/gm_loco_student_clr50 (it 419, CPU export of the swing-height probes machine-1 checkpoint)",
     "ppo": "artifacts/ppo_rft3d/policy.onnx",
 }
 

@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Session 9 machine 1 (issue 9). GPU: fine-tune the delivered student (clr50, it 1081) with a 6x swing-clearance
+# Machine 1 of the swing-trip study (issue 9). GPU: fine-tune the delivered student (clr50, it 1081) with a 6x swing-clearance
 # weight (foot_clearance_l2 = -300) as run gm_loco_student_hs; chunk A, then (background) the chunk-A student on MPM
 # sand at 3 cm / 5 ms / 250 its in the probe while chunk B trains on.
 # Usage (in ~/src): bash job.sh END_EPOCH

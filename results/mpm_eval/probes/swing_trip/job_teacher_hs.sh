@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Session 9 machine 3 (issue 9): continue the clr50 teacher (it 1276) with a 6x swing-clearance weight
+# Machine 3 of the swing-trip study (issue 9): continue the clr50 teacher (it 1276) with a 6x swing-clearance weight
 # (foot_clearance_l2 = -300) as run gm_loco_teacher_hs. The student fine-tune of machine 2 showed that the
 # distillation term holds the student to its teacher's ~4.5 cm swing, so the gait has to change in the teacher.
 # Usage (in ~/src): bash job3.sh END_EPOCH

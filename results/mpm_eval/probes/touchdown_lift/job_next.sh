@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
-# Prepared in session 10 for the next GPU session (issue 9); NOT yet run.
-# The resolution check of session 10 (README.md) accepts only 3 cm / 250 iterations / 5 ms frames for the walking
+# Prepared in the touchdown-lift study for a later GPU run (issue 9); NOT yet run.
+# The resolution check of the touchdown-lift study (README.md) accepts only 3 cm / 250 iterations / 5 ms frames for the walking
 # student (gm_loco_student_td, it 672); 5 cm falls at any iteration count. This job:
 # 1. g1_eval, dry sand, 1.0 m/s, at that setting with 16 robots per MPM solver, time-boxed and resumable: the
 #    success rate over as many 10 s episodes as fit, and the throughput (summary.json) at the accepted setting;

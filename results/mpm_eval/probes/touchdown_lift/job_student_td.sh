@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Session 10 machine 2 (issue 9): distil the touchdown/box teacher (gm_loco_teacher_td) into a new student
+# Machine 2 of the touchdown-lift study (issue 9): distil the touchdown/box teacher (gm_loco_teacher_td) into a new student
 # (gm_loco_student_td): actor/critic from the teacher, TCN from the delivered clr50 student; chunk A, then (background)
 # chunk A's export on MPM sand at 3 cm / 5 ms / 250 its in the probe while chunk B trains on.
 # Usage (in ~/src): bash job.sh END_EPOCH TEACHER_CKPT

@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Session 10 machine 1 (issue 9): teacher from clr50 (it 1276) with the touchdown lift reward and box-face RFT,
+# Machine 1 of the touchdown-lift study (issue 9): teacher from clr50 (it 1276) with the touchdown lift reward and box-face RFT,
 # then the adaptation walk of its newest checkpoint on the GPU.
 # Usage (in ~/src): bash job.sh END_EPOCH
 END=$1

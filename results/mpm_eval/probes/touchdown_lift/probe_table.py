@@ -3,9 +3,9 @@
 
     uv run python results/mpm_eval/probes/touchdown_lift/probe_table.py
 
-Reads the ``policy_probe.py`` records of session 10 (``probe_td.jsonl``: the new student after 282 iterations
+Reads the ``policy_probe.py`` records of the touchdown-lift study (``probe_td.jsonl``: the new student after 282 iterations
 (chunk A) and after 672 (chunk B), 3 s and 10 s walks at 1.0 and 1.5 m/s) and the delivered student's record of
-session 8 (same numerics: 3 cm voxels, 250 iterations, 5 ms frames x 1 step, 30 cm of dry sand), and the
+the voxel-size probes (same numerics: 3 cm voxels, 250 iterations, 5 ms frames x 1 step, 30 cm of dry sand), and the
 resolution check run on the CPU (``probe_td_cpu.jsonl``: the it-672 walk at 5 cm with 250 / 100 / 50 iterations and
 5 or 10 ms frames). Prints one
 markdown row per walk (fall time, mean forward speed, the stance depth of the soles, and

@@ -1,5 +1,5 @@
 # SPDX-License-Identifier: Apache-2.0
-"""Basalt at the square window (session 22, issue 9): does the heading's drift decide which walks finish?
+"""Basalt at the square window (the basalt and rough-sand runs, issue 9): does the heading's drift decide which walks finish?
 
 Every one of the 100 walks stayed upright for the 10 s, so a walk fails only by not finishing the straight course
 (progress along the commanded line short of 80 % of v x 10 s). Plots each walk's largest heading turn from its

@@ -1,12 +1,12 @@
 #!/usr/bin/env bash
-# Prepared in session 22 (issue 9); ran in session 23, unchanged (results: ../last_rows_retire_lanes/). Any machine of 1-4 H200s:
+# Prepared in the basalt and rough-sand runs (issue 9); ran in the last-row runs, unchanged (results: ../last_rows_retire_lanes/). Any machine of 1-4 H200s:
 # `python -m gmloco.eval.g1_eval_queue --tasks` runs one evaluation per GPU from the task file below, in order, each
 # time-boxed to END, resumable, and fitted into the time box (g1_eval fit_time_box).
-#   1. rough dry sand at the square window, session 22's four shares resumed (3 / 5 / 4 / 4 of 25 kept): share 0
+#   1. rough dry sand at the square window, the basalt and rough-sand runs' four shares resumed (3 / 5 / 4 / 4 of 25 kept): share 0
 #      (1.0 m/s; its robots walk up to the 10 s: ~18 min with 22 lanes) first, then shares 1-3 (1.5-2.5 m/s; every
 #      walk so far fell within 1.9-5.5 s: a few minutes each). This completes the tables' last row;
-#   2. the clr50 student on dry sand at the reach window (session 22 had no time left for it; ~3 min a share): a
-#      check, on a third policy, of session 21's rule that window exits coming with the fall leave a row unchanged;
+#   2. the clr50 student on dry sand at the reach window (the basalt and rough-sand runs had no time left for it; ~3 min a share): a
+#      check, on a third policy, of the reach-window runs' rule that window exits coming with the fall leave a row unchanged;
 #   3. (four GPUs only, last) the 10 s retire-lanes A/B timed by the wall clock, side by side: the td student on dry
 #      sand at 1.5 m/s, 25 episodes in 25 lanes at the tables' window, idle lanes retired vs --keep-idle-lanes
 #      (~9 min each if no robot fell; on four GPUs they start ~9 min in, with ~16 left).

@@ -1,8 +1,8 @@
 #!/usr/bin/env bash
-# Session 20's job (issue 9), for the machine lent this session: nvidia-h200-x2 (two H200s; the x4 kind was not lent).
-# Session 19's job_next.sh cut to what two GPUs can finish in one session's ~26 minutes of queue: the td student's
-# dry-sand row at the square 1.4 x 1.4 m window (session 18 at the tables' 1.4 x 0.6 m window: 17 of 25 walks at
-# 1.0 m/s turned out of it), resuming session 19's shares 1 and 2 (1 episode each), shares 0 and 3 fresh. The
+# The square-window runs' job (issue 9), for the machine lent this study: nvidia-h200-x2 (two H200s; the x4 kind was not lent).
+# The transition-course runs' job_next.sh cut to what two GPUs can finish in one 30-minute device allotment's ~26 minutes of queue: the td student's
+# dry-sand row at the square 1.4 x 1.4 m window (the ablation-circle runs at the tables' 1.4 x 0.6 m window: 17 of 25 walks at
+# 1.0 m/s turned out of it), resuming the transition-course runs' shares 1 and 2 (1 episode each), shares 0 and 3 fresh. The
 # 1.0 m/s share walks longest (~18 min), so it starts first; 2.5 m/s (~8 min) follows the 1.5 m/s share on the
 # other GPU. Basalt, rough and the cut circle shares follow in case time is left. The 10 s retire-lanes A/B of
 # job_next.sh waits for a four-GPU machine (it would take both GPUs for ~8 minutes).

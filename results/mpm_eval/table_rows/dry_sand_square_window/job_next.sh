@@ -1,18 +1,18 @@
 #!/usr/bin/env bash
-# Prepared in session 20 (issue 9); ran in session 21, unchanged (results: ../poppy_seed_deep_sand_reach/). Any machine of 1-4 H200s:
+# Prepared in the square-window runs (issue 9); ran in the reach-window runs, unchanged (results: ../poppy_seed_deep_sand_reach/). Any machine of 1-4 H200s:
 # `python -m gmloco.eval.g1_eval_queue --tasks` runs one evaluation per GPU from the task file below, in order, each
 # time-boxed to END and resumable. A row is four shares (--shard I/4: one speed each); at the square window a share
-# whose robots walk the full 10 s takes ~17-19 min on an H200 (session 20), one whose robots all fall ~6 min.
+# whose robots walk the full 10 s takes ~17-19 min on an H200 (the square-window runs), one whose robots all fall ~6 min.
 #   1. (four GPUs only) retiring idle lanes, side by side on two GPUs of one host, timed by the episodes' wall
-#      clock: the td student on dry sand at 1.5 m/s, 25 episodes of the full 10 s in 25 lanes (session 19's 6 s
+#      clock: the td student on dry sand at 1.5 m/s, 25 episodes of the full 10 s in 25 lanes (the transition-course runs' 6 s
 #      A/B left no tail), idle lanes retired vs --keep-idle-lanes;
-#   2. the td student's dry-sand row at the square window: session 20's 2.0 m/s share resumed (13 of 25);
+#   2. the td student's dry-sand row at the square window: the square-window runs' 2.0 m/s share resumed (13 of 25);
 #   3. poppy seed and deep sand at the reach window (1.7 x 0.8 m: rear 0.8 m behind the pelvis, front 0.9 ahead):
 #      at the tables' window 54 % and 37 % of their walks left it at ~0.7 s by a trailing sole 0.6-0.73 m behind the pelvis (its rear is
 #      0.5 m behind), 0.3 s before they fell; the square window would not help (same rear). They fall within
 #      ~1-2 s, so a share takes a few minutes: two rows done early;
-#   4. basalt at the square window (session 16 at the tables' window: 50 of 100, 94 % turned out of it), resuming
-#      session 20's share 0 (started, no episode ended), then rough dry sand (31 % exits, 20 % by turn);
+#   4. basalt at the square window (the per-terrain runs at the tables' window: 50 of 100, 94 % turned out of it), resuming
+#      the square-window runs' share 0 (started, no episode ended), then rough dry sand (31 % exits, 20 % by turn);
 #   5. the two circle shares cut by earlier time boxes: ppo_rigid 1.0 m/s (23 of 25), clr50 1.0 m/s (24 of 25).
 #   The rows' windows: `python -m gmloco.eval.tables_todo` (../tables/todo_tasks.txt) lists the same rows; its
 #   windows hold the 97.5th percentile of the recorded reach, fall included (basalt 1.45 x 1.45, rough 1.65 x 1.65,

@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Session 23's second job (issue 9): the one walk the first job's time box left out of the clr50 reach check
+# The last-row runs' second job (issue 9): the one walk the first job's time box left out of the clr50 reach check
 # (share 3 of 4, 2.5 m/s: 24 of 25), resumed so the row is complete. The task line is the one
 # `python -m gmloco.eval.tables_todo` wrote to results/mpm_eval/tables/todo_tasks.txt (copied to .devsrc/tasks_todo.txt).
 #   Before (here): scripts/gpu/snapshot_src.sh && cp results/mpm_eval/table_rows/last_rows_retire_lanes/job_last.sh .devsrc/job.sh &&

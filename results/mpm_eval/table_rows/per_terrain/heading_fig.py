@@ -1,5 +1,5 @@
 # SPDX-License-Identifier: Apache-2.0
-"""Why the soles left the sand window in session 16's rows: the robot's turn or its reach (issue 9).
+"""Why the soles left the sand window in the per-terrain runs' rows: the robot's turn or its reach (issue 9).
 
 Reads every row's ``episodes.jsonl`` (each episode's largest sole reach from the pelvis, its yaw frame) and the
 recordings (the first episode of every speed: the pelvis heading over time). An episode whose soles, over the
@@ -44,7 +44,7 @@ def exit_causes(folder: Path, window: tuple[float, float, float]) -> dict[str, f
               if e["sole_behind_m"] + m <= 0.5 * length - lead and e["sole_ahead_m"] + m <= 0.5 * length + lead
               and e["sole_side_m"] + m <= 0.5 * width]  # fmt: skip
     alive = [e["alive_s"] for e in eps]
-    if eps and "window_exit_s" not in eps[0]:  # runs before the window check (session 13): nothing to count
+    if eps and "window_exit_s" not in eps[0]:  # runs before the window check (the grid-capacity runs): nothing to count
         return {
             "episodes": len(eps),
             "success": sum(e["success"] for e in eps),

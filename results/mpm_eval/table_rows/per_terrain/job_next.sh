@@ -1,15 +1,15 @@
 #!/usr/bin/env bash
-# Prepared in session 16 for the next session (issue 9); NOT yet run. For a machine of several GPUs (nvidia-h100-x4
+# Prepared in the per-terrain runs for the next run (issue 9); NOT yet run. For a machine of several GPUs (nvidia-h100-x4
 # or larger; one GPU works too, slower): `python -m gmloco.eval.g1_eval_queue --tasks` runs one evaluation per GPU
 # from the task file below, in order, each time-boxed to END and resumable. Rows split into four shares
 # (--shard I/4: with four speeds, one speed each) run on four GPUs at once.
 #   1. basalt at the square 1.4 x 1.4 m window (lead 0.2; it contains the tables' 1.4 x 0.6 m window at every
-#      heading): session 16's basalt row left the window in 94 % of its episodes because the student turns
+#      heading): the per-terrain runs' basalt row left the window in 94 % of its episodes because the student turns
 #      35-69 degrees in 10 s and the window does not turn;
 #   2. the lanes case (32 / 50 / 100 robots per solver, 0.3 s, side by side on three GPUs at the same time: the last
 #      throughput lever not measured on one machine), with the ppo_rigid wide row's last 16 episodes (resumed);
 #   3. the rough row (resumed), the transition course (square window: it starts on basalt, where the student turns);
-#   4. the td student on dry sand at the square window (does session 13's 22 % row, scored before exits were
+#   4. the td student on dry sand at the square window (does the grid-capacity runs' 22 % row, scored before exits were
 #      recorded, hold?); then the circles of the four ablation policies (their window is square by construction;
 #      the policies that fall within ~2 s get one task each).
 #   Before: mkdir -p .devsrc/row && cp -r results/mpm_eval/table_rows/per_terrain/runs/table_ppo_rigid_wide_dry_sand \

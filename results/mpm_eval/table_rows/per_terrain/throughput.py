@@ -1,5 +1,5 @@
 # SPDX-License-Identifier: Apache-2.0
-"""Per-row solver rates of session 16's four-GPU run, from the episodes themselves -> ``throughput.json``.
+"""Per-row solver rates of the per-terrain runs' four-GPU run, from the episodes themselves -> ``throughput.json``.
 
 Each episode line holds its batch's solver rate (``frames_per_s``: MPM frames per second of the whole batch),
 particle count, lanes and build time; robot-frames/s while every lane walks = frames/s x lanes. Indicative only:

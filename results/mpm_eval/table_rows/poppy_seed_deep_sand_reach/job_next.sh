@@ -1,19 +1,19 @@
 #!/usr/bin/env bash
-# Prepared in session 21 (issue 9); ran in session 22, unchanged (results: ../basalt_rough_square_window/). Any machine of 1-4 H200s:
+# Prepared in the reach-window runs (issue 9); ran in the basalt and rough-sand runs, unchanged (results: ../basalt_rough_square_window/). Any machine of 1-4 H200s:
 # `python -m gmloco.eval.g1_eval_queue --tasks` runs one evaluation per GPU from the task file below, in order, each
-# time-boxed to END and resumable. A row is four shares (--shard I/4: one speed each). Since session 21 every cell is
+# time-boxed to END and resumable. A row is four shares (--shard I/4: one speed each). Since the reach-window runs every cell is
 # fitted into the time box (g1_eval fit_time_box): a share that cannot end in the time left if no robot falls is
 # rebuilt after ~30 s with the lanes that can, so the last task on each GPU keeps what it walks instead of losing it.
-#   1. basalt at the square window (session 16 at the tables' window: 50 of 100, 94 % turned out of it; session 21's
+#   1. basalt at the square window (the per-terrain runs at the tables' window: 50 of 100, 94 % turned out of it; the reach-window runs'
 #      shares 0-1 were dropped whole by the time box): the td student walks the 10 s there, so a share takes ~18 min;
 #   2. the two circle shares cut by earlier time boxes: ppo_rigid 1.0 m/s (23 of 25), clr50 1.0 m/s (24 of 25):
 #      ~3-5 min each (two or one lanes);
-#   3. rough dry sand at the square window (session 17 at the tables' window: 31 % early exits, 20 % by turn);
+#   3. rough dry sand at the square window (the rough-and-circles runs at the tables' window: 31 % early exits, 20 % by turn);
 #   4. the clr50 student on dry sand at the reach window (22 % early exits at the tables' window, 18 of them within
 #      0.75 s before the fall; its walks fall in ~2 s, a share takes ~3 min): a check, on a third policy, of the rule
-#      session 21 drew from poppy seed and deep sand (exits that come with the fall leave a row unchanged), by which
+#      the reach-window runs drew from poppy seed and deep sand (exits that come with the fall leave a row unchanged), by which
 #      tables_todo no longer lists this rerun.
-#   The 10 s retire-lanes A/B (session 20's job_next.sh) is left out: the time-box fit would cut it unevenly.
+#   The 10 s retire-lanes A/B (the square-window runs' job_next.sh) is left out: the time-box fit would cut it unevenly.
 #   `python -m gmloco.eval.tables_todo` (../tables/todo_tasks.txt) lists the same rows; its windows hold the 97.5th
 #   percentile of the recorded reach (basalt 1.45 x 1.45, rough 1.65 x 1.65); here basalt and rough keep the
 #   dry-sand row's square (one window for the per-terrain rows): of rough's 31 early exits 16 came with the fall

@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Session 17's job (issue 9): session 16's job_next.sh with the queue reordered for what the tables miss most. For a
+# The rough-and-circles runs' job (issue 9): the per-terrain runs' job_next.sh with the queue reordered for what the tables miss most. For a
 # machine of several GPUs (nvidia-h100-x4 or larger; one GPU works too, slower): `python -m gmloco.eval.g1_eval_queue
 # --tasks` runs one evaluation per GPU from the task file below, in order, each time-boxed to END and resumable.
 # Rows split into four shares (--shard I/4: with four speeds, one speed each) run on four GPUs at once.
@@ -10,10 +10,10 @@
 #      circle's window is square by construction);
 #   4. the transition course (square window: it starts on basalt, where the student turns);
 #   5. basalt at the square 1.4 x 1.4 m window (lead 0.2; it contains the tables' 1.4 x 0.6 m window at every
-#      heading): session 16's basalt row left the window in 94 % of its episodes because the student turns
+#      heading): the per-terrain runs' basalt row left the window in 94 % of its episodes because the student turns
 #      35-69 degrees in 10 s and the window does not turn; then the td student on dry sand at the square window
-#      (does session 13's 22 % row, scored before exits were recorded, hold?).
-#   What the time box leaves undone resumes next session from the fetched folders (copy them to .devsrc/row/).
+#      (does the grid-capacity runs' 22 % row, scored before exits were recorded, hold?).
+#   What the time box leaves undone resumes next run from the fetched folders (copy them to .devsrc/row/).
 #   Before: mkdir -p .devsrc/row && cp -r results/mpm_eval/table_rows/per_terrain/runs/table_ppo_rigid_wide_dry_sand \
 #           results/mpm_eval/table_rows/per_terrain/runs/table_td_dry_sand_rough .devsrc/row/   (the two resumed rows)
 #   Usage (in ~/src, after the wheels and the Warp cache): bash job.sh END_EPOCH

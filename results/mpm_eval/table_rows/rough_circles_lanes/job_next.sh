@@ -1,17 +1,17 @@
 #!/usr/bin/env bash
-# Prepared in session 17 for the next session (issue 9); NOT yet run. For a machine of several GPUs (nvidia-h100-x4
+# Prepared in the rough-and-circles runs for the next run (issue 9); NOT yet run. For a machine of several GPUs (nvidia-h100-x4
 # or larger; one GPU works too, slower): `python -m gmloco.eval.g1_eval_queue --tasks` runs one evaluation per GPU
 # from the task file below, in order, each time-boxed to END and resumable. Rows split into four shares
 # (--shard I/4: with four speeds, one speed each) run on four GPUs at once.
 #   1. the td student on dry sand at the tables' window in four shares, started together: one row's wall-clock on
-#      four GPUs (the route to the 10-minute target that one GPU cannot reach), and session 13's 22 % row rescored
+#      four GPUs (the route to the 10-minute target that one GPU cannot reach), and the grid-capacity runs' 22 % row rescored
 #      with the window exits recorded;
 #   2. the circles still missing from the ablation table: td at 2.5 m/s, ppo_rft3d, clr50 and ppo_rigid in four
 #      shares each (the circle's window is square by construction);
 #   3. the transition course (square window: it starts on basalt, where the student turns);
-#   4. basalt at the square 1.4 x 1.4 m window (lead 0.2; session 16's basalt row left the window in 94 % of its
+#   4. basalt at the square 1.4 x 1.4 m window (lead 0.2; the per-terrain runs' basalt row left the window in 94 % of its
 #      episodes because the student turns 35-69 degrees in 10 s and the window does not turn), then the rough row at
-#      the square window (13 of its 24 walks at 1.0 m/s turned out of the tables' window in session 17; the whole
+#      the square window (13 of its 24 walks at 1.0 m/s turned out of the tables' window in the rough-and-circles runs; the whole
 #      row, so the tables can take it in place of the old one; the shares above 1.0 m/s fall within ~3 s).
 #   What the time box leaves undone resumes from the fetched folders (copy them to .devsrc/row/).
 #   This script writes the task file and hands it to scripts/gpu/run_queue.sh (one queue process per machine).

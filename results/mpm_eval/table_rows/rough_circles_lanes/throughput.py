@@ -1,5 +1,5 @@
 # SPDX-License-Identifier: Apache-2.0
-"""Session 17's solver rates from the episodes themselves -> ``throughput.json`` and ``fig_lanes.png``.
+"""The rough-and-circles runs' solver rates from the episodes themselves -> ``throughput.json`` and ``fig_lanes.png``.
 
 Each episode line holds its batch's solver rate (``frames_per_s``: MPM frames per second of the whole batch),
 particle count, lanes and build time; robot-frames/s while every lane walks = frames/s x lanes. The lanes case

@@ -1,17 +1,17 @@
 #!/usr/bin/env bash
-# Prepared in session 19 for the next session (issue 9); NOT yet run. For a machine of several GPUs (nvidia-h200-x4;
+# Prepared in the transition-course runs for the next run (issue 9); NOT yet run. For a machine of several GPUs (nvidia-h200-x4;
 # one GPU works too, slower): `python -m gmloco.eval.g1_eval_queue --tasks` runs one evaluation per GPU from the task
 # file below, in order, each time-boxed to END and resumable. A row is four shares (--shard I/4: one speed each);
-# the 1.0 m/s share (share 0) walks longest (~18 min at the square window in session 19, shares 1-3 ~12/9/8 min),
+# the 1.0 m/s share (share 0) walks longest (~18 min at the square window in the transition-course runs, shares 1-3 ~12/9/8 min),
 # so the first lines start two rows' share 0 while the retire A/B runs beside them.
 #   1. retiring idle lanes, side by side on two GPUs of one host, now timed by the episodes' wall clock
-#      (elapsed_s; session 19's records missed the frames in flight at each episode end): the td student on dry sand
-#      at 1.5 m/s, 25 episodes of the full 10 s in 25 lanes (session 18: 5 of 25 walk the 10 s, most fall at 3-6 s,
+#      (elapsed_s; the transition-course runs' records missed the frames in flight at each episode end): the td student on dry sand
+#      at 1.5 m/s, 25 episodes of the full 10 s in 25 lanes (the ablation-circle runs: 5 of 25 walk the 10 s, most fall at 3-6 s,
 #      so the batch has a tail of few walkers), idle lanes retired vs --keep-idle-lanes;
-#   2. the td student on dry sand at the square 1.4 x 1.4 m window (session 18: 17 of 25 walks at 1.0 m/s turned out
-#      of the tables' window), resuming session 19's cut shares (1 episode each in shares 1 and 2);
+#   2. the td student on dry sand at the square 1.4 x 1.4 m window (the ablation-circle runs: 17 of 25 walks at 1.0 m/s turned out
+#      of the tables' window), resuming the transition-course runs' cut shares (1 episode each in shares 1 and 2);
 #   3. basalt and rough dry sand at the square window (basalt left the tables' window in 94 % of its episodes in
-#      session 16, rough in 31 %);
+#      the per-terrain runs, rough in 31 %);
 #   4. the two circle shares cut by earlier time boxes: ppo_rigid 1.0 m/s (23 of 25), clr50 1.0 m/s (24 of 25).
 #   Before (here): scripts/gpu/snapshot_src.sh && cp results/mpm_eval/table_rows/transition_course/job_next.sh .devsrc/job.sh &&
 #     mkdir -p .devsrc/row && cp -r results/mpm_eval/table_rows/transition_course/runs/table_td_dry_sand_sq_share[12]of4 \

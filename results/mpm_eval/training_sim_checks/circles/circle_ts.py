@@ -1,5 +1,5 @@
 # SPDX-License-Identifier: Apache-2.0
-"""Whether the td student walks the commanded circle in the training simulator (issue 9, session 17).
+"""Whether the td student walks the commanded circle in the training simulator (issue 9, the rough-and-circles runs).
 
 On MPM dry sand the student finished none of 75 circle episodes (``../../table_rows/rough_circles_lanes/README.md``). This walks the same
 student (its ``StudentPPO`` checkpoint, whose ONNX export the MPM evaluation runs) in the granular training simulator

@@ -1,5 +1,5 @@
 # SPDX-License-Identifier: Apache-2.0
-"""Whether the td student's heading drifts in the training simulator too (issue 9, session 16).
+"""Whether the td student's heading drifts in the training simulator too (issue 9, the per-terrain runs).
 
 On MPM basalt the student turned 35-69 degrees in 10 s under a zero yaw-rate command (``../../table_rows/per_terrain/README.md``).
 This walks the same student (its ``StudentPPO`` checkpoint, whose ONNX export the MPM evaluation runs) in the

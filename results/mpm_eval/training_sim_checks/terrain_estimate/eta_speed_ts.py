@@ -8,8 +8,8 @@ granular training simulator (3D-RFT on the whole foot box, as it was trained) on
 pinned, ``--repeats`` envs per cell. Per cell: the mean decoded eta of the student and of its frozen teacher over
 the alive steps after ``--warmup`` s (and the student's over the first 3 s, warm-up included, as the MPM records
 average it), the true eta, the time alive. Beside them the MPM runs' decoded eta per
-speed, from the committed episode records: the transition course per layer (session 19) and the single-material
-rows (basalt, poppy seed: session 16; dry sand: session 18). Writes ``eta_speed_ts.json`` and
+speed, from the committed episode records: the transition course per layer (the transition-course runs) and the single-material
+rows (basalt, poppy seed: the per-terrain runs; dry sand: the ablation-circle runs). Writes ``eta_speed_ts.json`` and
 ``fig_eta_speed.png`` beside this script.
 
     python results/mpm_eval/training_sim_checks/terrain_estimate/eta_speed_ts.py [--repeats 3] [--device cpu]

@@ -1,5 +1,5 @@
 # SPDX-License-Identifier: Apache-2.0
-"""Session 15's cost table and figure from the runs' episodes (robot-frames/s = frames/s x lanes, median).
+"""The window-behind-pelvis runs' cost table and figure from the runs' episodes (robot-frames/s = frames/s x lanes, median).
 
 python results/mpm_eval/window_study/window_behind_pelvis/cost_fig.py   # writes cost.json and fig_cost.png beside this file
 """

@@ -1,17 +1,17 @@
 #!/usr/bin/env bash
-# Prepared in session 15 (issue 9); never run: superseded by ../../table_rows/per_terrain/job_next.sh. One machine, ~24 min after the wheels.
-# Runs one after the other: session 15 ran its checks side by side on one H100 and the GPU did less in all
+# Prepared in the window-behind-pelvis runs (issue 9); never run: superseded by ../../table_rows/per_terrain/job_next.sh. One machine, ~24 min after the wheels.
+# Runs one after the other: the window-behind-pelvis runs ran its checks side by side on one H100 and the GPU did less in all
 # (~112 robot-frames/s summed against ~150 for one process).
-#   (1) Power for the 1.0 x 0.5 m window (lead -0.1) at 1.5 m/s: session 15 accepted it on 16 episodes, but with
+#   (1) Power for the 1.0 x 0.5 m window (lead -0.1) at 1.5 m/s: the window-behind-pelvis runs accepted it on 16 episodes, but with
 #       11 vs 14 successes and +10 % sinkage. 16 more episodes of each window with seed 1; the verdict pools both
 #       seeds (32 vs 32). It is read before any row moves to that window (rows here keep 1.4 x 0.6 m).
 #   (2) Does a stumbling policy need a wider window? ppo_rigid's soles reached 0.64 m ahead / behind and 0.58 m
-#       sideways of the pelvis in session 15's row (55 % early window exits). 16 robots x 5 s at 1.0 m/s:
+#       sideways of the pelvis in the window-behind-pelvis runs' row (55 % early window exits). 16 robots x 5 s at 1.0 m/s:
 #       1.4 x 1.3 m lead 0 (covers that reach) against 1.0 x 0.5 m lead -0.1. Accepted -> the small window is
 #       enough to score it (the falls are not caused by the missing sand); rejected -> its row is rerun wide.
 #   (2b) Lanes: 32, 50 and 100 robots per solver, side by side (cost only).
-#   (3) Rows (100 episodes, straight, 1.0-2.5 m/s, 50 or 100 lanes by (2b), time-boxed, resumable): ppo_rigid (resume session
-#       15's 92 episodes: carry results/mpm_eval/window_study/window_behind_pelvis/runs/table_ppo_rigid_dry_sand as
+#   (3) Rows (100 episodes, straight, 1.0-2.5 m/s, 50 or 100 lanes by (2b), time-boxed, resumable): ppo_rigid (resume the
+#       92 episodes here: carry results/mpm_eval/window_study/window_behind_pelvis/runs/table_ppo_rigid_dry_sand as
 #       .devsrc/row/table_ppo_rigid_dry_sand, only if (2) keeps the small window), clr50 on dry sand and td on
 #       poppy seed at the default 1.4 x 0.6 m window (the tables' setting).
 #   On a machine of several GPUs use job_next_multi.sh instead.
@@ -87,7 +87,7 @@ else
   row table_ppo_rigid_wide_dry_sand $RIGID dry_sand 1.82 --window-length 1.4 --window-width 1.3 --window-lead 0.0
 fi
 # The tables' rows stay at the accepted 1.4 x 0.6 m window whatever (1) says: (1) decides the window of later
-# sessions' rows only after its verdict has been read (a weak pass at 16 episodes made session 15 keep the default).
+# rows only after its verdict has been read (a weak pass at 16 episodes made the window-behind-pelvis runs keep the default).
 log "pooled window verdict: $TDWIN (rows below at the default window)"
 row table_clr50_dry_sand_l1.4 artifacts/gm_loco_student_clr50/policy.onnx dry_sand 0.84
 row table_td_poppy_seed $TD poppy_seed 0.84

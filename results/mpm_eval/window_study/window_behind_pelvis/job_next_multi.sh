@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
-# Prepared in session 15 for a machine of several GPUs (issue 9); ran in session 16 (results: ../../table_rows/per_terrain/). Device time counts the machine's
+# Prepared in the window-behind-pelvis runs for a machine of several GPUs (issue 9); ran in the per-terrain runs (results: ../../table_rows/per_terrain/). Device time counts the machine's
 # held time whatever its GPU count, so on nvidia-h100-x4 (or x8) each GPU runs one evaluation at a time from a
-# shared queue, in priority order: 4-8 times the rows of a one-GPU session. Every row uses the tables' accepted
+# shared queue, in priority order: 4-8 times the rows of a one-GPU run. Every row uses the tables' accepted
 # setting (1.4 x 0.6 m window, the default), except ppo_rigid, whose soles reach 0.64 m ahead / behind and 0.58 m
 # sideways: it gets a 1.4 x 1.3 m window that covers them (strictly more sand; the tables footnote the setting).
 # Rows are time-boxed to END and resumable: carry their folders back as .devsrc/row/<name> next time.
@@ -36,7 +36,7 @@ check() {  # check NAME SPEED SEED WINDOW_FLAGS...: the td student, 16 robots x 
     --episode-s 5 --num-episodes 16 --robots-per-batch 16 --seed $SEED "$@" --out $G/$N > $G/$N.log 2>&1
   log "check $N rc=$? (gpu $CUDA_VISIBLE_DEVICES)"
 }
-window_check() {  # the pooled 1.5 m/s check of the 1.0 x 0.5 m window (session 15's 16 + 16 more, seed 1)
+window_check() {  # the pooled 1.5 m/s check of the 1.0 x 0.5 m window (the window-behind-pelvis runs' 16 + 16 more, seed 1)
   check td_l1.4_w0.6_lead0.2_r16_5s_v1.5_seed1 1.5 1 --window-length 1.4 --window-width 0.6 --window-lead 0.2
   check td_l1.0_w0.5_lead-0.1_r16_5s_v1.5_seed1 1.5 1 $SMALL
   python3 -m gmloco.eval.convergence \

@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Session 12, machine 2 (H200): the cost of the accepted 3 cm / 500 setting on the H200 and the next axes of the
+# Machine 2 of the accepted-setting runs (H200): the cost of the accepted 3 cm / 500 setting on the H200 and the next axes of the
 # convergence check at converged iterations (td student, dry sand, 1.0 m/s, 8 robots, 5 s). Usage: bash job.sh END
 END=$1
 cd ~/src && source scripts/gpu/env.sh && mkdir -p ~/chunks/g1_eval ~/chunks/sweep12

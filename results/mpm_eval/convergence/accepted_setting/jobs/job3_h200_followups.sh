@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Session 12, machine 2 (H200), started from device calls after job2_h200.sh (recorded here as they ran):
+# Machine 2 of the accepted-setting runs (H200), started from device calls after job2_h200.sh (recorded here as they ran):
 # (a) cost cases at 3 cm / 500 it: 8 robots with the 1.8 m window, 32 / 8 / 64 robots with the 1.4 m window;
 # (b) the accepted setting with 10 s episodes (8 robots); (c) 8 more 5 s episodes of the 1.4 m window, seed 1.
 cd ~/src && source scripts/gpu/env.sh

@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Session 11, machine 2: (1) cost sweep (0.5 s episodes, 32 robots) of cheaper windows at 3 cm / 250 / 5 ms;
+# Machine 2 of the batched-cuts runs: (1) cost sweep (0.5 s episodes, 32 robots) of cheaper windows at 3 cm / 250 / 5 ms;
 # (2) 10 s episodes at 1.0 m/s, concurrently: 3 cm on the narrow window (16 robots) and 2 cm on it (4 robots).
 # Usage (in ~/src): bash job2.sh END_EPOCH
 END=$1

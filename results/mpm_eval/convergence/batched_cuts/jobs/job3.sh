@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Session 11, machine 3: iteration check at 3 cm: the narrow window (1.8 x 0.6 m, 30 cm bed) with 150 rheology
+# Machine 3 of the batched-cuts runs: iteration check at 3 cm: the narrow window (1.8 x 0.6 m, 30 cm bed) with 150 rheology
 # iterations instead of 250, 16 robots, 10 s at 1.0 m/s (compare runs/td_v03_r16_w18x06_d03). Usage: bash job3.sh END
 END=$1
 cd ~/src && source scripts/gpu/env.sh && mkdir -p ~/chunks/g1_eval

@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
-# Session 11 phase 2: 10 s episodes of the td student (dry sand, 1.0 m/s, 3 cm / 250 its / 5 ms frames):
-# the reduced window (1.2 x 0.7 m, 20 cm bed, 32 robots per solver) against the session-10 window (1.8 x 1.0 m,
+# The batched-cuts runs phase 2: 10 s episodes of the td student (dry sand, 1.0 m/s, 3 cm / 250 its / 5 ms frames):
+# the reduced window (1.2 x 0.7 m, 20 cm bed, 32 robots per solver) against the touchdown-lift study window (1.8 x 1.0 m,
 # 30 cm bed, 8 robots). Usage (in ~/src): bash phase2.sh END_EPOCH
 END=$1
 cd ~/src && source scripts/gpu/env.sh && mkdir -p ~/chunks/g1_eval

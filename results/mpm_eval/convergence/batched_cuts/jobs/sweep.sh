@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Session 11 throughput sweep of g1_eval at the accepted setting (3 cm / 250 its / 5 ms frames / 1 substep):
+# The batched-cuts runs throughput sweep of g1_eval at the accepted setting (3 cm / 250 its / 5 ms frames / 1 substep):
 # 0.5 s episodes (100 frames), robots per solver and window size varied. Usage (in ~/src): bash sweep.sh END_EPOCH
 END=$1
 cd ~/src && source scripts/gpu/env.sh && mkdir -p ~/chunks/sweep

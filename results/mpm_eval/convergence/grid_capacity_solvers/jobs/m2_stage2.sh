@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Session 13 stage 2 (H200): the rheology-solver study from mid-walk states, then the CUDA-graph cost of 32 robots
+# The grid-capacity runs stage 2 (H200): the rheology-solver study from mid-walk states, then the CUDA-graph cost of 32 robots
 # (0.3 s, accepted setting): gs at grid capacity 3.0 (anchor) / 1.5 / 1.25, jacobi and gs-batched at 3.0.
 END=$1
 cd ~/src && source scripts/gpu/env.sh && mkdir -p ~/chunks/sweep13 ~/chunks/study

@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
-# Session 13, machine 2 (H200): (1) the window width 1.0 m at the accepted setting (seeds 0, 1; 16 episodes of 5 s)
-# against session 12's 0.6 m runs; (2) m2_stage2.sh (the rheology-solver study and the cost cases);
+# Machine 2 of the grid-capacity runs (H200): (1) the window width 1.0 m at the accepted setting (seeds 0, 1; 16 episodes of 5 s)
+# against the accepted-setting runs' 0.6 m runs; (2) m2_stage2.sh (the rheology-solver study and the cost cases);
 # (3) 2 cm at 500 iterations (lost: the machine was given back before it finished; rerun on machine 4).
 END=$1
 cd ~/src && source scripts/gpu/env.sh && mkdir -p ~/chunks/sweep13 ~/chunks/g1_eval

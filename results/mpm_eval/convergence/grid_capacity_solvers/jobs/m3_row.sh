@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Session 13, machine 3 (H200): the first 100-episode row (td student, dry sand, straight, speeds 1.0-2.5 m/s
+# Machine 3 of the grid-capacity runs (H200): the first 100-episode row (td student, dry sand, straight, speeds 1.0-2.5 m/s
 # cycled) at the accepted setting, grid capacity 1.5x, 36 lanes; resumable (m4_resume_and_2cm.sh finished it).
 END=$1
 cd ~/src && source scripts/gpu/env.sh && mkdir -p ~/chunks/g1_eval

@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Session 13, machine 4 (H200): (1) the 4 episodes of the first row that the time box dropped (resumed from the
+# Machine 4 of the grid-capacity runs (H200): (1) the 4 episodes of the first row that the time box dropped (resumed from the
 # carried run folder); (2) the voxel axis below 3 cm: 2 cm at 500 iterations, 8 robots x 5 s (time-boxed).
 END=$1
 cd ~/src && source scripts/gpu/env.sh && mkdir -p ~/chunks/g1_eval

@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
-# Session 13, machine 5 (H200, the budget's last ~8 held minutes): the start of the ppo_rft3d row (dry sand,
-# straight, 1.0-2.5 m/s, 100 episodes, 36 lanes), time-boxed; resumable next session (job_next.sh part a).
+# Machine 5 of the grid-capacity runs (H200, the budget's last ~8 held minutes): the start of the ppo_rft3d row (dry sand,
+# straight, 1.0-2.5 m/s, 100 episodes, 36 lanes), time-boxed; resumable next run (job_next.sh part a).
 END=$1
 cd ~/src && source scripts/gpu/env.sh && mkdir -p ~/chunks/g1_eval
 log() { echo "$* at $(date +%T)" >> ~/chunks/job.log; }

@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Session 14, machine A (H100, issue 9): stream A = the voxel check left open (2 cm / 1000 sweeps, 8 robots x 5 s),
+# The voxel-reference runs, machine A (H100, issue 9): stream A = the voxel check left open (2 cm / 1000 sweeps, 8 robots x 5 s),
 # then two cheaper windows (3 cm / 500); stream B (after 150 s, so the Warp cache is written once) = the
 # contact-model ablation rows on dry sand. Both streams share the GPU (physics results; no timing is read from
 # them). Stream B was stopped by hand (kill of the parent shell) once the ppo_rft3d row had finished, to give the

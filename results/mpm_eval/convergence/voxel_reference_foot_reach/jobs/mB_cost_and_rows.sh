@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
-# Session 14, machine B (H100, issue 9). (1) Cost on an idle GPU, side by side: the accepted 1.4 x 0.6 m window
+# The voxel-reference runs, machine B (H100, issue 9). (1) Cost on an idle GPU, side by side: the accepted 1.4 x 0.6 m window
 # (lead 0.2) against the 1.0 x 0.5 m window (lead 0.1) that machine A's check accepted; 32 robots, 0.3 s,
-# 3 cm / 500, as session 13's cost table. (2) The contact-model ablation rows of ppo_rigid and the clr50 student
+# 3 cm / 500, as the grid-capacity runs' cost table. (2) The contact-model ablation rows of ppo_rigid and the clr50 student
 # (dry sand, straight, 1.0-2.5 m/s, 100 episodes) at the 1.0 x 0.5 window, then the td student on poppy seed
 # (not reached: the machine's 30 minutes ran out). Usage: bash job.sh END_EPOCH
 END=$1

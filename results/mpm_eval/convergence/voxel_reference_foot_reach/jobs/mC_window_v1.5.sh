@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Session 14, machine C (issue 9): the window check at a faster command. The td student at 1.5 m/s, 16 robots x 5 s,
+# The voxel-reference runs, machine C (issue 9): the window check at a faster command. The td student at 1.5 m/s, 16 robots x 5 s,
 # 3 cm / 500: the 1.4 x 0.6 m window (lead 0.2) against 1.0 x 0.5 m (lead 0.1). Usage: bash job.sh END_EPOCH
 END=$1
 cd ~/src && source scripts/gpu/env.sh && mkdir -p ~/chunks/g1_eval

@@ -1,8 +1,8 @@
 #!/usr/bin/env bash
-# Session 15, machine A (issue 9). (1) Window and bed checks, all at once on one GPU (accuracy only, no timing):
+# The window-behind-pelvis runs, machine A (issue 9). (1) Window and bed checks, all at once on one GPU (accuracy only, no timing):
 #     at 1.5 m/s, 16 robots x 5 s: 1.4 x 0.6 m lead 0.2 (reference) against 1.0 x 0.5 m lead -0.1 and
 #     0.8 x 0.5 m lead -0.1 on a 25 cm bed; at 1.0 m/s, 8 robots x 5 s: 1.0 x 0.5 lead -0.1, 0.8 x 0.5 lead -0.1,
-#     1.0 x 0.5 lead -0.1 bed 25 cm, 0.8 x 0.5 lead -0.1 bed 25 cm (reference: session 12's 1.4 x 0.6 runs).
+#     1.0 x 0.5 lead -0.1 bed 25 cm, 0.8 x 0.5 lead -0.1 bed 25 cm (reference: the accepted-setting runs' 1.4 x 0.6 runs).
 #     The cheapest setting accepted at both speeds is the rows' window.
 # (2) Cost on the idle GPU, side by side, 0.3 s episodes: 1.4 x 0.6 (anchor), 1.0 x 0.5, 0.8 x 0.5 bed 25 cm at
 #     32 robots, and 0.8 x 0.5 bed 25 cm at 64 robots.

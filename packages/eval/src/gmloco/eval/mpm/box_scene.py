@@ -80,7 +80,7 @@ class MpmSolverCfg:
     velocity_handover: VelocityHandover = "predict"
     """Collider velocity the MPM solve sees (the coupling scheme; :func:`hand_over_velocity`): ``"predict"``
     (velocity + g frame_dt), ``"rewind"`` (velocity minus the lagged sand wrench's change; every MPM result before
-    session 6 used it: it returns an impact twice, restitution ~1) or ``"actual"`` (the velocity as it is)."""
+    the hand-over probes used it: it returns an impact twice, restitution ~1) or ``"actual"`` (the velocity as it is)."""
 
     def __post_init__(self) -> None:
         """Refuse settings under which Newton's eager (CPU / no-graph) rheology loop would not iterate."""
