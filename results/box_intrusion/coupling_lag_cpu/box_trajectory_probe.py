@@ -1,5 +1,5 @@
 # SPDX-License-Identifier: Apache-2.0
-"""CPU probe (session 5): the path of one MPM box-study trial (forward launch), every third frame.
+"""CPU probe (the DP-mapping round): the path of one MPM box-study trial (forward launch), every third frame.
 
 The study's trial ``--trial`` medium (seed 0), 5 cm voxels, 250 iterations, study defaults otherwise, 1 s. Prints
 time [s], box centre x and z [m] (resting height on the undisturbed surface 0.1 m) and pitch [deg].

@@ -1,5 +1,5 @@
 # SPDX-License-Identifier: Apache-2.0
-"""CPU probe (session 5): does the MPM box's bounce-back depend on the coupling step (the lagged sand wrench)?
+"""CPU probe (the DP-mapping round): does the MPM box's bounce-back depend on the coupling step (the lagged sand wrench)?
 
 One box-study trial (forward launch, the study's medium of trial ``--trial``, seed 0) in ``MpmBoxScene`` at 5 cm
 voxels, with the MPM frame (= coupling) step ``frame_dt`` halved twice while the rigid substep stays 2.5 ms.

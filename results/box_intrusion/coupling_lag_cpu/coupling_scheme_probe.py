@@ -1,5 +1,5 @@
 # SPDX-License-Identifier: Apache-2.0
-"""CPU probe (session 5): which velocity should the MPM solve see for the box? Three coupling schemes.
+"""CPU probe (the DP-mapping round): which velocity should the MPM solve see for the box? Three coupling schemes.
 
 The box scene steps the box with the previous frame's sand wrench, then gives the MPM solve a collider velocity
 and applies the impulse it returns during the next frame. The velocity given to MPM is:

@@ -1,5 +1,5 @@
 # SPDX-License-Identifier: Apache-2.0
-"""CPU probe (session 5): where does a 35 kg box placed on dry sand (no drop, no velocity) come to rest?
+"""CPU probe (the DP-mapping round): where does a 35 kg box placed on dry sand (no drop, no velocity) come to rest?
 
 0.7 x 0.7 x 0.25 m bed, 250 iterations, 0.5 s, 5 and 3 cm voxels; prints the box centre's final and lowest
 height [m] and the sinkage [mm] (resting height on the undisturbed surface: 0.1 m).

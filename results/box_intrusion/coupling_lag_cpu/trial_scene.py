@@ -1,5 +1,5 @@
 # SPDX-License-Identifier: Apache-2.0
-"""The session-5 box probes' shared setup: one box-study trial as an ``MpmBoxScene`` on CPU (not yet run)."""
+"""The DP-mapping round box probes' shared setup: one box-study trial as an ``MpmBoxScene`` on CPU (not yet run)."""
 
 from __future__ import annotations
 
