@@ -14,7 +14,7 @@ spent ~70 s on each of four such probes and ~1.1 min on each of four shares in w
 (the worst case): robots that fall end sooner, so a fitted cell ends early rather than late.
 
 Per-frame cost model, from the wall-clock frames of the square-window runs to the basalt and rough-sand runs (H200, 3 cm voxels, 500 sweeps, all lanes
-walking; ``results/mpm_eval/frame_cost.py`` -> ``frame_cost.json``, ``fig_frame_cost.png``): 0.18M particles (one
+walking; ``benchmarks/mpm_eval/frame_cost.py`` -> ``frame_cost.json``, ``fig_frame_cost.png``): 0.18M particles (one
 lane) 0.059 s, 0.35M 0.083 s, 0.53M 0.098 s, 2.12M 0.288 s, 3.08M 0.400 s, 4.24M 0.534 s, 4.42M 0.549 s a frame,
 i.e. 0.040 s + 0.116 s per million particles: the part that does not shrink with the sand is ~7 % of a full 25-lane
 square-window frame. Lanes of one cell have the same window, so a cell's particles follow its lanes: ``frame_s(n) =

@@ -8,7 +8,7 @@ setting the tables use, or a change that leaves the physics alone: grid reserve,
 10 minutes = 333 robot-frames/s. A row split over several GPUs (the ablation-circle runs) is drawn as the rate its wall-clock
 stands for (100 x 10 s / wall-clock), apart from the one-GPU cases.
 
-    python results/mpm_eval/throughput_levers.py
+    python benchmarks/mpm_eval/throughput_levers.py
 """
 
 from __future__ import annotations
@@ -17,12 +17,12 @@ import json
 import statistics
 from pathlib import Path
 
-HERE = Path(__file__).resolve().parent
+MPM_RESULTS = Path(__file__).resolve().parents[2] / "results" / "mpm_eval"  # the runs read, the outputs written
 TARGET_RF_S = 100 * 10.0 / 0.005 / 600.0
 
 
 def _load(rel: str) -> dict:
-    return json.loads((HERE / rel).read_text())
+    return json.loads((MPM_RESULTS / rel).read_text())
 
 
 def cases() -> list[dict]:
@@ -35,7 +35,7 @@ def cases() -> list[dict]:
 
     s12 = {
         json.loads(line)["case"]: json.loads(line)
-        for line in (HERE / "convergence/accepted_setting/sweep.jsonl").read_text().splitlines()
+        for line in (MPM_RESULTS / "convergence/accepted_setting/sweep.jsonl").read_text().splitlines()
     }
     add("s12: 5 cm / 1000 sweeps, 1.8 x 0.6 m, 32 lanes", "H100", s12["td_v0.05_it1000_r32"]["robot_frames_per_s"], "rejected",
         "convergence/accepted_setting/sweep.jsonl")  # fmt: skip
@@ -121,7 +121,7 @@ def main() -> None:
     best = max(one_gpu, key=lambda r: r["robot_frames_per_s"])
     doc = {"target_robot_frames_per_s": round(TARGET_RF_S, 1), "best_accepted": best,
            "target_over_best_accepted": round(TARGET_RF_S / best["robot_frames_per_s"], 2), "cases": rows}  # fmt: skip
-    (HERE / "throughput_levers.json").write_text(json.dumps(doc, indent=1) + "\n")
+    (MPM_RESULTS / "throughput_levers.json").write_text(json.dumps(doc, indent=1) + "\n")
     fig, ax = plt.subplots(figsize=(9, 0.32 * len(rows) + 1.4), constrained_layout=True)
     y = range(len(rows))
     colors = ["C2" if r["gpus"] > 1 else "C0" if r["verdict"] == "accepted" else "0.7" for r in rows]
@@ -137,7 +137,7 @@ def main() -> None:
     ax.set_xlabel("robot-frames/s per GPU\n(3 cm, 500 sweeps, 5 ms frames, 30 cm bed, 1.4 x 0.6 m unless named)")
     ax.set_xlim(0, TARGET_RF_S * 1.2)
     ax.legend(fontsize=7, loc="lower center", bbox_to_anchor=(0.5, 1.0), ncol=2)
-    fig.savefig(HERE / "fig_throughput_levers.png", dpi=130)
+    fig.savefig(MPM_RESULTS / "fig_throughput_levers.png", dpi=130)
     print(
         f"best accepted on one GPU: {best['label']} {best['robot_frames_per_s']} ({best['gpu']}); "
         f"the target is {doc['target_over_best_accepted']}x that"

@@ -16,7 +16,7 @@ and the 1-3 tail few; the grid check every 30 s also waits outside the step, so 
 frame), which ``running_rates`` uses instead; the square-window runs' code counts the waits as stepping time
 (``G1MpmScene.sync``).
 
-    python results/mpm_eval/retire_lanes.py
+    python benchmarks/mpm_eval/retire_lanes.py
 """
 
 from __future__ import annotations
@@ -27,7 +27,7 @@ from pathlib import Path
 from gmloco.eval.g1_eval import read_episodes
 from gmloco.eval.run_rates import retire_setting, running_rates
 
-HERE = Path(__file__).resolve().parent
+MPM_RESULTS = Path(__file__).resolve().parents[2] / "results" / "mpm_eval"  # the runs read, the outputs written
 BINS = ((25, 25), (10, 24), (4, 9), (1, 3))
 """Robots walking (of 25 lanes), inclusive ranges."""
 FOLDERS = (  # the row folders, oldest code first
@@ -55,7 +55,7 @@ def pooled() -> dict[str, dict[str, dict[str, float]]]:
     """
     out: dict[str, dict[str, dict[str, float]]] = {}
     for folder in FOLDERS:
-        for run in sorted((HERE / folder / "runs").iterdir()):
+        for run in sorted((MPM_RESULTS / folder / "runs").iterdir()):
             path = run / "episodes.jsonl"
             if not path.is_file():
                 continue
@@ -123,8 +123,8 @@ def figure(data: dict, path: Path) -> None:
 def main() -> None:
     """Write ``retire_lanes.json`` and ``fig_retire_lanes.png`` beside this script and print the pooled rates."""
     data = pooled()
-    (HERE / "retire_lanes.json").write_text(json.dumps(data, indent=1) + "\n")
-    figure(data, HERE / "fig_retire_lanes.png")
+    (MPM_RESULTS / "retire_lanes.json").write_text(json.dumps(data, indent=1) + "\n")
+    figure(data, MPM_RESULTS / "fig_retire_lanes.png")
     for key, bins in data.items():
         print(key, {b: c["frames_per_s"] for b, c in bins.items()})
 

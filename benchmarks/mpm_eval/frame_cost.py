@@ -7,7 +7,7 @@ per built size (particles, lanes). Fits ``frame_s = a + b * particles`` and comp
 ``gmloco.eval.g1_eval_fit`` uses to fit cells into a time box: a measured full cell's frame, scaled by lanes above
 ``FRAME_COST_FLOOR``. Writes ``frame_cost.json`` and ``fig_frame_cost.png`` beside this script.
 
-    python results/mpm_eval/frame_cost.py
+    python benchmarks/mpm_eval/frame_cost.py
 """
 
 from __future__ import annotations
@@ -21,7 +21,7 @@ from gmloco.eval.g1_eval import read_episodes
 from gmloco.eval.g1_eval_fit import FRAME_COST_FLOOR, CellCost, frame_seconds
 from gmloco.eval.run_rates import has_wall_clock, running_rates, scenes
 
-HERE = Path(__file__).resolve().parent
+MPM_RESULTS = Path(__file__).resolve().parents[2] / "results" / "mpm_eval"  # the runs read, the outputs written
 FOLDERS = (  # the row folders whose episodes carry the wall clock
     "table_rows/dry_sand_square_window",
     "table_rows/poppy_seed_deep_sand_reach",
@@ -34,7 +34,7 @@ def points() -> list[dict[str, float]]:
     """One point per built size: particles, lanes, frames, seconds and seconds per frame (all lanes walking)."""
     pooled: dict[tuple[int, int], list[float]] = {}
     for folder in FOLDERS:
-        for path in sorted((HERE / folder / "runs").glob("*/episodes.jsonl")):
+        for path in sorted((MPM_RESULTS / folder / "runs").glob("*/episodes.jsonl")):
             for scene in scenes(read_episodes(path)):
                 if not all(has_wall_clock(e) for e in scene):
                     continue
@@ -75,7 +75,7 @@ def main() -> None:
             str(n): round(float(model[n] / (a + b * per_lane * n)), 3) for n in (1, 3, 6, 12, 18, 25) if n in model
         },
     }
-    (HERE / "frame_cost.json").write_text(json.dumps(doc, indent=1) + "\n")
+    (MPM_RESULTS / "frame_cost.json").write_text(json.dumps(doc, indent=1) + "\n")
     fig, ax = plt.subplots(figsize=(6.4, 4.2), constrained_layout=True)
     ax.scatter(x, y, s=20 + 0.05 * np.array([p["frames"] for p in pts]), label="measured (size: frames pooled)")
     xs = np.linspace(0.0, x.max() * 1.05, 50)
@@ -92,7 +92,7 @@ def main() -> None:
     ax.set_xlim(0, None)
     ax.set_ylim(0, None)
     ax.legend(fontsize=7, loc="upper left")
-    fig.savefig(HERE / "fig_frame_cost.png", dpi=130)
+    fig.savefig(MPM_RESULTS / "fig_frame_cost.png", dpi=130)
     print(json.dumps(doc["fit"]), "model/fit by lanes:", doc["model_over_fit"])
 
 

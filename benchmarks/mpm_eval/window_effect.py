@@ -7,7 +7,7 @@ the robot, so walks whose heading drifts step out of its side) and the square-wi
 walks that left the window early ended. Fisher's exact test compares the two windows per speed and over
 1.0-1.5 m/s (above, both score 0).
 
-    python results/mpm_eval/window_effect.py
+    python benchmarks/mpm_eval/window_effect.py
 """
 
 from __future__ import annotations
@@ -20,7 +20,7 @@ from scipy.stats import fisher_exact
 from gmloco.eval.g1_eval import read_episodes
 from gmloco.eval.tables_mpm import wilson_interval
 
-HERE = Path(__file__).resolve().parent
+MPM_RESULTS = Path(__file__).resolve().parents[2] / "results" / "mpm_eval"  # the runs read, the outputs written
 ROWS = {
     "tables' 1.4 x 0.6 m window (the ablation-circle runs)": "table_rows/ablation_circles/runs/table_td_dry_sand_x4_share*",
     "square 1.4 x 1.4 m window (the square-window runs)": "table_rows/dry_sand_square_window/runs/table_td_dry_sand_sq_share*",
@@ -30,7 +30,7 @@ SPEEDS = (1.0, 1.5, 2.0, 2.5)
 
 def per_speed(pattern: str) -> dict[str, dict[str, float]]:
     """``{speed: {episodes, successes, success_pct, lo95, hi95, early_exits, early_exit_successes, turn_exits}}``."""
-    eps = [e for run in sorted(HERE.glob(pattern)) for e in read_episodes(run / "episodes.jsonl")]
+    eps = [e for run in sorted(MPM_RESULTS.glob(pattern)) for e in read_episodes(run / "episodes.jsonl")]
     out = {}
     for v in SPEEDS:
         rows = [e for e in eps if abs(e["speed"] - v) < 1e-6]
@@ -93,8 +93,8 @@ def main() -> None:
     """Write ``window_effect.json`` and ``fig_window_effect.png`` beside this script and print the comparison."""
     data = {label: per_speed(pattern) for label, pattern in ROWS.items()}
     doc = {"rows": ROWS, "per_speed": data, "fisher": compare(data)}
-    (HERE / "window_effect.json").write_text(json.dumps(doc, indent=1) + "\n")
-    figure(data, HERE / "fig_window_effect.png")
+    (MPM_RESULTS / "window_effect.json").write_text(json.dumps(doc, indent=1) + "\n")
+    figure(data, MPM_RESULTS / "fig_window_effect.png")
     for label, rows in data.items():
         print(label, {v: f"{r['successes']}/{r['episodes']}" for v, r in rows.items()})
     print(doc["fisher"])
