@@ -274,8 +274,8 @@ class EvalMpmCfg(StageCfg):
     episode_s: float = 10.0
     """Episode length = course time limit [s]."""
     voxel_size: float = 0.03
-    """MPM voxel size [m]. The numerics defaults are the setting the convergence check accepted in session 12
-    (``docs/mpm_eval.md``, ``results/mpm_eval/gpu_s12/README.md``): 3 cm, 500 rheology iterations, 5 ms frames x 1
+    """MPM voxel size [m]. The numerics defaults are the setting the convergence check accepted in the accepted-setting runs
+    (``docs/mpm_eval.md``, ``results/mpm_eval/convergence/accepted_setting/README.md``): 3 cm, 500 rheology iterations, 5 ms frames x 1
     rigid step, a 30 cm bed and 1.4 x 0.6 m windows. 4 and 5 cm voxels change the tracking errors (rejected)."""
     max_iterations: int = 500
     """Rheology solver iterations per MPM frame at most. A 3 cm frame of a G1 walk does not reach the solver's
@@ -302,25 +302,25 @@ class EvalMpmCfg(StageCfg):
     moving_window: bool = True
     """Sand window moving with each robot (False: a static bed covering the course, the naive baseline)."""
     window_length: float = 1.4
-    """Moving window size along x [m] (centred 0.2 m ahead of the pelvis; 1.4 m walks as 1.8 m does: session 12)."""
+    """Moving window size along x [m] (centred 0.2 m ahead of the pelvis; 1.4 m walks as 1.8 m does: the accepted-setting runs)."""
     window_width: float = 0.6
-    """Moving window size along y [m] (0.6 m walks as 1.0 m does and costs 40 % less: session 11)."""
+    """Moving window size along y [m] (0.6 m walks as 1.0 m does and costs 40 % less: the batched-cuts runs)."""
     window_lead: float = 0.2
     """Window centre ahead of the pelvis [m] (negative: behind it). The soles lead the pelvis by <= 0.2 m and trail
-    it by ~0.3 m walking, 0.5-0.75 m in falls (``results/mpm_eval/gpu_s14/foot_reach.json``)."""
+    it by ~0.3 m walking, 0.5-0.75 m in falls (``results/mpm_eval/convergence/voxel_reference_foot_reach/foot_reach.json``)."""
     robots_per_batch: int = 32
     """Robots sharing one MPM solver (one lane each)."""
     retire_idle_lanes: bool = True
     """Take a lane's sand out of the MPM solve once its robot has no episode left (a cell's tail then carries only
-    the sand of the robots still walking); False keeps it in (the runs up to session 18)."""
+    the sand of the robots still walking); False keeps it in (the runs up to the ablation-circle runs)."""
     fit_time_box: bool = True
     """With ``max_minutes``: start only walks that can end before the time box (a cell too big for the time left is
     rebuilt with the lanes that fit, a freed lane takes a new walk only while one can end); False: cells run until
-    the box drops their running episodes (the runs up to session 21)."""
+    the box drops their running episodes (the runs up to the reach-window runs)."""
     cell_capacity_factor: float = 1.5
     """Grid capacity = factor x particles / particles-per-cell (fixed capacity: CUDA graph); 0 = unbounded.
     The rheology solver sweeps the whole capacity, so its cost grows with the factor: 1.5 gave 1.46x the
-    robot-frames/s of 3.0 (H200, 32 robots, results/mpm_eval/gpu_s13); an overflow stops the cell with an error."""
+    robot-frames/s of 3.0 (H200, 32 robots, results/mpm_eval/convergence/grid_capacity_solvers); an overflow stops the cell with an error."""
     record_mcap: bool = True
     """Write the first episode of every (terrain, scenario, speed) as an MCAP recording."""
     gpus: list[int] = field(default_factory=list)

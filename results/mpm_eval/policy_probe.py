@@ -132,7 +132,7 @@ def main() -> None:
         "--handover",
         choices=("predict", "rewind", "actual"),
         default="predict",
-        help="coupling: collider velocity MPM sees (MpmSolverCfg.velocity_handover; before session 6: rewind)",
+        help="coupling: collider velocity MPM sees (MpmSolverCfg.velocity_handover; before the hand-over probes: rewind)",
     )
     p.add_argument("--duration", type=float, default=None, help="simulated time [s]; overrides --frames")
     p.add_argument("--log", type=Path, default=Path("results/mpm_eval/policies_cpu.jsonl"))

@@ -3,10 +3,10 @@
 
 One time-boxed, resumable call; one JSON out.
 
-Superseded for issue 9's numbers (session 12): this benchmark steps 10 ms frames x 2 rigid steps with 50 rheology
+Superseded for issue 9's numbers (the accepted-setting runs): this benchmark steps 10 ms frames x 2 rigid steps with 50 rheology
 iterations by default, numerics the convergence check has since rejected (``docs/mpm_eval.md``). The cost of the
 accepted setting (3 cm, 500 iterations, 5 ms frames) is measured with ``g1_eval_cli`` itself on short episodes
-(``results/mpm_eval/gpu_s12/sweep.jsonl``). Kept for its naive / window / multi comparison (``BENCHMARKS.md``).
+(``results/mpm_eval/convergence/accepted_setting/sweep.jsonl``). Kept for its naive / window / multi comparison (``BENCHMARKS.md``).
 
     source scripts/gpu/env.sh
     python scripts/gpu/bench_mpm_eval.py --out $OUT/bench --max-minutes 8.5
@@ -68,7 +68,7 @@ def _parse() -> argparse.Namespace:
         "--iters",
         type=int,
         default=50,
-        help="rheology iterations (session 5's eval default; the accepted setting uses 500)",
+        help="rheology iterations (the dig-in probes' eval default; the accepted setting uses 500)",
     )
     p.add_argument("--iters-check", type=int, default=250, help="iterations of the iteration-convergence case")
     p.add_argument("--tol", type=float, default=0.15, help="relative tolerance of the convergence check")

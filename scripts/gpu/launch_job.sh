@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Start a session's job on the GPU machine in the background, time-boxed (issue 9's MPM queues; session 18's way).
+# Start a study's job on the GPU machine in the background, time-boxed (issue 9's MPM queues; the ablation-circle runs' way).
 #   There, from the device call's repository root, after the last wheel part's --install, in the same call:
 #     bash scripts/gpu/launch_job.sh SECONDS        (SECONDS: the job's END, counted from now)
 # Needs here: .devsrc/src.tar + .devsrc/job.sh (scripts/gpu/snapshot_src.sh, then copy the job script), optionally

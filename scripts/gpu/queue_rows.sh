@@ -11,7 +11,7 @@ ROW="--speeds 1.0 1.5 2.0 2.5 --num-episodes 100 --robots-per-batch 50"
 SQ="--window-length 1.4 --window-width 1.4 --window-lead 0.2"
 WIDE="--window-length 1.4 --window-width 1.3 --window-lead 0.0"
 # Reach window for walks that sink and stumble (poppy seed, deep sand): their trailing sole stays up to 0.73 m
-# behind the pelvis (session 16), past the tables' window's rear (0.5 m at lead 0.2); ahead it reaches 0.13 m. This
+# behind the pelvis (the per-terrain runs), past the tables' window's rear (0.5 m at lead 0.2); ahead it reaches 0.13 m. This
 # window (g1_eval.covering_window of that reach) has its rear 0.8 m behind and keeps the accepted front (0.9 m).
 REACH="--window-length 1.7 --window-width 0.8 --window-lead 0.05"
 shares() {

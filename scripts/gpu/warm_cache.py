@@ -11,7 +11,7 @@ module variant they show compiled there is compiled here too when some block siz
 folder to the GPU machine (``tar czf``) and point ``WARP_CACHE_PATH`` at it: modules whose hash matches load as
 ``(cached)``; any the CPU run did not reproduce still compile there as before, so a partial cache is never wrong.
 
-    python scripts/gpu/warm_cache.py --cache .devcache/warp --gpu-logs results/mpm_eval/gpu_s18/logs/*.log \
+    python scripts/gpu/warm_cache.py --cache .devcache/warp --gpu-logs results/mpm_eval/table_rows/ablation_circles/logs/*.log \
         -- --terrains dry_sand --speeds 1.0
 """
 

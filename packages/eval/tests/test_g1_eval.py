@@ -131,7 +131,7 @@ def test_a_run_reports_the_soles_reach_against_its_window(capsys: pytest.Capture
 
 
 def test_a_covering_window_grows_only_where_the_soles_reached_past_it() -> None:
-    """Session 16's poppy-seed reach against the tables' window, a turning walk, and a reach already held."""
+    """The per-terrain runs' poppy-seed reach against the tables' window, a turning walk, and a reach already held."""
     from gmloco.eval.g1_eval import covering_window
 
     tables = SandWindowCfg(length=1.4, width=0.6, lead=0.2)  # 0.5 m behind, 0.9 ahead, 0.3 beside
@@ -335,13 +335,13 @@ def test_a_fallen_lane_takes_the_next_episode(monkeypatch: pytest.MonkeyPatch) -
     elapsed = [r["elapsed_s"] for r in rows]  # the wall clock since the first frame, in the order the ends came
     assert all(e >= 0.0 for e in elapsed) and elapsed == sorted(elapsed)
     assert [r["end_frame"] for r in rows] == [16, 40, 56, 80, 96]  # the scene's frame at each end (4 per step)
-    # every grid check waits for the frames in flight through the scene's clock first (session 20's clock fix)
+    # every grid check waits for the frames in flight through the scene's clock first (the square-window runs' clock fix)
     ev = scene.events
     assert ev.count("check") >= 5 and all(ev[i - 1] == "sync" for i, e in enumerate(ev) if e == "check")
 
 
 def test_idle_lanes_keep_their_sand_when_asked(monkeypatch: pytest.MonkeyPatch) -> None:
-    """retire_idle_lanes=False: the same episodes, no lane retired (the cost of sessions before 19)."""
+    """retire_idle_lanes=False: the same episodes, no lane retired (the runs before ``retire_idle_lanes`` existed)."""
     cfg, specs = _cell(monkeypatch, {0: 3}, retire_idle_lanes=False)
     logs: list[dict] = []
     assert run_cell(specs, cfg, _Policy(), logs.append).finished

@@ -28,8 +28,8 @@ def test_frame_cost_is_linear_in_lanes_above_a_floor() -> None:
     assert cell_seconds(cost, 25, 100, build=False) == pytest.approx(FIT_MARGIN * 100 * 0.56)
 
 
-def test_session_21_basalt_share_would_have_kept_14_walks() -> None:
-    """Session 21's basalt share at 1.0 m/s, which the time box dropped whole, refit.
+def test_dropped_basalt_share_would_have_kept_14_walks() -> None:
+    """The reach-window runs' basalt share at 1.0 m/s, which the time box dropped whole, refit.
 
     25 lanes at 1.79 frames/s (wall clock), built in ~35 s, 799 s left after the build and the 30 s probe, 2000
     frames a 10 s walk. 25 lanes need ~1264 s; 14 lanes fit (predicted ~767 s), 15 do not; the real 14-lane cell,
@@ -39,7 +39,7 @@ def test_session_21_basalt_share_would_have_kept_14_walks() -> None:
     assert cell_seconds(cost, 25, 2000) > 799.0
     n = fit_lanes(cost, 2000, 799.0, 25)
     assert n == 14 and cell_seconds(cost, 15, 2000) > 799.0 >= cell_seconds(cost, 14, 2000)
-    # sessions 20-22's wall-clock frames: 0.0399 s + 0.1155 s per million particles, 176,720 particles a lane
+    # the square-window runs to the basalt and rough-sand runs wall-clock frames: 0.0399 s + 0.1155 s per million particles, 176,720 particles a lane
     real_14 = 35.0 + 2000 * (0.0399 + 0.1155 * 14 * 0.17672)
     assert real_14 < cell_seconds(cost, 14, 2000) < 799.0
 
@@ -57,8 +57,8 @@ def test_nothing_fits_when_one_walk_outlasts_the_time_left() -> None:
 def test_model_tracks_the_frames_timed_at_fewer_lanes(lanes: int, measured_s: float) -> None:
     """The model, scaled from the full frame, reads the frames timed at fewer lanes within -1 .. +10 %.
 
-    Scaled down from the 25-lane square-window frame (0.5493 s, 4.42M particles), it reads the frames sessions
-    20-22 timed with fewer lanes of the same window (``results/mpm_eval/frame_cost.json``) at most 10 % high and
+    Scaled down from the 25-lane square-window frame (0.5493 s, 4.42M particles), it reads the frames the
+    square- and reach-window rows timed with fewer lanes of the same window (``results/mpm_eval/frame_cost.json``) at most 10 % high and
     never more than 1 % low, so with the fit margin a fitted cell ends before its prediction.
     """
     predicted = frame_seconds(CellCost(lanes=25, frame_s=0.5493, build_s=0.0), lanes)
@@ -67,7 +67,7 @@ def test_model_tracks_the_frames_timed_at_fewer_lanes(lanes: int, measured_s: fl
 
 
 def test_the_prior_reads_the_measured_square_window_frame_and_errs_fast() -> None:
-    """25 lanes of the square window (176,720 particles each) price within 1 % of session 22's 0.549 s frame.
+    """25 lanes of the square window (176,720 particles each) price within 1 % of the basalt and rough-sand runs' 0.549 s frame.
 
     Fewer rheology sweeps scale the particle term down, more leave it as at 500 (a slower solve is left to the
     probe); the build is the fastest measured.
@@ -78,5 +78,5 @@ def test_the_prior_reads_the_measured_square_window_frame_and_errs_fast() -> Non
     assert prior_cost(176_720, 25, sweeps=1000).frame_s == pytest.approx(full.frame_s)
     half = prior_cost(176_720, 25, sweeps=250).frame_s
     assert half == pytest.approx(0.040 + 0.5 * (full.frame_s - 0.040))
-    # session 22's rough shares, 6.2 min left: the prior builds 5 lanes where the probe-and-refit kept 3
+    # the basalt and rough-sand runs' rough shares, 6.2 min left: the prior builds 5 lanes where the probe-and-refit kept 3
     assert fit_lanes(full, 2000, 6.2 * 60, 25) == 5

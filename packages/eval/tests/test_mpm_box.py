@@ -165,7 +165,7 @@ def _rise_after_lowest_point(scene: MpmBoxScene) -> float:
 def test_predicted_handover_lands_the_box_without_a_bounce() -> None:
     """Default coupling (predicted velocity): a landing box does not rise after it stops; the rewind bounces.
 
-    Measured on this case: predict 0.0 mm, rewind 20 mm (the impact returned twice, ``results/box_intrusion/cpu_s5``).
+    Measured on this case: predict 0.0 mm, rewind 20 mm (the impact returned twice, ``results/box_intrusion/coupling_lag_cpu``).
     """
     assert MpmSolverCfg().velocity_handover == "predict"
     predicted = _landing_box("predict")

@@ -1,5 +1,5 @@
 # SPDX-License-Identifier: Apache-2.0
-"""A session folder's costs read back from its episodes and queue.json (issue 9)."""
+"""A study folder's costs read back from its episodes and queue.json (issue 9)."""
 
 from __future__ import annotations
 
@@ -8,7 +8,7 @@ from pathlib import Path
 
 import pytest
 
-from gmloco.eval.run_rates import TARGET_ROBOT_FRAMES_PER_S, main, run_rate, running_rates, session_rates
+from gmloco.eval.run_rates import TARGET_ROBOT_FRAMES_PER_S, folder_rates, main, run_rate, running_rates
 
 
 def _episode(k: int, fps: float, alive: float, success: bool) -> dict:
@@ -16,7 +16,7 @@ def _episode(k: int, fps: float, alive: float, success: bool) -> dict:
             "batch_size": 25, "particles": 1_880_000, "build_s": 30.0 + k}  # fmt: skip
 
 
-def _session(tmp_path: Path) -> Path:
+def _study_folder(tmp_path: Path) -> Path:
     """Two shares of one row (GPU 0 and 1) and a lone task; the row took 9.5 min."""
     for name, fps, alive in (("row_share0of2", [4.0, 4.2, 4.4], [10.0, 10.0, 3.0]), ("row_share1of2", [4.4], [2.0]),
                              ("lone", [2.0, 2.0], [1.0, 1.5])):  # fmt: skip
@@ -51,9 +51,9 @@ def test_run_rate_refuses_empty_and_old_records() -> None:
         run_rate([{"key": "a", "success": True}])
 
 
-def test_session_rates_reads_runs_and_rows(tmp_path: Path) -> None:
+def test_folder_rates_reads_runs_and_rows(tmp_path: Path) -> None:
     """Each run's rate and task minutes; the row pools its shares' episodes under queue.json's wall-clock."""
-    out = session_rates(_session(tmp_path))
+    out = folder_rates(_study_folder(tmp_path))
     assert set(out["runs"]) == {"row_share0of2", "row_share1of2", "lone"}  # the empty task has no rate
     assert out["runs"]["lone"]["task_minutes"] == 2.0 and out["device"] == "4 x H200"
     assert out["runs"]["lone"]["by_running_clock"].startswith("sim_s")  # records without elapsed_s
@@ -62,32 +62,32 @@ def test_session_rates_reads_runs_and_rows(tmp_path: Path) -> None:
     assert row["longest_alive_s"] == 10.0 and row["build_s_max"] == 30.0
 
 
-def test_session_rates_without_queue_and_bad_folder(tmp_path: Path) -> None:
+def test_folder_rates_without_queue_and_bad_folder(tmp_path: Path) -> None:
     """Without queue.json the runs still get rates (no rows); a folder without runs/ is refused."""
-    root = _session(tmp_path)
+    root = _study_folder(tmp_path)
     (root / "logs" / "queue.json").unlink()
-    out = session_rates(root)
+    out = folder_rates(root)
     assert out["rows"] == {} and out["runs"]["lone"]["task_minutes"] is None
     with pytest.raises(FileNotFoundError, match="no runs/ folder"):
-        session_rates(tmp_path / "runs" / "lone")
+        folder_rates(tmp_path / "runs" / "lone")
 
 
 def test_main_writes_throughput_json(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
     """The command line writes FOLDER/throughput.json and prints each row's wall-clock."""
-    main([str(_session(tmp_path))])
+    main([str(_study_folder(tmp_path))])
     assert json.loads((tmp_path / "throughput.json").read_text())["rows"]["row"]["shares"] == 2
     assert "row row: 9.5 min on GPUs 0 1" in capsys.readouterr().out
 
 
 def test_rows_split_by_the_queue_shares_flag_are_found_too(tmp_path: Path) -> None:
     """``--shards`` names a cell's shares ``CELL__shareIofN``: their episodes pool under the row as task files' do."""
-    root = _session(tmp_path)
+    root = _study_folder(tmp_path)
     for name in ("row_share0of2", "row_share1of2"):
         (root / "runs" / name).rename(root / "runs" / name.replace("row_", "dry_sand__straight__"))
     queue = json.loads((root / "logs" / "queue.json").read_text())
     queue["rows"] = {"dry_sand__straight": queue["rows"]["row"]}
     (root / "logs" / "queue.json").write_text(json.dumps(queue))
-    assert session_rates(root)["rows"]["dry_sand__straight"]["episodes"] == 4
+    assert folder_rates(root)["rows"]["dry_sand__straight"]["episodes"] == 4
 
 
 def _rounded(out: dict[int, tuple[float, float]]) -> dict[int, tuple[float, float]]:
@@ -123,7 +123,7 @@ def test_running_rates_leaves_out_cut_batches() -> None:
 
 
 def test_running_rates_prefers_the_elapsed_clock() -> None:
-    """Records with ``elapsed_s`` / ``end_frame`` (session 19 on) are timed by them, not by the in-step ``sim_s``."""
+    """Records with ``elapsed_s`` / ``end_frame`` (the transition-course runs on) are timed by them, not by the in-step ``sim_s``."""
     eps = _ends([(10.0, 40.0), (20.0, 60.0)])
     for e, (elapsed, frame) in zip(eps, [(12.0, 40), (24.0, 60)], strict=True):
         e |= {"elapsed_s": elapsed, "end_frame": frame}
@@ -141,14 +141,14 @@ def test_run_rate_reads_the_wall_clock_where_records_have_it() -> None:
     # a run resumed from an older record without the wall clock: the rate comes from the records that have it
     eps[0] = {k: v for k, v in eps[0].items() if k not in ("end_frame", "elapsed_s")} | {"frames_per_s": 5.0}
     assert run_rate(eps)["solver_frames_per_s_median"] == pytest.approx(1.8, abs=1e-3)
-    # no record has it (runs before session 19): the stepping clock
+    # no record has it (runs before the transition-course runs): the stepping clock
     old = [{k: v for k, v in e.items() if k not in ("end_frame", "elapsed_s")} for e in eps]
     r = run_rate(old)
     assert r["rate_clock"] == "sim_s" and r["solver_frames_per_s_median"] == pytest.approx(2.0)
 
 
 def test_run_rate_of_a_resumed_run_is_its_widest_batches() -> None:
-    """A run resumed across sessions: 3 episodes of a 3-lane refit batch, then 22 of a 22-lane one.
+    """A run resumed across machines: 3 episodes of a 3-lane refit batch, then 22 of a 22-lane one.
 
     The rate is the 22-lane batch's (2.0 frames/s x 22 lanes = 44 robot-frames/s), not its median frame rate
     times the first record's 3 lanes; the narrow batch is listed apart.

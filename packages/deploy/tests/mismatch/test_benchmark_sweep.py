@@ -49,7 +49,7 @@ def test_seed_offset_and_parts_split_the_lists_into_fresh_interleaved_replicates
     stock, fresh = sand_episode_list(2, 4), sand_episode_list(2, 4, seed_offset=10000)
     assert [e["name"] for e in stock] == [e["name"] for e in fresh]
     assert all(f["seed"] == s["seed"] + 10000 for s, f in zip(stock, fresh, strict=True))
-    # the stock single-seed list is unchanged (the session-3 sand suite's names and seeds)
+    # the stock single-seed list is unchanged (the sand suite's names and seeds)
     ool = [e for e in sand_episode_list(1, 6) if e["effect"].startswith("ool.")]
     assert [(e["name"], e["seed"]) for e in ool] == [
         ("sand-ool.shank_length-0", 2100),

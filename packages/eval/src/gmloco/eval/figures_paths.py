@@ -2,7 +2,7 @@
 """Executed against commanded paths of the MPM evaluation's recorded episodes (what the DTW path error scores).
 
 Each ``g1_eval`` run records the best walk of every (terrain, scenario, speed) group (a success if any, else the
-longest time alive; runs before session 20: the first episode to end, often an early fall) as
+longest time alive; runs before the square-window runs: the first episode to end, often an early fall) as
 ``recordings/<terrain>__<scenario>__v<speed>.mcap``: one episode, not the group's typical one. :func:`recorded_path` reads one back as the pelvis path in its
 start frame (start at the origin, heading +x) with the command it walked; :func:`fig_paths` draws a panel per policy
 (or run), each speed's executed path solid over its commanded path dashed, marked where it ended: a cross where the

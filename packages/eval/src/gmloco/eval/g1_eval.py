@@ -122,7 +122,7 @@ class G1EvalCfg:
     """Fraction of the commanded path that may be left when time runs out and still count as finished [-]."""
     bed_depth: float = 0.30
     """Sand depth of the flat and rough terrains [m] (the deep terrain has its own 0.30 m); a loaded sole of a
-    walking G1 reaches 20-30 cm on MPM sand (``results/mpm_eval/gpu_s11``)."""
+    walking G1 reaches 20-30 cm on MPM sand (``results/mpm_eval/convergence/batched_cuts``)."""
     window: SandWindowCfg = field(default_factory=lambda: SandWindowCfg(length=1.4, width=0.6))
     """Sand window of each robot (``moving=False``: a static bed covering the course, the naive baseline). 1.4 m
     walks as 1.8 m does, 0.6 m wide as 1.0 m does (``docs/mpm_eval.md``); a 1.0 x 0.5 m window was rejected. The
@@ -137,18 +137,18 @@ class G1EvalCfg:
     retire_idle_lanes: bool = True
     """Take a lane's sand out of the MPM solve once its robot has no episode left (``G1MpmScene.retire_robots``):
     the cell's tail, while its last robots walk, costs only their sand. False: idle lanes keep their sand in the
-    solve (the runs up to session 18)."""
+    solve (the runs up to the ablation-circle runs)."""
     lane_gap: float = 2.0
     """Free space between neighbouring lanes' windows or paths [m] (robots may drift)."""
     cell_capacity_factor: float = 1.5
     """Grid capacity = factor x particles / particles-per-cell (fixed capacity: CUDA graph); 0 = unbounded.
     The rheology solver sweeps the whole capacity, so its cost grows with the factor: 1.5 gave 1.46x the
-    robot-frames/s of 3.0 (H200, 32 robots, results/mpm_eval/gpu_s13); an overflow stops the cell with an error."""
+    robot-frames/s of 3.0 (H200, 32 robots, results/mpm_eval/convergence/grid_capacity_solvers); an overflow stops the cell with an error."""
     solver: MpmSolverCfg = field(
         default_factory=lambda: MpmSolverCfg(voxel_size=0.03, frame_dt=0.005, rigid_substeps=1, max_iterations=500)
     )
     """MPM numerics: 3 cm voxels, 5 ms frames (200 Hz coupling), 500 rheology iterations per frame, the setting the
-    convergence check accepted (session 12, ``docs/mpm_eval.md``): 500 against 1000 iterations and a 1.4 m window
+    convergence check accepted (the accepted-setting runs, ``docs/mpm_eval.md``): 500 against 1000 iterations and a 1.4 m window
     against 1.8 m are accepted; 350 iterations, 4 or 5 cm voxels, a 20 cm bed and 10 ms frames are rejected. A 3 cm
     frame of a G1 walk does not reach the 1e-4 tolerance within 1000 iterations, so the cap is the cost. The
     pipeline's smoke scale uses fast, unconverged numerics (``conf/scale/smoke.yaml``)."""
@@ -156,7 +156,7 @@ class G1EvalCfg:
     """Failure rules."""
     record_mcap: bool = True
     """Write the best walk of every (terrain, scenario, speed) group as an MCAP recording (``recordings/``): a success
-    if any, else the longest time alive; a sidecar JSON names the episode. Runs before session 20 recorded the
+    if any, else the longest time alive; a sidecar JSON names the episode. Runs before the square-window runs recorded the
     group's first episode to end."""
     seed: int = 0
     """Seed of the sand."""
@@ -521,7 +521,7 @@ def score_episode(spec: EpisodeSpec, cfg: G1EvalCfg, log: dict[str, Any]) -> dic
         "particles": log["particles"], "batch_size": log.get("batch_size", 1), "build_s": log["build_s"],
         "sim_s": log["sim_s"], "frames_per_s": log["frames"] / max(log["sim_s"], 1e-9),
         # the scene's frame at the episode's end and the wall seconds since its first frame, host work included
-        # (``sim_s`` is the scene's stepping time: ``G1MpmScene.step`` and, since session 20, every wait for the
+        # (``sim_s`` is the scene's stepping time: ``G1MpmScene.step`` and, since the square-window runs, every wait for the
         # frames in flight; before, the waits of the grid-capacity checks went uncounted and rates read ~8 % high)
         "end_frame": log["frames"], "elapsed_s": log.get("elapsed_s"),
     }  # fmt: skip
@@ -531,9 +531,9 @@ WINDOW_EXIT_GRACE_S = 0.25
 """A sole leaving the sand window this close to an episode's end (the fall under way) does not flag it [s]."""
 FALL_EXIT_S = 0.75
 """An early window exit this close before the episode's fall counts as part of the fall [s]: the trailing sole of
-a stumble. Session 21 reran the poppy-seed and deep-sand rows, whose exits (54 % and 37 % of their walks) came
+a stumble. The reach-window runs reran the poppy-seed and deep-sand rows, whose exits (54 % and 37 % of their walks) came
 0.26-0.72 s before the fall, at a window no sole left: the rows and their times alive did not change (0 of 100
-each; Mann-Whitney p = 0.94 / 0.91; ``results/mpm_eval/gpu_s21/README.md``)."""
+each; Mann-Whitney p = 0.94 / 0.91; ``results/mpm_eval/table_rows/poppy_seed_deep_sand_reach/README.md``)."""
 
 
 FALL_REASONS = ("tilt", "base_height")
@@ -776,7 +776,7 @@ def run(cfg: G1EvalCfg) -> tuple[dict[str, float], bool]:
     done = {r["key"] for r in rows}
     # each group's recording is its best walk (recording_rank): earlier calls' picks, then this call's best so far
     recorded = _recorded_ranks(out)
-    for r in rows:  # runs before session 20 recorded a group's first episode and wrote no sidecar
+    for r in rows:  # runs before the square-window runs recorded a group's first episode and wrote no sidecar
         spec = _spec_of(r)
         if spec.group not in recorded and _recording_path(out, spec).exists():
             recorded[spec.group] = recording_rank(r)

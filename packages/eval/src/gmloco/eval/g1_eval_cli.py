@@ -72,7 +72,7 @@ def _parse(argv: list[str] | None) -> argparse.Namespace:
     p.add_argument(
         "--keep-idle-lanes",
         action="store_true",
-        help="keep a lane's sand in the MPM solve after its robot's last episode (the runs up to session 18)",
+        help="keep a lane's sand in the MPM solve after its robot's last episode (the runs up to the ablation-circle runs)",
     )
     p.add_argument("--static-bed", action="store_true", help="naive baseline: a bed covering the course")
     p.add_argument("--window-length", type=float, default=_WINDOW.length)

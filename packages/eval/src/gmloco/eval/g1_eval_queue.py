@@ -1,7 +1,7 @@
 # SPDX-License-Identifier: Apache-2.0
 """Several GPUs, one evaluation each: the MPM evaluation's cells spread over a machine's GPUs (issue 9).
 
-One ``g1_eval_cli`` process drives one GPU; running several on one GPU does not pay (session 15: seven side by side
+One ``g1_eval_cli`` process drives one GPU; running several on one GPU does not pay (the window-behind-pelvis runs: seven side by side
 on an H100 summed ~112 robot-frames/s against ~150 for one alone). On a machine with N GPUs this tool splits the
 evaluation into one task per (terrain, scenario) cell, each with its own run folder ``OUT/<terrain>__<scenario>``
 (with ``--shards N``: N tasks per cell, ``OUT/<terrain>__<scenario>__share<I>ofN``, each scoring the episodes whose

@@ -257,7 +257,7 @@ def _window_exit_rows(rows: list[list[Any]]) -> dict[str, float]:
 
 
 def _window_share_rows(rows: list[list[Any]], exits: dict[str, float], column: str) -> dict[str, float]:
-    """Key -> a ``column`` of the ``exits`` rows that recorded it (runs from session 16 on).
+    """Key -> a ``column`` of the ``exits`` rows that recorded it (runs from the per-terrain runs on).
 
     ``window_exit_turn_pct``: % of episodes that left the window early because the robot turned;
     ``window_exit_fall_pct``: % whose early exit came within ``g1_eval.FALL_EXIT_S`` before their fall.
@@ -299,7 +299,7 @@ def _window_exit_note(
         "that covers the reach printed by the run (`--window-length`, `--window-width`, `--window-lead`), or, where "
         "the robot turned out of it (the window does not turn), with a square one (length = width). Exits within "
         f"{FALL_EXIT_S:g} s before a fall came with it (a stumble's trailing sole): rerun at a window no sole left, "
-        "session 21's poppy-seed and deep-sand rows did not change (`results/mpm_eval/gpu_s21/README.md`):\n\n"
+        "the reach-window runs' poppy-seed and deep-sand rows did not change (`results/mpm_eval/table_rows/poppy_seed_deep_sand_reach/README.md`):\n\n"
         + "\n".join(lines)
         + "\n"
     )

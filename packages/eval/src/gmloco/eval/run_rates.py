@@ -1,9 +1,9 @@
 # SPDX-License-Identifier: Apache-2.0
-"""What a GPU session's MPM-evaluation runs cost, read back from their own records (issue 9).
+"""What a GPU run's MPM-evaluation runs cost, read back from their own records (issue 9).
 
 Every episode line of a ``g1_eval`` run holds its batch's solver rate (``frames_per_s``: MPM frames per second of
 the whole batch), particle count, lanes and build time; a queue's ``queue.json`` holds each task's minutes and each
-row's wall-clock over its shares (``g1_eval_queue``). This module turns a session folder laid out as the GPU jobs
+row's wall-clock over its shares (``g1_eval_queue``). This module turns a study folder laid out as the GPU jobs
 leave it (``runs/<task>/episodes.jsonl``, ``logs/queue.json``) into one ``throughput.json``:
 
 * per run: episodes, particles, lanes, median solver frames/s, robot-frames/s with every lane stepping
@@ -16,7 +16,7 @@ leave it (``runs/<task>/episodes.jsonl``, ``logs/queue.json``) into one ``throug
   scene the lanes step together with a known number of robots left, so the records give the rate of a frame with
   25, 24, ... 1 robots, with or without idle lanes retired (``retire_idle_lanes`` from the run's ``summary.json``).
 
-    python -m gmloco.eval.run_rates results/mpm_eval/gpu_s18 [--out results/mpm_eval/gpu_s18/throughput.json]
+    python -m gmloco.eval.run_rates results/mpm_eval/table_rows/ablation_circles [--out results/mpm_eval/table_rows/ablation_circles/throughput.json]
 """
 
 from __future__ import annotations
@@ -41,16 +41,16 @@ def run_rate(episodes: list[dict[str, Any]]) -> dict[str, Any]:
     """Median solver rate, particles, lanes and build time of one run's episodes.
 
     The rate is read from the wall clock (``end_frame / elapsed_s``: frames of the batch over the wall seconds
-    since its first frame) of the records that have it (session 19's code on; a run resumed from older records
-    mixes both), else from ``frames_per_s`` (the scene's stepping clock, which until session 20 missed the GPU
+    since its first frame) of the records that have it (the transition-course runs' code on; a run resumed from older records
+    mixes both), else from ``frames_per_s`` (the scene's stepping clock, which until the square-window runs missed the GPU
     time waited in the grid-capacity checks and read ~8 % high at 4.4M particles); ``rate_clock`` says which.
 
-    A run resumed across sessions can hold batches of different widths (the time-box fit refits a late cell to
+    A run resumed across machines can hold batches of different widths (the time-box fit refits a late cell to
     the lanes that fit): the rate is that of its widest batches (most lanes), and ``other_lanes`` maps each
     narrower width to its episodes (``episodes`` counts them all), so a 3-lane batch's rate is never multiplied by 22 lanes.
 
     Raises:
-        ValueError: no episodes, or an episode without the rate fields (a run older than session 12).
+        ValueError: no episodes, or an episode without the rate fields (a run older than the accepted-setting runs).
     """
     if not episodes:
         raise ValueError("no episodes: a run that finished none has no rate")
@@ -86,9 +86,9 @@ step syncs the GPU, so a frame's time can land up to three frames late (~1 s at 
 def running_rates(episodes: list[dict[str, Any]], min_s: float = MIN_PIECE_S) -> dict[int, tuple[float, float]]:
     """MPM frames and wall seconds a run's scenes stepped with n robots walking: ``{n: (frames, seconds)}``.
 
-    An episode record carries its scene's frame at its end (``end_frame``; before session 19
+    An episode record carries its scene's frame at its end (``end_frame``; before the transition-course runs
     ``sim_s * frames_per_s``) and the wall seconds since the scene's first frame (``elapsed_s``, host work
-    included; before session 19 only ``sim_s``, the time inside the scene's step, which misses the frames in flight
+    included; before the transition-course runs only ``sim_s``, the time inside the scene's step, which misses the frames in flight
     while ended episodes are scored: up to three frames per end, so stretches with many ends read fast).
     Records of one scene are consecutive lines with one ``build_s``. Only scenes that recorded exactly
     ``batch_size`` episodes count: one batch, every lane's episode recorded, so after the k-th end (by its clock)
@@ -126,7 +126,7 @@ def scenes(episodes: list[dict[str, Any]]) -> list[list[dict[str, Any]]]:
 
 
 def has_wall_clock(e: dict[str, Any]) -> bool:
-    """Whether an episode record carries ``elapsed_s`` / ``end_frame`` (session 19 on)."""
+    """Whether an episode record carries ``elapsed_s`` / ``end_frame`` (the transition-course runs on)."""
     return e.get("elapsed_s") is not None and e.get("end_frame") is not None
 
 
@@ -143,7 +143,7 @@ def _by_running(episodes: list[dict[str, Any]]) -> dict[str, float]:
 
 
 def retire_setting(run: Path) -> bool | None:
-    """Whether a run retired idle lanes: its ``summary.json`` config (runs before session 18 never did)."""
+    """Whether a run retired idle lanes: its ``summary.json`` config (runs before the ablation-circle runs never did)."""
     path = run / "summary.json"
     if not path.is_file():
         return None
@@ -155,15 +155,17 @@ def _task_minutes(queue: dict[str, Any]) -> dict[str, float]:
     return {t["name"]: t["minutes"] for t in queue.get("tasks", []) if t.get("minutes") is not None}
 
 
-def session_rates(folder: str | Path) -> dict[str, Any]:
-    """``throughput.json``'s content for a session folder (``runs/``, optional ``logs/queue.json``, ``manifest.json``).
+def folder_rates(folder: str | Path) -> dict[str, Any]:
+    """``throughput.json``'s content for a study folder (``runs/``, optional ``logs/queue.json``, ``manifest.json``).
 
     Raises:
         FileNotFoundError: the folder has no ``runs/``.
     """
     root = Path(folder)
     if not (root / "runs").is_dir():
-        raise FileNotFoundError(f"{root}: no runs/ folder; pass a session folder such as results/mpm_eval/gpu_s18")
+        raise FileNotFoundError(
+            f"{root}: no runs/ folder; pass a study folder such as results/mpm_eval/table_rows/ablation_circles"
+        )
     qpath = root / "logs" / "queue.json"
     queue = json.loads(qpath.read_text()) if qpath.is_file() else {}
     minutes = _task_minutes(queue)
@@ -191,12 +193,12 @@ def session_rates(folder: str | Path) -> dict[str, Any]:
 
 
 def main(argv: list[str] | None = None) -> None:
-    """Write a session folder's ``throughput.json`` and print its rates (see the module docstring)."""
+    """Write a study folder's ``throughput.json`` and print its rates (see the module docstring)."""
     p = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    p.add_argument("folder", help="session folder with runs/ (and logs/queue.json, manifest.json)")
+    p.add_argument("folder", help="study folder with runs/ (and logs/queue.json, manifest.json)")
     p.add_argument("--out", help="where to write the JSON (default: FOLDER/throughput.json)")
     a = p.parse_args(argv)
-    out = session_rates(a.folder)
+    out = folder_rates(a.folder)
     path = Path(a.out) if a.out else Path(a.folder) / "throughput.json"
     path.write_text(json.dumps(out, indent=1) + "\n")
     for name, r in out["runs"].items():

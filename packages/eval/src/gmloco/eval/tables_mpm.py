@@ -6,7 +6,7 @@
   per-terrain and contact-model tables;
   ``window_exit_pct``: episodes whose soles left the sand window early, a validity check, NaN for older runs;
   ``window_exit_turn_pct``: those of them that left it because the robot turned (the window does not turn), NaN for
-  runs before session 16; ``window_exit_fall_pct``: those of them whose exit came within ``g1_eval.FALL_EXIT_S``
+  runs before the per-terrain runs; ``window_exit_fall_pct``: those of them whose exit came within ``g1_eval.FALL_EXIT_S``
   before the fall (a stumble's trailing sole: the walk was already lost);
   several policies' ``episodes.jsonl`` concatenated give the ablation rows).
 * ``table_speeds``: success rate per commanded forward speed (rows terrain x scenario).

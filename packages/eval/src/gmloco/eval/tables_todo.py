@@ -15,7 +15,7 @@ The task file holds one ``NAME g1_eval_cli-arguments`` line per task (``python -
 --tasks FILE``), resumes first (they finish rows), then reruns, most exits first, each with a comment saying why. A
 row can appear in both: the resume completes it at its window, the rerun replaces it. Exits within
 ``g1_eval.FALL_EXIT_S`` before a fall (a stumble's trailing sole) are not counted (``--fall-exits`` counts them):
-session 21 reran two rows made of such exits at a window no sole left and neither changed.
+the reach-window runs reran two rows made of such exits at a window no sole left and neither changed.
 
     python -m gmloco.eval.tables_todo --runs-file results/mpm_eval/tables/runs.txt --out /tmp/todo_tasks.txt
 """
@@ -157,7 +157,7 @@ def todo(
 def _turned(r: dict[str, Any], window: SandWindowCfg) -> bool:
     """Whether an early exit came from the robot's turn.
 
-    Its recorded cause, or (runs before session 16 recorded none) soles that never reached past the window's extent
+    Its recorded cause, or (runs before the per-terrain runs recorded none) soles that never reached past the window's extent
     along the heading.
     """
     if r.get("window_exit_cause") is not None:

@@ -128,7 +128,7 @@ class GranularTaskCfg:
     foot_faces: Literal["sole", "box"] = "sole"
     """Faces of the foot box the RFT models sample: ``"sole"`` (GM-Loco's collider, the -z face) or ``"box"`` (all
     six). With the sole alone a swinging foot that rises or points its toe down meets no sand at any depth; the
-    whole box gives 30-80 N of drag at 4-8 cm, as MPM sand does (results/mpm_eval/gpu_s9/face_drag.md). Cone and
+    whole box gives 30-80 N of drag at 4-8 cm, as MPM sand does (results/mpm_eval/probes/swing_trip/face_drag.md). Cone and
     rigid models ignore it."""
     terrain: SandTerrainCfg = field(default_factory=flat_sand_terrain)
     """Sand free surface and floor."""
@@ -164,8 +164,8 @@ class GranularTaskCfg:
     while tracking earned 17 %, no walking; see artifacts/ppo_rft3d/manifest.json); ``"touchdown"``: the penalty
     plus ``swing_height_at_touchdown`` (weight +100, lift out of the footprint up to 0.12 m, paid per completed
     swing), which pays neither standing nor an early fall (the penalty alone at weight -300 taught a teacher to fall
-    early, results/mpm_eval/gpu_s9/README.md). With ``foot_faces="box"`` it trained ``artifacts/gm_loco_teacher_td``,
-    whose student is the first policy to walk 10 s on MPM sand (results/mpm_eval/gpu_s10/README.md); the weight
+    early, results/mpm_eval/probes/swing_trip/README.md). With ``foot_faces="box"`` it trained ``artifacts/gm_loco_teacher_td``,
+    whose student is the first policy to walk 10 s on MPM sand (results/mpm_eval/probes/touchdown_lift/README.md); the weight
     is that run's, not tuned against others."""
     yaw_command: Literal["yaw_target", "heading_envs"] = "yaw_target"
     """Heading command. ``"yaw_target"`` (GM-Loco's code): every env holds a yaw target that integrates the

@@ -9,7 +9,7 @@ implicitly against the box's mass and inertia (the body is a *dynamic* collider,
 are the new sand wrench, applied over the next frame, which ends the box at the velocity MPM solved for. Newton's
 ``example_mpm_twoway_coupling`` instead removes the lagged wrench's velocity change (``"rewind"``): MPM then
 re-solves an impact the box has already received and returns it a second time (a landing box bounces back,
-restitution ~1; ``results/box_intrusion/cpu_s5/``).
+restitution ~1; ``results/box_intrusion/coupling_lag_cpu/``).
 
 Batching: given a list of media, the scene holds one walled bed per medium ("region"), side by side in one MPM
 solve, each with its own box. Regions are separated by their walls and a gap of several voxels, so no grid node
@@ -80,7 +80,7 @@ class MpmSolverCfg:
     velocity_handover: VelocityHandover = "predict"
     """Collider velocity the MPM solve sees (the coupling scheme; :func:`hand_over_velocity`): ``"predict"``
     (velocity + g frame_dt), ``"rewind"`` (velocity minus the lagged sand wrench's change; every MPM result before
-    session 6 used it: it returns an impact twice, restitution ~1) or ``"actual"`` (the velocity as it is)."""
+    the hand-over probes used it: it returns an impact twice, restitution ~1) or ``"actual"`` (the velocity as it is)."""
 
     def __post_init__(self) -> None:
         """Refuse settings under which Newton's eager (CPU / no-graph) rheology loop would not iterate."""

@@ -127,7 +127,7 @@ def sole_reach(corners: np.ndarray, low: np.ndarray, base_q: np.ndarray) -> np.n
 
 FOOT_BODIES = ("left_ankle_roll_link", "right_ankle_roll_link")
 # MuJoCo Warp constraint rows per robot: both soles on the rigid floor (8 corners x 2 soles x 4 pyramidal rows) plus
-# joint limits of a fallen robot reached 93 on the H100 (session 8: "nefc overflow" at 64, rows dropped).
+# joint limits of a fallen robot reached 93 on the H100 (the voxel-size probes: "nefc overflow" at 64, rows dropped).
 NJMAX_PER_ROBOT = 160
 
 
@@ -614,7 +614,7 @@ class G1MpmScene:
 
         ``step`` returns once a frame is launched; the GPU runs it while the host goes on. A host call that waits
         for the device outside ``step`` (the grid-capacity check, reading a result) would otherwise take up to
-        ``frames_per_policy`` frames of GPU time off the scene's clock (session 20: ~8 % at 4.4M particles).
+        ``frames_per_policy`` frames of GPU time off the scene's clock (the square-window runs: ~8 % at 4.4M particles).
         """
         import warp as wp
 
