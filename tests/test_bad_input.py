@@ -4,11 +4,13 @@
 from __future__ import annotations
 
 from collections.abc import Callable
+from pathlib import Path
 
 import pytest
 from omegaconf import DictConfig
 
 from config_errors import ConfigInputError
+from run_dir import atomic_write_json
 from tests.pipeline_helpers import plain_python_env, run_cli
 
 CASES = [
@@ -78,3 +80,13 @@ def test_hydra_full_error_shows_the_traceback() -> None:
     res = run_cli(["workflows/full_pipeline.py", "+exp=gm_lco"], env=env)
     assert res.returncode != 0
     assert "Traceback" in res.stderr
+
+
+def test_cli_refuses_another_experiment_in_a_run_dir(tmp_path: Path) -> None:
+    """``+exp=ppo_rft3d run_dir=<a gm_loco run>`` exits 2 before Hydra writes its record into the folder."""
+    atomic_write_json(tmp_path / "manifest.json", {"version": 1, "exp_name": "gm_loco", "stages": {}})
+    res = run_cli(["workflows/full_pipeline.py", "+exp=ppo_rft3d", f"run_dir={tmp_path}", "+scale=smoke"])
+    assert res.returncode == 2, res.stderr
+    message = " ".join(res.stderr.split())
+    assert "holds a 'gm_loco' run" in message and "+exp=gm_loco" in message and "Traceback" not in message
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["manifest.json"]

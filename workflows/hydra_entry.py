@@ -27,6 +27,7 @@ from config_errors import CONF_DIR, ConfigInputError, explain, group_options, gr
 from config_ranges import range_problem
 from input_checks import input_problem
 from pipeline_report import console
+from run_guard import run_dir_problem
 from schemas import PipelineCfg
 from stage_runner import PipelineConfigError, validate_selection
 
@@ -160,12 +161,18 @@ def _fail(e: ConfigInputError) -> None:
 
 
 def _smoke_needed(overrides: Sequence[str], multirun: bool, config_name: str) -> bool:
-    """Compose-check the command line and decide whether the smoke scale must be appended."""
-    if multirun:  # sweep syntax cannot be composed once; decide from the text
+    """Compose-check the command line and its run directory; decide whether the smoke scale must be appended."""
+    if multirun:  # sweep syntax cannot be composed once; decide from the text (each job gets its own folder)
         chosen = any(o.lstrip("+").startswith(("scale=", "debug=")) for o in overrides)
         return not chosen and not _cuda_available()
     cfg = compose_checked(config_name, overrides, keep_hydra=True)
-    return "scale" not in cfg.hydra.runtime.choices and not _cuda_available()
+    smoke = "scale" not in cfg.hydra.runtime.choices and not _cuda_available()
+    if smoke:  # the run directory is judged with the config that will run
+        cfg = compose_checked(config_name, [*overrides, SMOKE_OVERRIDE])
+    problem = run_dir_problem(cfg, stage_registry.STAGES)
+    if problem is not None:
+        raise ConfigInputError(*problem)
+    return smoke
 
 
 def _multirun() -> bool:
