@@ -4,11 +4,13 @@
 from __future__ import annotations
 
 from collections.abc import Callable
+from pathlib import Path
 
 import pytest
 from omegaconf import DictConfig
 
 from config_errors import ConfigInputError
+from run_dir import atomic_write_json
 from tests.pipeline_helpers import plain_python_env, run_cli
 
 CASES = [
@@ -25,6 +27,18 @@ CASES = [
     (["+exp=gm_loco", "stages=[train]"], "stages", ["train_teacher", "mismatch"]),
     (["+exp=gm_loco", "force=[exprt]"], "force", ["export"]),
     (["+exp=gm_loco", "+scale=huge"], "scale", ["full", "smoke"]),
+    # numeric values outside the range their schema field declares (workflows/config_ranges.py)
+    (["+exp=gm_loco", "eval_mpm.num_episodes=-1"], "eval_mpm.num_episodes", ["=-1 ", "an integer >= 1"]),
+    (["+exp=gm_loco", "train_teacher.num_envs=-3"], "train_teacher.num_envs", ["=-3 ", "an integer >= 1"]),
+    (["+exp=gm_loco", "max_minutes=-1"], "max_minutes", ["=-1.0 ", "a number > 0"]),
+    (["+exp=gm_loco", "distill.max_minutes=0"], "distill.max_minutes", ["a number > 0"]),
+    (["+exp=gm_loco", "train_teacher.ppo.gamma=1.5"], "train_teacher.ppo.gamma", ["a number in [0, 1]"]),
+    (["+exp=gm_loco", "eval_mpm.speeds=[1.0,-2]"], "eval_mpm.speeds", ["element -2.0", "> 0"]),
+    (["+exp=ppo_rigid", "seed=-1"], "seed", ["in [0, 4294967295]"]),
+    # inputs of the selected stages (workflows/input_checks.py)
+    (["+exp=gm_loco", "mismatch.effects=[actuator.dleay]"], "mismatch.effects", ["did you mean 'actuator.delay'"]),
+    (["+exp=gm_loco", "mismatch.real=README.md"], "mismatch.real", ["not an MCAP recording"]),
+    (["+exp=gm_loco", "analyze_logs.inputs=[/nonexistent/logs]"], "analyze_logs.inputs", ["does not exist"]),
 ]
 
 
@@ -48,6 +62,7 @@ def test_bad_input_names_key_and_choices(
         (["+exp=gm_lco"], "gm_lco"),
         (["+exp=gm_loco", "train_teacher.num_envz=8"], "train_teacher.num_envz"),
         ([], "+exp"),
+        (["+exp=gm_loco", "eval_mpm.num_episodes=-1"], "eval_mpm.num_episodes=-1"),
     ],
 )
 def test_cli_bad_input_exits_2_without_traceback(args: list[str], key: str) -> None:
@@ -65,3 +80,13 @@ def test_hydra_full_error_shows_the_traceback() -> None:
     res = run_cli(["workflows/full_pipeline.py", "+exp=gm_lco"], env=env)
     assert res.returncode != 0
     assert "Traceback" in res.stderr
+
+
+def test_cli_refuses_another_experiment_in_a_run_dir(tmp_path: Path) -> None:
+    """``+exp=ppo_rft3d run_dir=<a gm_loco run>`` exits 2 before Hydra writes its record into the folder."""
+    atomic_write_json(tmp_path / "manifest.json", {"version": 1, "exp_name": "gm_loco", "stages": {}})
+    res = run_cli(["workflows/full_pipeline.py", "+exp=ppo_rft3d", f"run_dir={tmp_path}", "+scale=smoke"])
+    assert res.returncode == 2, res.stderr
+    message = " ".join(res.stderr.split())
+    assert "holds a 'gm_loco' run" in message and "+exp=gm_loco" in message and "Traceback" not in message
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["manifest.json"]

@@ -14,6 +14,7 @@ from omegaconf import DictConfig
 from pipeline_run import EXIT_FAILED, EXIT_INCOMPLETE, EXIT_OK, run_pipeline
 from run_dir import read_json
 from stage_registry import StageIncompleteError, not_implemented
+from stage_runner import PipelineConfigError
 from tests.pipeline_helpers import CALLS, toy_registry, toy_teacher
 
 Compose = Callable[..., DictConfig]
@@ -80,15 +81,40 @@ def test_force_reruns_only_the_named_stage(run: Callable[..., dict[str, Any]]) -
     assert CALLS == {"train_teacher": 2, "distill": 3}
 
 
-def test_config_change_invalidates_the_stage_and_downstream(run: Callable[..., dict[str, Any]]) -> None:
-    """Changing distill reruns distill; changing the teacher reruns both (hashes chain through ``needs``)."""
+def test_config_change_invalidates_the_stage_and_downstream(run: Callable[..., dict[str, Any]], tmp_path: Path) -> None:
+    """A changed stage reruns only when force names it (or a stage it needs); its old results are kept otherwise.
+
+    Hashes chain through ``needs``: forcing the teacher with a changed setting reruns the distillation too.
+    """
     run()
-    s = _statuses(run("distill.max_iterations=3"))
+    student = tmp_path / "run" / "distill" / "student.json"
+    before = student.read_bytes()
+    with pytest.raises(PipelineConfigError, match=r"force=\[distill\]") as info:
+        run("distill.max_iterations=3")
+    assert info.value.key == "force" and student.read_bytes() == before
+    s = _statuses(run("distill.max_iterations=3", "force=[distill]"))
     assert (s["train_teacher"], s["distill"]) == ("skipped", "done")
-    s = _statuses(run("distill.max_iterations=3", "train_teacher.num_envs=8"))
+    with pytest.raises(PipelineConfigError, match="train_teacher"):
+        run("distill.max_iterations=3", "train_teacher.num_envs=8")
+    s = _statuses(run("distill.max_iterations=3", "train_teacher.num_envs=8", "force=[train_teacher]"))
     assert (s["train_teacher"], s["distill"]) == ("done", "done")
-    s = _statuses(run("distill.max_iterations=3", "train_teacher.num_envs=8", "seed=7"))
+    s = _statuses(run("distill.max_iterations=3", "train_teacher.num_envs=8", "seed=7", "force=true"))
     assert (s["train_teacher"], s["distill"]) == ("done", "done")
+
+
+def test_run_dir_refuses_another_experiment(
+    run: Callable[..., dict[str, Any]], compose: Callable[..., DictConfig], tmp_path: Path
+) -> None:
+    """A gm_loco run directory records its experiment; +exp=ppo_rft3d in it is refused before anything is written."""
+    run()
+    root = tmp_path / "run"
+    assert read_json(root / "manifest.json")["exp_name"] == "gm_loco"
+    checkpoint = (root / "train_teacher" / "checkpoint.json").read_bytes()
+    cfg = compose("+exp=ppo_rft3d", f"run_dir={root}", "+scale=smoke")
+    with pytest.raises(PipelineConfigError, match="holds a 'gm_loco' run") as info:
+        run_pipeline(cfg, toy_registry())
+    assert info.value.key == "run_dir"
+    assert (root / "train_teacher" / "checkpoint.json").read_bytes() == checkpoint
 
 
 def test_missing_output_reruns_the_stage(run: Callable[..., dict[str, Any]], tmp_path: Path) -> None:
@@ -143,7 +169,7 @@ def test_time_boxes(run: Callable[..., dict[str, Any]]) -> None:
     assert summary["exit_code"] == EXIT_INCOMPLETE
     assert _statuses(summary)["distill"] == "incomplete"
     assert 0 < summary["stages"][0]["metrics"]["max_minutes"] <= 9  # the stage saw its capped time box
-    summary = run("max_minutes=0", "force=true")
+    summary = run("max_minutes=1e-12", "force=true")  # used up before the first stage starts
     assert _statuses(summary)["train_teacher"] == "deferred" and summary["exit_code"] == EXIT_INCOMPLETE
 
 
@@ -156,7 +182,10 @@ def test_stage_selection(run: Callable[..., dict[str, Any]]) -> None:
 
 
 def test_stage_is_told_whether_to_resume(run: Callable[..., dict[str, Any]]) -> None:
-    """``<stage>.resume``: true on a first run and after an incomplete one; false when forced or the config changed."""
+    """``<stage>.resume``: true on a first run and after an incomplete one; false when forced.
+
+    Another config needs ``force`` once the stage's folder holds results.
+    """
     seen: list[bool] = []
     stop = [True]
 
@@ -171,5 +200,5 @@ def test_stage_is_told_whether_to_resume(run: Callable[..., dict[str, Any]]) -> 
     stop[0] = False
     run(registry=registry)  # same config: continue
     run("force=[train_teacher]", registry=registry)  # forced: start fresh
-    run("train_teacher.num_envs=8", registry=registry)  # another config: start fresh
+    run("train_teacher.num_envs=8", "force=[train_teacher]", registry=registry)  # another config: start fresh
     assert seen == [True, True, False, False]

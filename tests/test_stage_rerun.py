@@ -12,6 +12,7 @@ from omegaconf import DictConfig
 
 from pipeline_run import EXIT_INCOMPLETE, EXIT_OK, run_pipeline
 from run_dir import read_json
+from stage_runner import PipelineConfigError
 from tests.pipeline_helpers import REPO_ROOT
 
 SAMPLE_LOGS = sorted((REPO_ROOT / "packages" / "deploy" / "data" / "sample_logs").glob("*.mcap"))
@@ -53,11 +54,21 @@ def test_real_stage_is_skipped_on_rerun_and_rerun_with_force(
     assert manifest["stages"]["analyze_logs"]["invocation"] == 2
 
 
-def test_changed_input_reruns_the_real_stage(run_logs: Callable[..., dict[str, Any]]) -> None:
-    """Pointing analyze_logs at one recording changes its config hash: it runs again and analyzes just that one."""
+def test_changed_input_reruns_the_real_stage_only_when_forced(
+    run_logs: Callable[..., dict[str, Any]], tmp_path: Path
+) -> None:
+    """One recording instead of all changes analyze_logs' config: refused, results kept; forced, it reruns.
+
+    With ``force=[analyze_logs]`` it analyzes just that one recording.
+    """
     assert run_logs("analyze_logs.figures=false")["status"] == "done"
+    table = tmp_path / "run" / "analyze_logs" / "summary.md"
+    before = table.read_text()
     one = "${paths.sample_logs_dir}/g1_scripted_rigid_no_odometry.mcap"
-    row = run_logs("analyze_logs.figures=false", f"analyze_logs.inputs=[{one}]")
+    with pytest.raises(PipelineConfigError, match=r"force=\[analyze_logs\]"):
+        run_logs("analyze_logs.figures=false", f"analyze_logs.inputs=[{one}]")
+    assert table.read_text() == before
+    row = run_logs("analyze_logs.figures=false", f"analyze_logs.inputs=[{one}]", "force=[analyze_logs]")
     assert row["status"] == "done" and row["metrics"]["recordings"] == 1
 
 

@@ -6,29 +6,37 @@ Usage:
     python workflows/full_pipeline.py +exp=gm_loco run_dir=runs/gm_loco/<name>   # resume: done stages skip
     python workflows/full_pipeline.py +exp=gm_loco force=[export]   # rerun one stage
 
+A Python without the project's dependencies re-runs the command with the checkout's ``.venv`` (or says how to
+make one): see ``project_python.py``.
+
 Exit codes: 0 every stage done, skipped, blocked or not implemented yet; 1 a stage failed; 2 bad input;
 3 a time box was reached (rerun the same command to continue).
 """
 
 from __future__ import annotations
 
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
-from omegaconf import DictConfig
+from project_python import ensure_project_python
 
-from pipeline_run import run_from_hydra, run_pipeline
+if TYPE_CHECKING:
+    from omegaconf import DictConfig
 
 __all__ = ["main", "run"]
 
 
 def run(cfg: DictConfig) -> dict[str, Any]:
     """Run every stage selected by ``cfg.stages`` and return the summary (also in ``summary.json``)."""
+    from pipeline_run import run_pipeline
+
     return run_pipeline(cfg)
 
 
 def main() -> None:
     """Command-line entry (Hydra)."""
+    ensure_project_python(__file__)
     from hydra_entry import hydra_entry
+    from pipeline_run import run_from_hydra
 
     hydra_entry(run_from_hydra)
 

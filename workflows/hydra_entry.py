@@ -24,7 +24,11 @@ from rich.markup import escape
 import schemas  # noqa: F401  (registers the schemas and resolvers)
 import stage_registry
 from config_errors import CONF_DIR, ConfigInputError, explain, group_options, groups, unknown_key_error
+from config_ranges import range_problem
+from input_checks import input_problem
 from pipeline_report import console
+from run_guard import run_dir_problem
+from schemas import PipelineCfg
 from stage_runner import PipelineConfigError, validate_selection
 
 __all__ = ["EXIT_BAD_INPUT", "check_config", "compose_checked", "hydra_entry"]
@@ -81,7 +85,11 @@ def _check_appended(overrides: Sequence[str]) -> None:
 
 
 def check_config(cfg: DictConfig, overrides: Sequence[str] = ()) -> None:
-    """Check a composed config: appended keys, ``???`` values, stage names, interpolations of used sections."""
+    """Check a composed config: keys, ``???`` values, stage names, interpolations, ranges and stage inputs.
+
+    Ranges are those the schema declares (``config_ranges``); inputs are the selected stages' recordings and
+    effect ids (``input_checks``).
+    """
     names = stage_registry.stage_names()
     _check_appended(overrides)
     _check_missing(cfg, names)
@@ -95,6 +103,9 @@ def check_config(cfg: DictConfig, overrides: Sequence[str] = ()) -> None:
         value = cfg[key]  # resolves a scalar's interpolation
         if isinstance(value, DictConfig):
             OmegaConf.to_container(value, resolve=True)
+    problem = range_problem(cfg, PipelineCfg) or input_problem(cfg)
+    if problem is not None:
+        raise ConfigInputError(*problem)
 
 
 def compose_checked(config_name: str, overrides: Sequence[str], keep_hydra: bool = False) -> DictConfig:
@@ -150,12 +161,18 @@ def _fail(e: ConfigInputError) -> None:
 
 
 def _smoke_needed(overrides: Sequence[str], multirun: bool, config_name: str) -> bool:
-    """Compose-check the command line and decide whether the smoke scale must be appended."""
-    if multirun:  # sweep syntax cannot be composed once; decide from the text
+    """Compose-check the command line and its run directory; decide whether the smoke scale must be appended."""
+    if multirun:  # sweep syntax cannot be composed once; decide from the text (each job gets its own folder)
         chosen = any(o.lstrip("+").startswith(("scale=", "debug=")) for o in overrides)
         return not chosen and not _cuda_available()
     cfg = compose_checked(config_name, overrides, keep_hydra=True)
-    return "scale" not in cfg.hydra.runtime.choices and not _cuda_available()
+    smoke = "scale" not in cfg.hydra.runtime.choices and not _cuda_available()
+    if smoke:  # the run directory is judged with the config that will run
+        cfg = compose_checked(config_name, [*overrides, SMOKE_OVERRIDE])
+    problem = run_dir_problem(cfg, stage_registry.STAGES)
+    if problem is not None:
+        raise ConfigInputError(*problem)
+    return smoke
 
 
 def _multirun() -> bool:

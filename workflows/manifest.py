@@ -97,13 +97,15 @@ class Manifest:
     """One entry per command that touched this run (time, argv, git commit, seed, scale)."""
     config_hash: str = ""
     """Hash of the whole resolved config of the latest invocation (volatile keys removed)."""
+    exp_name: str = ""
+    """Experiment the run directory belongs to ('' until the first invocation records it)."""
 
     @classmethod
     def load(cls, path: Path) -> Manifest:
         """Read ``path`` or start an empty manifest when it does not exist."""
         raw = read_json(path, default={}) or {}
         stages = {k: StageRecord.from_dict(v) for k, v in raw.get("stages", {}).items()}
-        return cls(path, stages, list(raw.get("invocations", [])), raw.get("config_hash", ""))
+        return cls(path, stages, list(raw.get("invocations", [])), raw.get("config_hash", ""), raw.get("exp_name", ""))
 
     def save(self) -> None:
         """Write the manifest atomically."""
@@ -111,6 +113,7 @@ class Manifest:
             self.path,
             {
                 "version": MANIFEST_VERSION,
+                "exp_name": self.exp_name,
                 "config_hash": self.config_hash,
                 "stages": {k: v.to_dict() for k, v in self.stages.items()},
                 "invocations": self.invocations,

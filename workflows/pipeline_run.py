@@ -21,10 +21,11 @@ import stage_registry
 from manifest import Manifest, StageStatus
 from pipeline_report import print_header, print_summary, stage_progress
 from run_dir import RunDir, atomic_write_json, atomic_write_yaml, config_hash, seed_everything, write_git_state
+from run_guard import run_dir_problem
 from schemas import REPO_ROOT
 from stage_hashing import hashable_config, stage_hashes
 from stage_registry import StageSpec
-from stage_runner import StageOutcome, StageRunner, resolve_device, validate_selection
+from stage_runner import PipelineConfigError, StageOutcome, StageRunner, resolve_device, validate_selection
 from tracking import Tracker
 
 __all__ = ["EXIT_FAILED", "EXIT_INCOMPLETE", "EXIT_OK", "exit_code", "run_from_hydra", "run_pipeline"]
@@ -89,10 +90,17 @@ def run_pipeline(
 
     Returns:
         The summary also written to ``<run_dir>/summary.json``, with ``exit_code``.
+
+    Raises:
+        PipelineConfigError: ``run_dir`` holds another experiment, or results of a changed stage that ``force``
+            does not name (:func:`run_guard.run_dir_problem`); nothing is written then.
     """
     registry = tuple(registry if registry is not None else stage_registry.STAGES)
     validate_selection(cfg, registry)
     cfg = _prepare(cfg, run_dir)
+    problem = run_dir_problem(cfg, registry)
+    if problem is not None:
+        raise PipelineConfigError(*problem)
     seed_everything(int(cfg.seed))
     layout = RunDir(Path(cfg.run_dir))
     container = OmegaConf.to_container(cfg, resolve=True, enum_to_str=True)
@@ -101,6 +109,7 @@ def run_pipeline(
     atomic_write_yaml(layout.config_yaml, resolved)
     git = write_git_state(REPO_ROOT, layout.root)
     manifest = Manifest.load(layout.manifest_json)
+    manifest.exp_name = str(cfg.exp_name)
     manifest.config_hash = config_hash(hashable_config(cfg, [s.name for s in registry]))
     manifest.invocations.append(_invocation(cfg, git, manifest.config_hash))
     manifest.save()

@@ -17,6 +17,7 @@ from typing import Any
 from hydra.core.config_store import ConfigStore
 from omegaconf import MISSING, OmegaConf
 
+from config_ranges import each, ranged
 from stage_registry import stage_names
 
 __all__ = [
@@ -113,7 +114,7 @@ class StageCfg:
 
     out_dir: str = MISSING
     """Folder the stage writes its outputs to (``metrics.json`` is added by the runner)."""
-    max_minutes: float | None = _interp("${max_minutes}")
+    max_minutes: float | None = ranged(_interp("${max_minutes}"), gt=0)
     """Time box of the stage [min]; it saves resumable state and stops when reached. None: no limit."""
     resume: bool = True
     """Continue from resumable state in ``out_dir``. Set by the runner: false when the stage is forced or its
@@ -155,25 +156,25 @@ class PpoSchedule(str, Enum):
 class PpoSettingsCfg:
     """PPO hyper-parameters (mirror of ``gmloco.train.teacher_student.PpoCfg``; GM-Loco values by default)."""
 
-    learning_rate: float = 1.0e-3
+    learning_rate: float = ranged(1.0e-3, gt=0)
     """Adam learning rate (initial value under the adaptive schedule)."""
     schedule: PpoSchedule = PpoSchedule.adaptive
     """Learning-rate schedule; adaptive keeps the policy KL near ``desired_kl``."""
-    desired_kl: float = 0.01
+    desired_kl: float = ranged(0.01, gt=0)
     """Target KL per update [nats] of the adaptive schedule."""
-    entropy_coef: float = 0.005
+    entropy_coef: float = ranged(0.005, ge=0)
     """Entropy bonus weight."""
-    gamma: float = 0.99
+    gamma: float = ranged(0.99, ge=0, le=1)
     """Discount factor per policy step."""
-    lam: float = 0.95
+    lam: float = ranged(0.95, ge=0, le=1)
     """GAE lambda."""
-    clip_param: float = 0.2
+    clip_param: float = ranged(0.2, gt=0)
     """PPO ratio clip."""
-    num_learning_epochs: int = 5
+    num_learning_epochs: int = ranged(5, ge=1)
     """Passes over the rollout per update."""
-    num_mini_batches: int = 4
+    num_mini_batches: int = ranged(4, ge=1)
     """Mini-batches per pass."""
-    max_grad_norm: float = 1.0
+    max_grad_norm: float = ranged(1.0, gt=0)
     """Gradient-norm clip."""
 
 
@@ -181,13 +182,13 @@ class PpoSettingsCfg:
 class PolicyTrainingCfg(StageCfg):
     """Fields shared by the two training stages (``gmloco.train.TrainRunCfg``)."""
 
-    num_envs: int = 4096
+    num_envs: int = ranged(4096, ge=1)
     """Parallel environments (rsl_rl / mjlab name)."""
-    max_iterations: int = 5000
+    max_iterations: int = ranged(5000, ge=1)
     """Iterations in total over all resumed calls."""
-    num_steps_per_env: int = 24
+    num_steps_per_env: int = ranged(24, ge=1)
     """Env steps per env and iteration."""
-    save_interval: int = 50
+    save_interval: int = ranged(50, ge=1)
     """Iterations between checkpoints (one is always written when a call ends)."""
     ppo: PpoSettingsCfg = field(default_factory=PpoSettingsCfg)
     """PPO hyper-parameters."""
@@ -204,27 +205,27 @@ class TrainTeacherCfg(PolicyTrainingCfg):
     """Granular contact model applied to the feet."""
     terrain: TerrainName = TerrainName.flat
     """Sand bed: flat soft sand, sinusoidal rough surface, or a 30 cm deep loose bed."""
-    policy_history_length: int = 5
+    policy_history_length: int = ranged(5, ge=1)
     """Actor frames stacked into o_t (1 for the teacher-student: the history goes through the encoders)."""
-    curriculum_scale: float = 1.0
+    curriculum_scale: float = ranged(1.0, gt=0)
     """Multiplier on the command-stage steps and tracking-ramp length (1.0: GM-Loco's, stages at 10k and 15k
     iterations; 0.1 fits a ~2k-iteration budget). See ``gmloco.train.GranularTaskCfg.curriculum_scale``."""
     foot_clearance: FootClearanceForm = FootClearanceForm.penalty
     """Swing-height term: the project page's L2 penalty or the public code's exp reward (pays standing still)."""
-    hidden_dims: list[int] = field(default_factory=lambda: [512, 256, 128])
+    hidden_dims: list[int] = field(default_factory=lambda: [512, 256, 128], metadata=each(integer=True, ge=1))
     """Actor and critic MLP widths (GM-Loco: 512, 256, 128)."""
-    latent_dim: int = 16
+    latent_dim: int = ranged(16, ge=1)
     """Terrain latent size z of the VAE teacher (ours; the paper does not give it)."""
-    kl_weight: float = 1.0e-4
+    kl_weight: float = ranged(1.0e-4, ge=0)
     """beta, weight of the teacher's KL term (ours; see ``TeacherCfg.kl_weight``)."""
-    decoder_learning_rate: float | None = 1.0e-3
+    decoder_learning_rate: float | None = ranged(1.0e-3, gt=0)
     """Fixed Adam learning rate of the teacher's eta decoder (null: the adaptive rate; the encoder always follows it)."""
     warm_start_ppo: str | None = None
     """vae_teacher: a vanilla-PPO checkpoint of the same task (e.g. ``artifacts/ppo_rft3d/checkpoint.pt``) whose
     actor and critic start a fresh teacher run; null: from scratch."""
-    encoder_hidden_dims: list[int] = field(default_factory=lambda: [256, 128, 64])
+    encoder_hidden_dims: list[int] = field(default_factory=lambda: [256, 128, 64], metadata=each(integer=True, ge=1))
     """Teacher terrain encoder widths (paper)."""
-    history_length: int = 50
+    history_length: int = ranged(50, ge=1)
     """N, frames of the ``history`` group the teacher encoder reads (the student reads the same N)."""
 
 
@@ -235,12 +236,12 @@ class DistillCfg(PolicyTrainingCfg):
     out_dir: str = _interp("${run_dir}/distill")
     teacher_dir: str = _interp("${train_teacher.out_dir}")
     """Folder holding the teacher checkpoint (newest ``model_<it>.pt``)."""
-    max_iterations: int = 2000
-    curriculum_finish: int = 1000
+    max_iterations: int = ranged(2000, ge=1)
+    curriculum_finish: int = ranged(1000, ge=1)
     """Iteration at which w_PPO and w_dist reach their end values (ours)."""
-    tcn_channels: list[int] = field(default_factory=lambda: [32, 32, 32])
+    tcn_channels: list[int] = field(default_factory=lambda: [32, 32, 32], metadata=each(integer=True, ge=1))
     """Output channels of the student's three 1-D convolutions (ours)."""
-    decoder_loss_weight: float = 1.0
+    decoder_loss_weight: float = ranged(1.0, ge=0)
     """Weight of (psi(z) - psi(z_hat))^2 (paper: 1)."""
     ppo: PpoSettingsCfg = field(
         default_factory=lambda: PpoSettingsCfg(learning_rate=5.0e-4, schedule=PpoSchedule.fixed, entropy_coef=0.001)
@@ -254,9 +255,9 @@ class ExportCfg(StageCfg):
     out_dir: str = _interp("${run_dir}/export")
     policy_dir: str = _interp("${distill.out_dir}")
     """Folder holding the student checkpoint (newest ``model_<it>.pt``)."""
-    parity_atol: float = 1.0e-5
+    parity_atol: float = ranged(1.0e-5, gt=0)
     """Largest onnxruntime-vs-torch difference accepted, on random and on rollout inputs."""
-    check_steps: int = 25
+    check_steps: int = ranged(25, ge=1)
     """Env steps rolled out with the ONNX runner, compared with the torch student and the teacher."""
 
 
@@ -269,20 +270,20 @@ class EvalMpmCfg(StageCfg):
     """Folder holding ``policy.onnx``."""
     policy_file: str = "policy.onnx"
     """File in ``policy_dir`` (gmloco student export or mjlab actor export)."""
-    num_episodes: int = 100
+    num_episodes: int = ranged(100, ge=1)
     """Episodes per (policy, terrain, scenario); the paper uses 100."""
-    episode_s: float = 10.0
+    episode_s: float = ranged(10.0, gt=0)
     """Episode length = course time limit [s]."""
-    voxel_size: float = 0.03
+    voxel_size: float = ranged(0.03, gt=0)
     """MPM voxel size [m]. The numerics defaults are the setting the convergence check accepted in the accepted-setting runs
     (``docs/mpm_eval.md``, ``results/mpm_eval/convergence/accepted_setting/README.md``): 3 cm, 500 rheology iterations, 5 ms frames x 1
     rigid step, a 30 cm bed and 1.4 x 0.6 m windows. 4 and 5 cm voxels change the tracking errors (rejected)."""
-    max_iterations: int = 500
+    max_iterations: int = ranged(500, ge=1)
     """Rheology solver iterations per MPM frame at most. A 3 cm frame of a G1 walk does not reach the solver's
     tolerance within 1000, so this cap is what each frame costs; 500 walks as 1000 does, 350 sinks 27 % deeper."""
-    frame_dt: float = 0.005
+    frame_dt: float = ranged(0.005, gt=0, le=0.02)
     """MPM frame = coupling period [s]; must divide the 0.02 s policy step."""
-    rigid_substeps: int = 1
+    rigid_substeps: int = ranged(1, ge=1)
     """Rigid-solver steps per MPM frame (physics step = frame_dt / rigid_substeps)."""
     terrains: list[str] = field(
         default_factory=lambda: ["basalt", "dry_sand", "poppy_seed", "dry_sand_rough", "dry_sand_deep", "transition"]
@@ -291,24 +292,24 @@ class EvalMpmCfg(StageCfg):
     ``<medium>_deep``, ``transition``)."""
     scenarios: list[str] = field(default_factory=lambda: ["straight", "circle"])
     """``straight`` and/or ``circle`` (``gmloco.eval.g1_eval``)."""
-    speeds: list[float] = field(default_factory=lambda: [1.0, 1.5, 2.0, 2.5])
+    speeds: list[float] = field(default_factory=lambda: [1.0, 1.5, 2.0, 2.5], metadata=each(gt=0))
     """Forward-speed commands [m/s]; episode k uses ``speeds[k % len(speeds)]``."""
-    circle_radius: float = 2.0
+    circle_radius: float = ranged(2.0, gt=0)
     """Radius of the circular walk [m]."""
-    course_slack: float = 0.2
+    course_slack: float = ranged(0.2, ge=0, lt=1)
     """Fraction of the commanded path that may be left at the time limit and still count as finished."""
-    bed_depth: float = 0.30
+    bed_depth: float = ranged(0.30, gt=0)
     """Sand depth of the flat and rough terrains [m]; a loaded sole of a walking G1 reaches 20-30 cm on MPM sand."""
     moving_window: bool = True
     """Sand window moving with each robot (False: a static bed covering the course, the naive baseline)."""
-    window_length: float = 1.4
+    window_length: float = ranged(1.4, gt=0)
     """Moving window size along x [m] (centred 0.2 m ahead of the pelvis; 1.4 m walks as 1.8 m does: the accepted-setting runs)."""
-    window_width: float = 0.6
+    window_width: float = ranged(0.6, gt=0)
     """Moving window size along y [m] (0.6 m walks as 1.0 m does and costs 40 % less: the batched-cuts runs)."""
-    window_lead: float = 0.2
+    window_lead: float = ranged(0.2, ge=-5, le=5)
     """Window centre ahead of the pelvis [m] (negative: behind it). The soles lead the pelvis by <= 0.2 m and trail
     it by ~0.3 m walking, 0.5-0.75 m in falls (``results/mpm_eval/convergence/voxel_reference_foot_reach/foot_reach.json``)."""
-    robots_per_batch: int = 32
+    robots_per_batch: int = ranged(32, ge=1)
     """Robots sharing one MPM solver (one lane each)."""
     retire_idle_lanes: bool = True
     """Take a lane's sand out of the MPM solve once its robot has no episode left (a cell's tail then carries only
@@ -317,13 +318,13 @@ class EvalMpmCfg(StageCfg):
     """With ``max_minutes``: start only walks that can end before the time box (a cell too big for the time left is
     rebuilt with the lanes that fit, a freed lane takes a new walk only while one can end); False: cells run until
     the box drops their running episodes (the runs up to the reach-window runs)."""
-    cell_capacity_factor: float = 1.5
+    cell_capacity_factor: float = ranged(1.5, ge=1, also=(0.0,))
     """Grid capacity = factor x particles / particles-per-cell (fixed capacity: CUDA graph); 0 = unbounded.
     The rheology solver sweeps the whole capacity, so its cost grows with the factor: 1.5 gave 1.46x the
     robot-frames/s of 3.0 (H200, 32 robots, results/mpm_eval/convergence/grid_capacity_solvers); an overflow stops the cell with an error."""
     record_mcap: bool = True
     """Write the first episode of every (terrain, scenario, speed) as an MCAP recording."""
-    gpus: list[int] = field(default_factory=list)
+    gpus: list[int] = field(default_factory=list, metadata=each(integer=True, ge=0))
     """CUDA devices to spread the evaluation over: one process per GPU, each (terrain, scenario) cell split into one
     share per GPU, pooled into this stage's outputs (``gmloco.eval.g1_eval_gpus``; the shares' folders under
     ``<out_dir>/cells``). Empty: one process on the pipeline's ``device``. One GPU steps ~110-130 robot-frames/s at
@@ -350,16 +351,16 @@ class MismatchCfg(StageCfg):
     out_dir: str = _interp("${run_dir}/mismatch")
     real: str = _interp("${paths.sample_logs_dir}/g1_scripted_rigid_no_odometry.mcap")
     """The "real" recording (MCAP, project schema); default: a committed sample recording."""
-    duration_s: float | None = None
+    duration_s: float | None = ranged(None, gt=0)
     """Analyze only the first ``duration_s`` seconds [s] (at least ~5 s); None: the whole recording."""
-    horizon: int | None = None
+    horizon: int | None = ranged(None, integer=True, ge=1)
     """Shooting horizon of the replay [samples]; None: 60 ms at the recording's rate (30 samples at 500 Hz)."""
     ground: str = "plane"
     """Nominal ground of the replay: ``plane`` (rigid) or ``sand[:MATERIAL]`` (3D-RFT sand, material preset, default
     dry_sand), as ``gmloco-mismatch --ground``."""
     effects: list[str] | None = None
     """Effect ids to screen (``gmloco.deploy.mismatch.EFFECT_IDS``); None: the whole library."""
-    n_boot: int = 400
+    n_boot: int = ranged(400, ge=1)
     """Block-bootstrap resamples of the attribution."""
     mirror_check: bool = True
     """Also test a left/right-swapped joint map."""
@@ -373,15 +374,15 @@ class SweepEvalCfg:
 
     materials: list[str] = field(default_factory=lambda: ["dry_sand", "poppy_seed"])
     """Material presets (``gmloco.contact.MATERIAL_PRESETS``), fixed for every trial."""
-    speeds: list[float] = field(default_factory=lambda: [1.0])
+    speeds: list[float] = field(default_factory=lambda: [1.0], metadata=each(gt=0))
     """Commanded forward speeds [m/s]."""
-    repeats: int = 4
+    repeats: int = ranged(4, ge=1)
     """Envs per (material, speed) cell."""
-    duration_s: float = 10.0
+    duration_s: float = ranged(10.0, gt=0)
     """Episode duration that counts as success [s]."""
-    smoke_repeats: int = 1
+    smoke_repeats: int = ranged(1, ge=1)
     """``repeats`` at smoke scale."""
-    smoke_duration_s: float = 0.5
+    smoke_duration_s: float = ranged(0.5, gt=0)
     """``duration_s`` at smoke scale [s]."""
 
 
@@ -394,9 +395,9 @@ class SweepCfg:
     of ``gmloco.train.evaluate_policy`` on the trial's exported policy (e.g. ``eval/all/vel_error``; PPO only)."""
     direction: str = "maximize"
     """``maximize`` or ``minimize``."""
-    n_trials: int = 20
+    n_trials: int = ranged(20, ge=1)
     """Finished trials (complete, pruned or failed) the study should hold."""
-    sampler_seed: int = _interp("${seed}")
+    sampler_seed: int = ranged(_interp("${seed}"), integer=True, ge=0, le=2**32 - 1)
     """Seed of the TPE sampler (seeded samplers make sweeps reproducible)."""
     storage: str = _interp("sqlite:///${paths.runs_dir}/optuna.db")
     """Optuna storage URL (an RDB URL shares one study across machines)."""
@@ -408,13 +409,13 @@ class SweepCfg:
     """Study name inside the storage."""
     experiment: str = "gm_loco"
     """Experiment swept when the command line has no ``+exp=``."""
-    n_startup_trials: int = 5
+    n_startup_trials: int = ranged(5, ge=0)
     """Random trials before the TPE sampler models the objective."""
-    pruner_startup_trials: int = 3
+    pruner_startup_trials: int = ranged(3, ge=0)
     """Trials that finish before the median pruner prunes anything."""
-    pruner_warmup_steps: int = 0
+    pruner_warmup_steps: int = ranged(0, ge=0)
     """Training iterations of a trial before it may be pruned."""
-    report_chunks: int = 4
+    report_chunks: int = ranged(4, ge=1)
     """Training of a trial runs in this many resumed chunks; the objective is reported after each (pruning)."""
     task_overrides: dict[str, Any] = field(default_factory=dict)
     """Fixed ``task.<field path>`` values applied to every trial (same keys as ``params``)."""
@@ -423,7 +424,7 @@ class SweepCfg:
     requeue_interrupted: bool = True
     """On start, mark trials left running by a killed or time-boxed call as failed and enqueue them again; the
     retry continues in the same trial folder from its newest checkpoint. Only for one worker per study."""
-    smoke_trials: int = 2
+    smoke_trials: int = ranged(2, ge=1)
     """``n_trials`` at smoke scale."""
     smoke_task_overrides: dict[str, Any] = field(default_factory=lambda: {"task.episode_length_s": 0.1})
     """Extra ``task`` overrides at smoke scale, so that episodes finish within the few smoke steps."""
@@ -456,15 +457,15 @@ class AblationCfg:
     """Sand terrain of the evaluation."""
     materials: list[str] = field(default_factory=lambda: ["dry_sand", "poppy_seed"])
     """Material presets (``gmloco.contact.MATERIAL_PRESETS``)."""
-    speeds: list[float] = field(default_factory=lambda: [0.5, 1.0])
+    speeds: list[float] = field(default_factory=lambda: [0.5, 1.0], metadata=each(gt=0))
     """Commanded forward speeds [m/s]."""
-    repeats: int = 4
+    repeats: int = ranged(4, ge=1)
     """Envs per (material, speed) cell."""
-    duration_s: float = 10.0
+    duration_s: float = ranged(10.0, gt=0)
     """Episode duration that counts as success [s]."""
-    smoke_repeats: int = 1
+    smoke_repeats: int = ranged(1, ge=1)
     """``repeats`` at smoke scale."""
-    smoke_duration_s: float = 0.5
+    smoke_duration_s: float = ranged(0.5, gt=0)
     """``duration_s`` at smoke scale [s]."""
 
 
@@ -478,13 +479,13 @@ class PipelineCfg:
     """Run directory name; reuse it (or ``run_dir``) to resume."""
     run_dir: str = _interp("${paths.runs_dir}/${exp_name}/${run_name}")
     """The run directory (config, git state, manifest, stage outputs)."""
-    seed: int = 42
+    seed: int = ranged(42, ge=0, le=2**32 - 1)
     """Seed given to ``seed_everything`` before any stage."""
     device: str = "auto"
     """``auto`` (cuda when available), ``cpu``, ``cuda`` or ``cuda:N``."""
     scale: ScaleName = ScaleName.full
     """Set by the ``scale`` group; ``smoke`` is applied automatically on a CPU-only machine."""
-    max_minutes: float | None = None
+    max_minutes: float | None = ranged(None, gt=0)
     """Time box of the whole invocation [min]; stages after it are deferred. None: no limit."""
     force: Any = False
     """Rerun stages even when done for the same config: ``true`` (all) or a list, e.g. ``[export]``."""

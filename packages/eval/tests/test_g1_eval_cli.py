@@ -3,6 +3,8 @@
 
 from __future__ import annotations
 
+from pathlib import Path
+
 import pytest
 
 from gmloco.eval.g1_eval_cli import _parse
@@ -131,3 +133,31 @@ def test_cli_args_give_back_the_config() -> None:
     assert "--terrains" not in per_cell and "--scenarios" not in per_cell and "--out" not in per_cell
     with pytest.raises(ValueError, match="lane_gap"):
         cli_args(replace(cfg, lane_gap=3.0))
+
+
+@pytest.mark.parametrize(
+    ("content", "words"), [(None, "does not exist"), (b"", "no graph"), (b"\xff\x00junk", "not an ONNX model")]
+)
+def test_a_missing_or_non_onnx_policy_exits_2(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str], content: bytes | None, words: str
+) -> None:
+    """``--policy`` on a missing, empty or non-ONNX file: one error line, exit code 2, no traceback, no run."""
+    import gmloco.eval.g1_eval_cli as cli
+
+    policy = tmp_path / "policy.onnx"
+    if content is not None:
+        policy.write_bytes(content)
+    with pytest.raises(SystemExit) as info:
+        cli.main(["--out", str(tmp_path / "out"), "--policy", str(policy)])
+    assert info.value.code == 2
+    err = capsys.readouterr().err
+    assert words in err and str(policy) in err and err.count("\n") == 1
+    assert not (tmp_path / "out").exists()
+
+
+@pytest.mark.parametrize("argv", [["--num-episodes", "-1"], ["--episode-s", "0"], ["--speeds", "1.0", "-2"]])
+def test_non_positive_counts_and_durations_are_refused(argv: list[str], capsys: pytest.CaptureFixture[str]) -> None:
+    """A negative episode count, a zero episode length or a negative speed is a usage error naming the value."""
+    with pytest.raises(SystemExit) as info:
+        _parse(["--out", "x", *argv])
+    assert info.value.code == 2 and argv[-1] in capsys.readouterr().err

@@ -65,3 +65,25 @@ def test_analyze_never_overwrites_inputs(tmp_path: Path, samples_dir: Path) -> N
     with pytest.raises(ValueError, match="would overwrite an input"):
         analyze([victim], tmp_path, figures=False, progress=False)
     assert victim.read_bytes() == before
+
+
+@pytest.mark.parametrize("content", [[], ["notes.txt"]])
+def test_cli_refuses_a_folder_without_recordings(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str], content: list[str]
+) -> None:
+    """An empty folder (or one without ``*.mcap``) exits 2 with one paragraph and writes no summary."""
+    folder = tmp_path / "logs"
+    folder.mkdir()
+    for name in content:
+        (folder / name).write_text("x")
+    out = tmp_path / "out"
+    assert main([str(folder), "--out", str(out), "--no-progress"]) == 2
+    err = capsys.readouterr().err
+    assert "holds no *.mcap recording" in err and str(folder) in err and err.count("\n") == 1
+    assert not out.exists()
+
+
+def test_cli_refuses_a_missing_path(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    """A path that does not exist exits 2 before anything is analyzed."""
+    assert main([str(tmp_path / "nope.mcap"), "--out", str(tmp_path / "out"), "--no-progress"]) == 2
+    assert "does not exist" in capsys.readouterr().err

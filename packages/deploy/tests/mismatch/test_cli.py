@@ -7,9 +7,12 @@ import json
 from pathlib import Path
 
 import numpy as np
+import pytest
 
 from gmloco.deploy.mismatch.cli import main
 from gmloco.deploy.mismatch.io import read_recording, write_recording
+from gmloco.deploy.mismatch.pipeline import AnalysisCfg, analyze
+from gmloco.deploy.mismatch.recording import Recording
 
 
 def test_mcap_roundtrip(delay_rec: object, tmp_path: Path) -> None:
@@ -45,3 +48,23 @@ def test_cli_refuses_a_material_on_the_plane_and_a_zero_horizon(delay_rec: objec
         out = tmp_path / extra[0].strip("-")
         assert main(["--real", str(path), "--out", str(out), "--no-plots", *extra]) == 2
         assert not (out / "report.json").exists()
+
+
+def test_cli_refuses_an_unknown_effect_id(
+    delay_rec: Recording, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """``--effects actuator.dleay`` stops with exit code 2, names the id and its closest match, writes no report."""
+    path = write_recording(delay_rec, tmp_path / "real.mcap")
+    out = tmp_path / "out"
+    assert main(["--real", str(path), "--out", str(out), "--no-plots", "--effects", "actuator.dleay"]) == 2
+    err = " ".join(capsys.readouterr().err.split())
+    assert "'actuator.dleay' (did you mean 'actuator.delay'?)" in err
+    assert not (out / "report.json").exists()
+
+
+def test_analyze_refuses_an_unknown_effect_id(null_rec: Recording) -> None:
+    """``analyze`` raises instead of screening nothing and answering ``unexplained``."""
+    cfg = AnalysisCfg()
+    cfg.attribution.effects = ("actuator.delay", "joint.frction")
+    with pytest.raises(ValueError, match=r"joint\.frction"):
+        analyze(null_rec, cfg)

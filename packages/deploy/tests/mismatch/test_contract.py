@@ -4,6 +4,7 @@
 from __future__ import annotations
 
 import dataclasses
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -12,6 +13,9 @@ from gmloco.deploy.mismatch.contract import ContractCfg, ContractError, JointMap
 from gmloco.deploy.mismatch.frames import quat_conj, quat_from_roll_pitch, quat_mul, quat_to_mat
 from gmloco.deploy.mismatch.pipeline import AnalysisCfg, analyze
 from gmloco.deploy.mismatch.recording import Recording
+
+SAMPLE_LOGS = Path(__file__).resolve().parents[2] / "data" / "sample_logs"
+"""The committed sample recordings."""
 
 
 def test_clean_recording_passes(null_rec: Recording) -> None:
@@ -74,6 +78,36 @@ def test_low_gain_policy_with_far_targets_passes(null_rec: Recording) -> None:
     perm[[3, 9]] = perm[[9, 3]]
     with pytest.raises(JointMapError):
         check_recording(dataclasses.replace(far, q=rec.q[:, perm], dq=rec.dq[:, perm]))
+
+
+def test_tau_est_from_the_previous_command_passes(null_rec: Recording) -> None:
+    """tau_est made by the command of the sample before (a 50 Hz policy log) is no joint-map error.
+
+    The 50 Hz simulator recordings log the state of step i with the target sent for [t_i, t_i+1), while the torque
+    at that state comes from the previous target: tau_est_i = kp (q*_{i-1} - q_i) - kd dq_i. Targets that jump
+    by ~0.3 rad per step (an RL policy's wrists) make the same-sample motor law misfit the labelled column.
+    """
+    arrays = {f.name: getattr(null_rec, f.name) for f in dataclasses.fields(null_rec)}
+    every10 = {k: v[::10] for k, v in arrays.items() if isinstance(v, np.ndarray)}
+    rec = dataclasses.replace(null_rec, **every10)  # 500 Hz -> 50 Hz, a policy-rate recording
+    rng = np.random.default_rng(1)
+    q_cmd = rec.q + 0.3 * rng.standard_normal(rec.q.shape)
+    tau = np.zeros_like(rec.q)
+    tau[1:] = rec.kp[1:] * (q_cmd[:-1] - rec.q[1:]) - rec.kd[1:] * rec.dq[1:]
+    lagged = dataclasses.replace(rec, q_cmd=q_cmd, tau_est=tau)
+    assert not [i for i in check_recording(lagged) if i.check == "joint_map"]
+    perm = np.arange(29)
+    perm[[3, 9]] = perm[[9, 3]]  # a real swap of the knee state columns is still caught
+    with pytest.raises(JointMapError, match="knee"):
+        check_recording(dataclasses.replace(lagged, q=rec.q[:, perm], dq=rec.dq[:, perm]))
+
+
+def test_committed_policy_recording_passes_the_joint_map() -> None:
+    """The committed 50 Hz sample recording of the PPO policy on dry sand has a right joint map."""
+    from gmloco.deploy.mismatch.io import read_recording
+
+    path = SAMPLE_LOGS / "g1_ppo_rft3d_it542_unvalidated_dry_sand_v1.mcap"
+    assert not [i for i in check_recording(read_recording(path)) if i.check == "joint_map"]
 
 
 def _turned(rec: Recording, start_deg: float, sweep_deg: float) -> Recording:

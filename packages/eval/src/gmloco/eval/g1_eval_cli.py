@@ -11,9 +11,11 @@ from __future__ import annotations
 
 import argparse
 import json
+import sys
 from dataclasses import replace
 
 from gmloco.eval.g1_eval import G1EvalCfg, run
+from gmloco.eval.g1_eval_policy import policy_problem
 from gmloco.eval.mpm.box_scene import frame_dt_problem
 from gmloco.eval.mpm.window import SandWindowCfg
 
@@ -115,6 +117,12 @@ def _parse(argv: list[str] | None) -> argparse.Namespace:
         p.error(f"--cell-capacity-factor {a.cell_capacity_factor}: use >= 1 (or 0 for Newton's per-step allocation)")
     if a.substeps < 1:
         p.error(f"--substeps {a.substeps} must be >= 1 (rigid steps per MPM frame)")
+    for flag, value in (("num-episodes", a.num_episodes), ("robots-per-batch", a.robots_per_batch)):
+        if value < 1:
+            p.error(f"--{flag} {value} must be >= 1")
+    for flag, value in (("episode-s", a.episode_s), ("max-minutes", a.max_minutes), *(("speeds", v) for v in a.speeds)):
+        if value is not None and not value > 0.0:
+            p.error(f"--{flag} {value} must be > 0")
     return a
 
 
@@ -208,8 +216,12 @@ def cli_args(cfg: G1EvalCfg, cells: bool = True) -> list[str]:
 
 
 def main(argv: list[str] | None = None) -> None:
-    """Run the evaluation from command-line arguments."""
-    metrics, complete = run(cfg_from_args(_parse(argv)))
+    """Run the evaluation from command-line arguments; exit code 2 for bad arguments or a policy that is no ONNX."""
+    a = _parse(argv)
+    if (problem := policy_problem(a.policy)) is not None:  # checked before Warp and Newton start
+        print(f"error: --policy {problem}. Nothing was run.", file=sys.stderr)
+        raise SystemExit(2)
+    metrics, complete = run(cfg_from_args(a))
     print(json.dumps({"complete": complete, **{k: v for k, v in metrics.items() if "/v" not in k}}, indent=1))
 
 

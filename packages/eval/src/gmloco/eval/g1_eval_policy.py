@@ -15,7 +15,7 @@ from typing import Any
 
 import numpy as np
 
-__all__ = ["MjlabOnnxPolicy", "PolicySpec", "StudentOnnxPolicy", "load_policy"]
+__all__ = ["MjlabOnnxPolicy", "PolicySpec", "StudentOnnxPolicy", "load_policy", "policy_problem"]
 
 
 @dataclass(frozen=True)
@@ -151,6 +151,22 @@ class StudentOnnxPolicy:
         return np.asarray(self.runner.step(np.concatenate(parts, axis=1).astype(np.float32))).reshape(
             self.num_robots, -1
         )
+
+
+def policy_problem(path: str | Path) -> str | None:
+    """Why ``path`` cannot be loaded as an ONNX policy (one sentence), or None when it can."""
+    import onnx
+
+    p = Path(path)
+    if not p.is_file():
+        return f"'{p}' {'is a directory' if p.is_dir() else 'does not exist'}: pass an exported policy.onnx"
+    try:
+        model = onnx.load(str(p), load_external_data=False)
+    except Exception as exc:  # protobuf's DecodeError and friends: not an ONNX file
+        return f"'{p}' is not an ONNX model ({type(exc).__name__}): pass an exported policy.onnx"
+    if not model.graph.node:  # an empty or foreign protobuf decodes to an empty model
+        return f"'{p}' is not an ONNX model (no graph): pass an exported policy.onnx"
+    return None
 
 
 def load_policy(path: str | Path, num_robots: int = 1) -> MjlabOnnxPolicy | StudentOnnxPolicy:

@@ -21,13 +21,17 @@ def _parser() -> argparse.ArgumentParser:
 
 
 def main(argv: list[str] | None = None) -> int:
-    """Run the CLI; return the exit code (1 when any file could not be analyzed)."""
+    """Run the CLI; return the exit code (1 when a file could not be analyzed, 2 for bad inputs)."""
     from gmloco.deploy.logs.analysis.report import analyze
     from gmloco.deploy.logs.analysis.run_analysis import AnalysisCfg
 
     args = _parser().parse_args(argv)
-    result = analyze(args.paths, args.out, AnalysisCfg(rate_hz=args.rate), figures=not args.no_figures,
-                     progress=not args.no_progress)  # fmt: skip
+    try:
+        result = analyze(args.paths, args.out, AnalysisCfg(rate_hz=args.rate), figures=not args.no_figures,
+                         progress=not args.no_progress)  # fmt: skip
+    except ValueError as exc:  # bad inputs or --out; nothing was analyzed or written
+        print(f"error: {exc} Nothing was analyzed.", file=sys.stderr)
+        return 2
     print(f"analyzed {len(result['runs'])} file(s) -> {args.out}/summary.md")
     for f in result["failures"]:
         print(f"FAILED {f['file']}: {f['error']}", file=sys.stderr)

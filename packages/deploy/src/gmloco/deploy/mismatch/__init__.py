@@ -9,7 +9,15 @@ over the effect library (:mod:`.effects`, :mod:`.attribution`) -> ``report.json`
 (:mod:`.report`). CLI: ``gmloco.deploy.mismatch.cli:main``. MuJoCo, SciPy and Matplotlib are imported lazily.
 """
 
-from gmloco.deploy.mismatch.effects import EFFECT_IDS, EFFECTS, OUTCOME_IDS, EffectSpec, ParamSpec, effect
+from gmloco.deploy.mismatch.effects import (
+    EFFECT_IDS,
+    EFFECTS,
+    OUTCOME_IDS,
+    EffectSpec,
+    ParamSpec,
+    check_effect_ids,
+    effect,
+)
 from gmloco.deploy.mismatch.pipeline import AnalysisCfg, AnalysisResult, analyze
 from gmloco.deploy.mismatch.recording import Recording
 
@@ -23,5 +31,6 @@ __all__ = [
     "ParamSpec",
     "Recording",
     "analyze",
+    "check_effect_ids",
     "effect",
 ]

@@ -41,8 +41,10 @@ def _parser() -> argparse.ArgumentParser:
 def main(argv: list[str] | None = None) -> int:
     """Run the analysis; exit code 0 for a report (any verdict), 2 for unreadable input."""
     from rich.console import Console
+    from rich.markup import escape
     from rich.progress import Progress
 
+    from gmloco.deploy.mismatch.effects import check_effect_ids
     from gmloco.deploy.mismatch.io import read_recording
     from gmloco.deploy.mismatch.pipeline import AnalysisCfg, analyze
     from gmloco.deploy.mismatch.replay import parse_ground, replay_cfg_for_rate
@@ -50,6 +52,11 @@ def main(argv: list[str] | None = None) -> int:
 
     args = _parser().parse_args(argv)
     console = Console(stderr=True)
+    try:
+        effects = None if not args.effects else check_effect_ids(s.strip() for s in args.effects.split(","))
+    except ValueError as exc:
+        console.print(f"[red]error:[/] --effects: {escape(str(exc))} Nothing was analysed.")
+        return 2
     try:
         rec = read_recording(args.real)
     except (OSError, ValueError) as exc:
@@ -67,8 +74,7 @@ def main(argv: list[str] | None = None) -> int:
         console.print(f"[red]--{exc}")
         return 2
     cfg = AnalysisCfg(replay=replay)
-    if args.effects:
-        cfg.attribution.effects = tuple(s.strip() for s in args.effects.split(","))
+    cfg.attribution.effects = effects
     with Progress(console=console) as prog:
         task = prog.add_task("mismatch", total=1.0)
         res = analyze(rec, cfg, lambda msg, f: prog.update(task, completed=f, description=msg))

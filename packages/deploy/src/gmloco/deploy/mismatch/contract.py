@@ -156,22 +156,48 @@ def _pd_pairing(rec: Recording, min_corr: float = 0.9) -> tuple[np.ndarray, np.n
     arrays: ``ok`` (the labelled column fits best, within 10 %, with c > ``min_corr``), ``swap`` (another column
     fits with less than half the labelled misfit and c > ``min_corr``) and the best column. ``ok`` and ``swap``
     are False where tau_est is not logged or does not vary.
+
+    The command in force at a logged state is either the one logged with it or the one before it
+    (:func:`_command_lag`); the pairing uses the lag under which the motor law fits the recording best.
     """
     ok, swap, bests = np.zeros(29, bool), np.zeros(29, bool), np.arange(29)
     if np.allclose(rec.tau_est, 0.0):
         return ok, swap, bests
-    base = rec.kp * rec.q_cmd + rec.kd * rec.dq_cmd + rec.tau_ff  # [N, 29]
+    lag = _command_lag(rec)
+    n = rec.n - lag
+    base = (rec.kp * rec.q_cmd + rec.kd * rec.dq_cmd + rec.tau_ff)[:n]  # [N - lag, 29], the command in force
+    kp, kd, q, dq, tau_est = rec.kp[:n], rec.kd[:n], rec.q[lag:], rec.dq[lag:], rec.tau_est[lag:]
     for j in range(29):
-        tau = rec.tau_est[:, j]
+        tau = tau_est[:, j]
         if tau.std() < 1e-3:
             continue
-        pd = base[:, j : j + 1] - rec.kp[:, j : j + 1] * rec.q - rec.kd[:, j : j + 1] * rec.dq  # [N, 29 cols]
+        pd = base[:, j : j + 1] - kp[:, j : j + 1] * q - kd[:, j : j + 1] * dq  # [N - lag, 29 cols]
         c = (tau @ pd) / np.maximum(np.sqrt((tau @ tau) * np.sum(pd * pd, axis=0)), 1e-300)
         err = np.sqrt(np.clip(1.0 - c * c, 0.0, None))
         best = bests[j] = int(np.argmin(err))
         ok[j] = err[j] <= 1.1 * err[best] + 1e-9 and c[j] > min_corr
         swap[j] = best != j and err[best] < 0.5 * err[j] and c[best] > min_corr
     return ok, swap, bests
+
+
+def _command_lag(rec: Recording) -> int:
+    """Samples between a logged command and the logged state whose tau_est it produced: 0 or 1.
+
+    A motor applies the latest command it has received, so the tau_est logged with a state comes from the command
+    sent one control tick earlier whenever command and state are logged on the same tick (the project's 50 Hz
+    simulator recordings: the state of step i, then the target sent for [t_i, t_i+1)). At 500 Hz the two readings
+    hardly differ; at 50 Hz the same-sample reading misfits joints whose target moves more per step than they lag
+    it (the wrists), and an unrelated column can then fit better and look like a swap. The lag whose labelled
+    columns fit the motor law best (median misfit over the joints) is taken.
+    """
+    misfit = []
+    for lag in (0, 1):
+        n = rec.n - lag
+        pd = rec.kp[:n] * (rec.q_cmd[:n] - rec.q[lag:]) + rec.kd[:n] * (rec.dq_cmd[:n] - rec.dq[lag:])
+        res = rec.tau_est[lag:] - pd - rec.tau_ff[:n]
+        scale = np.maximum(np.linalg.norm(rec.tau_est[lag:], axis=0), 1e-9)
+        misfit.append(float(np.median(np.linalg.norm(res, axis=0) / scale)))
+    return int(np.argmin(misfit))
 
 
 def _xcorr(a: np.ndarray, b: np.ndarray) -> np.ndarray:

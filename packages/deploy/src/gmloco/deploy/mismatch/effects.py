@@ -10,6 +10,8 @@ edits) and :mod:`gmloco.deploy.mismatch.terrain` (ground); the ranking code neve
 
 from __future__ import annotations
 
+import difflib
+from collections.abc import Iterable
 from dataclasses import dataclass
 
 import numpy as np
@@ -23,6 +25,7 @@ __all__ = [
     "OUTCOME_IDS",
     "EffectSpec",
     "ParamSpec",
+    "check_effect_ids",
     "effect",
     "params_from_patch",
     "zero_params",
@@ -307,6 +310,26 @@ def effect(effect_id: str) -> EffectSpec:
         if e.id == effect_id:
             return e
     raise KeyError(f"unknown effect id {effect_id!r}; vocabulary: {EFFECT_IDS}")
+
+
+def check_effect_ids(ids: Iterable[str]) -> tuple[str, ...]:
+    """Return ``ids`` as a tuple after checking each against the library.
+
+    Raises:
+        ValueError: An id is not in :data:`EFFECT_IDS`; one paragraph names it, the closest ids and the library.
+    """
+    ids = tuple(ids)
+    unknown = [i for i in ids if i not in EFFECT_IDS]
+    if not unknown:
+        return ids
+    hints = [
+        f"'{u}' (did you mean '{c[0]}'?)" if (c := difflib.get_close_matches(u, EFFECT_IDS, 1)) else f"'{u}'"
+        for u in unknown
+    ]
+    raise ValueError(
+        f"unknown effect id {', '.join(hints)}: an effect that is not in the library would be screened by nothing "
+        f"and the verdict would say nothing about it. Effect ids: {', '.join(EFFECT_IDS)}."
+    )
 
 
 def params_from_patch(patch: dict[str, dict[str, float]]) -> dict[str, np.ndarray]:

@@ -11,7 +11,7 @@ import numpy as np
 
 from gmloco.deploy.mismatch.attribution import AttributionCfg, confirm, decide, screen, second_round
 from gmloco.deploy.mismatch.contract import ContractCfg, ContractError, ContractIssue, check_recording
-from gmloco.deploy.mismatch.effects import EFFECTS
+from gmloco.deploy.mismatch.effects import EFFECTS, check_effect_ids
 from gmloco.deploy.mismatch.localize import localize
 from gmloco.deploy.mismatch.problem import FloorCfg, Problem, effective_samples
 from gmloco.deploy.mismatch.recording import Recording
@@ -94,8 +94,13 @@ def analyze(
 
     Contract errors do not raise: they return an ``invalid_input`` report (joint-map errors are reported as
     such, never as physics).
+
+    Raises:
+        ValueError: ``cfg.attribution.effects`` names an effect that is not in the library.
     """
     cfg = cfg or AnalysisCfg()
+    if cfg.attribution.effects is not None:
+        check_effect_ids(cfg.attribution.effects)
     t0 = time.time()
     say = progress or (lambda msg, frac: None)
     say("contract checks", 0.0)

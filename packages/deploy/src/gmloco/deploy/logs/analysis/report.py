@@ -25,10 +25,27 @@ _OUTPUTS = ("summary.md", "summary.csv", "summary.json", "tracking.csv")
 
 
 def expand_paths(paths: list[str | Path]) -> list[Path]:
-    """Expand directories to their ``*.mcap`` files (sorted); keep files as given."""
+    """Expand directories to their ``*.mcap`` files (sorted); keep files as given.
+
+    Raises:
+        ValueError: No path given, a path that does not exist, or a directory without ``*.mcap`` files; the
+            message is one paragraph saying what to pass instead.
+    """
+    if not paths:
+        raise ValueError("no recording given: pass MCAP files (gmloco.g1_log/1 schema) or directories holding them.")
     out: list[Path] = []
     for p in map(Path, paths):
-        out += sorted(p.glob("*.mcap")) if p.is_dir() else [p]
+        if not p.exists():
+            raise ValueError(f"'{p}' does not exist: pass MCAP files or directories holding them.")
+        found = sorted(p.glob("*.mcap")) if p.is_dir() else [p]
+        if not found:
+            kinds = sorted({f.suffix or f.name for f in p.iterdir()})[:5]
+            held = f"it holds {', '.join(kinds)}" if kinds else "it is empty"
+            raise ValueError(
+                f"directory '{p}' holds no *.mcap recording ({held}; subdirectories are not searched): pass MCAP "
+                "files or the directory that holds them, e.g. packages/deploy/data/sample_logs."
+            )
+        out += found
     return out
 
 
@@ -120,6 +137,9 @@ def analyze(
 
     Returns:
         ``summary.json``'s content plus ``"figures"`` (paths) and ``"warnings"`` (per file).
+
+    Raises:
+        ValueError: Bad ``paths`` (:func:`expand_paths`) or an ``out_dir`` whose outputs would overwrite an input.
     """
     files = expand_paths(paths)
     out = Path(out_dir)

@@ -1,0 +1,65 @@
+# SPDX-License-Identifier: Apache-2.0
+"""Checks of the selected stages' inputs that need no stage to run: recordings exist, effect ids are known.
+
+Each check returns ``(dotted key, message)`` for the first problem, or None; the entry point turns it into one
+exit-2 paragraph before anything runs, so a typo never becomes a failed stage or a silent ``unexplained``.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+from omegaconf import DictConfig
+
+__all__ = ["MCAP_MAGIC", "input_problem", "mcap_problem"]
+
+MCAP_MAGIC = b"\x89MCAP0\r\n"
+"""First bytes of every MCAP file (MCAP specification, "Magic")."""
+
+
+def mcap_problem(path: str | Path) -> str | None:
+    """Why ``path`` is not an MCAP recording (one clause), or None."""
+    p = Path(path)
+    if not p.is_file():
+        return f"'{p}' {'is a directory' if p.is_dir() else 'does not exist'}"
+    with p.open("rb") as f:
+        head = f.read(len(MCAP_MAGIC))
+    return None if head == MCAP_MAGIC else f"'{p}' is not an MCAP recording (its first bytes are not MCAP's magic)"
+
+
+def _mismatch_problem(section: DictConfig) -> tuple[str, str] | None:
+    """``mismatch.real`` must be an MCAP file and ``mismatch.effects`` ids of the library."""
+    from gmloco.deploy.mismatch.effects import check_effect_ids
+
+    if (problem := mcap_problem(str(section.real))) is not None:
+        return "mismatch.real", f"bad value for 'mismatch.real': {problem}; set it to a G1 recording (.mcap)."
+    if section.effects is not None:
+        try:
+            check_effect_ids(str(e) for e in section.effects)
+        except ValueError as exc:
+            return "mismatch.effects", f"bad value for 'mismatch.effects': {exc}"
+    return None
+
+
+def _analyze_logs_problem(section: DictConfig) -> tuple[str, str] | None:
+    """Every ``analyze_logs.inputs`` entry must be a recording or a folder holding some."""
+    from gmloco.deploy.logs.analysis.report import expand_paths
+
+    for item in section.inputs:
+        try:
+            files = expand_paths([str(item)])
+        except ValueError as exc:
+            return "analyze_logs.inputs", f"bad value for 'analyze_logs.inputs': {exc}"
+        bad = next((m for f in files if (m := mcap_problem(f)) is not None), None)
+        if bad is not None:
+            return "analyze_logs.inputs", f"bad value for 'analyze_logs.inputs': {bad}; pass .mcap recordings."
+    return None
+
+
+def input_problem(cfg: DictConfig) -> tuple[str, str] | None:
+    """First problem with the inputs of the selected stages, as ``(key, message)``; else None."""
+    if "mismatch" in cfg.stages and (found := _mismatch_problem(cfg.mismatch)) is not None:
+        return found
+    if "analyze_logs" in cfg.stages:
+        return _analyze_logs_problem(cfg.analyze_logs)
+    return None
