@@ -146,10 +146,18 @@ class StudentOnnxPolicy:
 
 
 def load_policy(path: str | Path, num_robots: int = 1) -> MjlabOnnxPolicy | StudentOnnxPolicy:
-    """Return the metadata-driven runner (gmloco's document present) or mjlab's actor export for ``num_robots``."""
+    """Return the metadata-driven runner (gmloco's document present) or mjlab's actor export for ``num_robots``.
+
+    Raises:
+        PolicyMetadataError: If the file has neither gmloco's document nor mjlab's keys (e.g. version-1 metadata).
+    """
     import onnx
 
-    from gmloco.deploy.export import METADATA_KEY
+    from gmloco.deploy.export import METADATA_KEY, PolicyMetadata
 
-    keys = {p.key for p in onnx.load(str(path), load_external_data=False).metadata_props}
-    return StudentOnnxPolicy(path, num_robots) if METADATA_KEY in keys else MjlabOnnxPolicy(path, num_robots)
+    props = {p.key: p.value for p in onnx.load(str(path), load_external_data=False).metadata_props}
+    if METADATA_KEY in props:
+        return StudentOnnxPolicy(path, num_robots)
+    if "observation_dims" not in props or "format" in props:
+        PolicyMetadata.from_props(props)  # raises, saying what the file carries instead
+    return MjlabOnnxPolicy(path, num_robots)
