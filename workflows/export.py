@@ -5,8 +5,9 @@ Loads the newest student checkpoint of ``export.policy_dir`` (the ``distill`` st
 same task, and writes with ``gmloco.deploy.export``:
 
 * ``policy.onnx``: inputs ``obs`` ``[batch, 96]`` and ``history`` ``[batch, N, 96]``, outputs ``actions``, ``latent``
-  and the decoded stiffness ``eta``; the deploy metadata (joints, kp/kd, default pose, action scale, observation
-  layout and scaling, history length, policy dt, commit) in its ``metadata_props``, and ``policy.json`` (the same).
+  and the decoded stiffness ``eta``; the deploy metadata (``gmloco.deploy.export.PolicyMetadata``: observation terms,
+  history order, joints with gains and effort limits, timing, contact model and foot collider, materials and
+  randomization trained on, command ranges) in its ``metadata_props``, and ``policy.json`` (the same document).
 * the parity checks, as metrics: onnxruntime vs torch on random inputs (``export_policy_onnx``), then a rollout of
   ``export.check_steps`` env steps in which ``OnnxPolicyRunner`` keeps its own history and must reproduce the torch
   student's actions and decoded eta on the env's history; every other env times out half-way, so the runner's
@@ -26,7 +27,7 @@ metrics; it takes seconds, so it has no time box of its own.
 from __future__ import annotations
 
 import os
-from dataclasses import asdict, replace
+from dataclasses import replace
 from pathlib import Path
 from typing import Any
 
@@ -66,7 +67,9 @@ def _metadata(runner: Any, cfg: DictConfig, checkpoint: Path) -> Any:
 
     run_path = os.path.relpath(checkpoint, cfg.run_dir)
     history, latent = int(cfg.train_teacher.history_length), int(cfg.train_teacher.latent_dim)
-    return student_policy_metadata(runner, history, latent, run_path, git_commit(REPO_ROOT)[0])
+    return student_policy_metadata(
+        runner, task_cfg(cfg.train_teacher), history, latent, run_path, git_commit(REPO_ROOT)[0]
+    )
 
 
 def run(cfg: DictConfig) -> dict[str, float]:
@@ -81,7 +84,7 @@ def run(cfg: DictConfig) -> dict[str, float]:
         metadata = _metadata(runner, cfg, checkpoint)
         atol, steps = float(section.parity_atol), int(section.check_steps)
         path, random_err = export_student_onnx(runner, out / "policy.onnx", metadata, atol)
-        atomic_write_json(out / "policy.json", asdict(metadata))
+        atomic_write_json(out / "policy.json", metadata.to_dict())
         checks = rollout_parity_check(runner, path, steps, atol, force_reset_after=max(steps // 2, 1))
     finally:
         runner.env.close()

@@ -32,7 +32,7 @@ import shutil
 import subprocess
 import sys
 import time
-from dataclasses import asdict, replace
+from dataclasses import replace
 from pathlib import Path
 from typing import Any
 
@@ -310,10 +310,15 @@ def _post_checks(args: argparse.Namespace, task: Any, checkpoint: Path, run_dir:
         if args.stage == "student":
             commit = subprocess.run(["git", "rev-parse", "HEAD"], capture_output=True, text=True).stdout.strip()
             metadata = student_policy_metadata(
-                runner, args.history_length, args.latent_dim, f"{run_dir.name}/{checkpoint.name}", commit or "unknown"
+                runner,
+                task,
+                args.history_length,
+                args.latent_dim,
+                f"{run_dir.name}/{checkpoint.name}",
+                commit or "unknown",
             )
             path, err = export_student_onnx(runner, args.out / "policy.onnx", metadata)
-            (args.out / "policy.json").write_text(json.dumps(asdict(metadata), indent=1))
+            (args.out / "policy.json").write_text(json.dumps(metadata.to_dict(), indent=1))
             checks |= {"onnx_max_abs_diff": err}
             checks |= rollout_parity_check(runner, path, args.parity_steps, force_reset_after=args.parity_steps // 2)
         checks |= decoded_eta_check(runner, args.check_steps, args.check_warmup)

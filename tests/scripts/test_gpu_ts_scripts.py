@@ -73,7 +73,8 @@ def test_student_chunk_starts_from_the_teacher_and_exports_a_matching_onnx(chunk
     assert [i.name for i in model.graph.input] == ["obs", "history"]
     assert [o.name for o in model.graph.output] == ["actions", "latent", "eta"]
     meta = json.loads((out / "policy.json").read_text())
-    assert meta["history_length"] == 50 and meta["latent_dim"] == 16 and len(meta["joint_names"]) == 29
+    assert meta["observation"]["history_length"] == 50 and meta["latent_dim"] == 16
+    assert meta["observation"]["history_order"] == "oldest_first" and len(meta["joints"]["names"]) == 29
     for name in ("loss_distill_action", "loss_distill_latent", "loss_distill_decoded", "loss_eta_r2", "loss_w_ppo"):
         assert name in summary["curve"], name
 

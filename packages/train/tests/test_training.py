@@ -97,6 +97,26 @@ def test_policy_onnx_carries_deploy_metadata(run_dir: Path) -> None:
     assert [float(d) for d in meta["observation_dims"].split(",")] == [3, 3, 3, 29, 29, 29]  # mjlab writes "%.3f"
 
 
+def test_policy_onnx_runs_from_its_gmloco_metadata(run_dir: Path) -> None:
+    """The versioned document: stacked layout, 5 frames oldest first, collider, dt, effort; the runner steps it."""
+    import numpy as np
+
+    from gmloco.deploy.export import OnnxPolicyRunner, read_policy_metadata
+
+    meta = read_policy_metadata(run_dir / "policy.onnx")
+    obs = meta.observation
+    assert obs.layout == "term_stacked" and obs.history_length == 5 and obs.history_order == "oldest_first"
+    assert [t.dim for t in obs.terms] == [3, 3, 3, 29, 29, 29]
+    assert meta.timing.physics_dt == pytest.approx(0.005) and meta.timing.decimation == 4
+    assert meta.contact.model == "rft3d" and meta.contact.foot_collider.faces == "sole"
+    assert meta.contact.foot_collider.body_names == ["left_ankle_roll_link", "right_ankle_roll_link"]
+    assert meta.joints.effort_limit[meta.joints.names.index("left_knee_joint")] == pytest.approx(139.0)
+    assert json.loads((run_dir / "policy.json").read_text()) == meta.to_dict()
+    runner = OnnxPolicyRunner(run_dir / "policy.onnx", num_envs=2)
+    actions = runner.step({t.name: np.zeros((2, t.dim), dtype=np.float32) for t in obs.terms})
+    assert actions.shape == (2, 29) and np.isfinite(actions).all()
+
+
 def test_evaluate_exported_policy(run_dir: Path) -> None:
     """evaluate_policy rolls the ONNX policy out per (material, speed) and reports bounded metrics."""
     metrics = evaluate_policy(

@@ -114,27 +114,40 @@ def students() -> SimpleNamespace:
     return SimpleNamespace(good=TinyStudent, stock=StockExportStudent, silent=SilentDropStudent)
 
 
+def tiny_metadata(
+    history_length: int = HISTORY,
+    layout: str = "frame_and_history",
+    history_padding: str = "repeat_first",
+    **overrides: object,
+) -> object:
+    """Metadata of the tiny policy: terms ``command`` (2, clipped) and ``joint_pos`` (3, per-element scale)."""
+    from gmloco.deploy.export import metadata as m
+
+    terms = [
+        m.ObservationTermSpec("command", 2, 1.0, [-1.0, 1.0], "(v_x [m/s], omega_z [rad/s])"),
+        m.ObservationTermSpec("joint_pos", 3, [1.0, 1.0, 0.5], None, "q - q_0 [rad]"),
+    ]
+    collider = m.FootColliderSpec(
+        ["left_foot", "right_foot"], [-0.065, 0.141], [-0.0368, 0.0368], [-0.03539, 0.0], "sole", [5, 5, 5]
+    )
+    fields = {
+        "observation": m.ObservationSpec(terms, history_length, layout, history_padding=history_padding),  # type: ignore[arg-type]
+        "joints": m.JointSpec(
+            ["left_knee_joint", "right_knee_joint"], [99.1, 99.1], [6.3, 6.3], [0.3, 0.3], [0.25, 0.5], [139.0, 139.0]
+        ),
+        "timing": m.TimingSpec(physics_dt=0.005, decimation=4, policy_dt=0.02),
+        "contact": m.ContactSpec(
+            "rft3d", collider, 40.0, {"kind": "flat"}, {"mu_int": [0.2, 0.9]}, {"push_velocity": 1.0}
+        ),
+        "command": m.CommandSpec("twist", [-1.0, 1.0], [-0.5, 0.5], [-0.5, 0.5]),
+        "policy_class": "StudentActor",
+        "latent_dim": LATENT,
+        "commit": "0123abc",
+    }
+    return m.PolicyMetadata(**(fields | overrides))  # type: ignore[arg-type]
+
+
 @pytest.fixture
 def make_metadata() -> Callable[..., object]:
-    """Return a factory of metadata matching the tiny policy (two terms: 2 + 3 features)."""
-    from gmloco.deploy.export import PolicyMetadata
-
-    def make(**overrides: object) -> PolicyMetadata:
-        fields = {
-            "joint_names": ["left_knee_joint", "right_knee_joint"],
-            "joint_stiffness": [99.1, 99.1],
-            "joint_damping": [6.3, 6.3],
-            "default_joint_pos": [0.3, 0.3],
-            "action_scale": [0.25, 0.5],
-            "observation_names": ["command", "joint_pos"],
-            "observation_dims": [2, 3],
-            "observation_scale": [1.0, [1.0, 1.0, 0.5]],
-            "observation_clip": [None, [-100.0, 100.0]],
-            "history_length": HISTORY,
-            "policy_dt": 0.02,
-            "latent_dim": LATENT,
-            "commit": "0123abc",
-        }
-        return PolicyMetadata(**(fields | overrides))  # type: ignore[arg-type]
-
-    return make
+    """Return :func:`tiny_metadata`, the factory of metadata matching the tiny policy (2 + 3 features)."""
+    return tiny_metadata

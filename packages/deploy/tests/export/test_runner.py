@@ -97,4 +97,4 @@ def test_joint_targets_use_default_pose_and_action_scale(exported: Callable[...,
     path, _ = exported()
     runner = OnnxPolicyRunner(path)
     np.testing.assert_allclose(runner.joint_targets(np.array([1.0, -2.0])), [0.55, -0.7], rtol=1e-6)
-    assert runner.metadata.joint_names == ["left_knee_joint", "right_knee_joint"]
+    assert runner.metadata.joints.names == ["left_knee_joint", "right_knee_joint"]

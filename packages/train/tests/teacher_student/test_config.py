@@ -3,7 +3,6 @@
 
 from __future__ import annotations
 
-import pytest
 from rsl_rl.utils import resolve_callable
 
 from gmloco.train.teacher_student import (
@@ -54,28 +53,3 @@ def test_distill_dict_shares_latent_and_decoder_sizes_with_the_teacher() -> None
     assert d["actor"]["latent_dim"] == d["teacher"]["latent_dim"] == 8
     assert d["actor"]["decoder_hidden_dims"] == d["teacher"]["decoder_hidden_dims"]
     assert d["actor"]["history_length"] == 50 and d["teacher_checkpoint"] == "t.pt"
-
-
-def test_policy_metadata_kwargs_from_mjlab_base_metadata() -> None:
-    """Map mjlab's dict onto PolicyMetadata fields: scalar action scale broadcast, infinite clips become None."""
-    from gmloco.train.teacher_student.deploy_metadata import policy_metadata_kwargs
-
-    base = {
-        "run_path": "local",
-        "joint_names": ["a", "b"],
-        "joint_stiffness": [40.0, 40.0],
-        "joint_damping": [2.0, 2.0],
-        "default_joint_pos": [0.1, -0.1],
-        "action_scale": 0.25,
-        "observation_names": ["command", "joint_pos"],
-        "observation_terms_scale": [1.0, [1.0, 0.5]],
-        "observation_terms_clip": [[float("-inf"), float("inf")], [-5.0, 5.0]],
-    }
-    kw = policy_metadata_kwargs(
-        base, observation_dims=[3, 2], history_length=50, policy_dt=0.02, latent_dim=16, commit="abc"
-    )
-    assert kw["action_scale"] == [0.25, 0.25]
-    assert kw["observation_clip"] == [None, [-5.0, 5.0]]
-    assert kw["observation_dims"] == [3, 2] and kw["history_length"] == 50
-    export = pytest.importorskip("gmloco.deploy.export")
-    assert export.PolicyMetadata(**kw).obs_dim == 5

@@ -17,19 +17,18 @@ pytest.importorskip("onnxruntime")
 
 
 def _metadata(alg: StudentPPO) -> object:
-    """Metadata matching the toy student (one 5-wide observation term, 2 joints)."""
-    return export.PolicyMetadata(
-        joint_names=["a_joint", "b_joint"],
-        joint_stiffness=[40.0, 40.0],
-        joint_damping=[2.0, 2.0],
-        default_joint_pos=[0.0, 0.0],
-        action_scale=[0.25, 0.25],
-        observation_names=["toy"],
-        observation_dims=[alg.actor.obs_dim],
-        observation_scale=[1.0],
-        observation_clip=[None],
-        history_length=alg.actor.history_length,
-        policy_dt=0.02,
+    """Metadata matching the toy student (one observation term, 2 joints)."""
+    m = export.metadata
+    collider = m.FootColliderSpec(["l", "r"], [-0.1, 0.1], [-0.05, 0.05], [-0.03, 0.0], "sole", [5, 5, 5])
+    return m.PolicyMetadata(
+        observation=m.ObservationSpec(
+            [m.ObservationTermSpec("toy", alg.actor.obs_dim)], alg.actor.history_length, "frame_and_history"
+        ),
+        joints=m.JointSpec(["a_joint", "b_joint"], [40.0] * 2, [2.0] * 2, [0.0] * 2, [0.25] * 2, [88.0] * 2),
+        timing=m.TimingSpec(0.005, 4, 0.02),
+        contact=m.ContactSpec("rft3d", collider, 40.0, {}, {}, {}),
+        command=m.CommandSpec("twist", [-1.0, 1.0], [-0.5, 0.5], [-0.5, 0.5]),
+        policy_class="StudentActor",
         latent_dim=alg.actor.latent_dim,
     )
 

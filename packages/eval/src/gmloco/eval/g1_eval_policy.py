@@ -1,8 +1,9 @@
 # SPDX-License-Identifier: Apache-2.0
 """Exported policies driving the G1 MPM scene, batched over robots (onnxruntime on CPU).
 
-Two formats: mjlab's actor export (one ``obs`` input, per-term history flattened term-major, oldest first) and
-gmloco's student export (``obs`` + ``history``, run by ``gmloco.deploy.export.OnnxPolicyRunner``). Both take one
+Two kinds: a file with gmloco's metadata document (student ``obs`` + ``history``, or an actor whose one input
+stacks each term's history oldest first), run by ``gmloco.deploy.export.OnnxPolicyRunner``; and a plain mjlab
+actor export, read from mjlab's comma-joined keys. Both take one
 frame of observation terms per robot, ``{name: [num_robots, dim]}``, and return actions ``[num_robots, A]``.
 """
 
@@ -112,7 +113,7 @@ class MjlabOnnxPolicy:
 
 
 class StudentOnnxPolicy:
-    """A gmloco student export (``obs`` + ``history``) for ``num_robots`` robots; o_t built from the metadata."""
+    """A policy carrying gmloco's metadata (student or actor), run by ``OnnxPolicyRunner`` for ``num_robots`` robots."""
 
     def __init__(self, path: str | Path, num_robots: int = 1) -> None:
         """Load the runner; check that the observation terms are ones the scene provides."""
@@ -121,17 +122,18 @@ class StudentOnnxPolicy:
         self.runner = OnnxPolicyRunner(path, num_envs=num_robots)
         meta = self.runner.metadata
         known = {"base_ang_vel", "projected_gravity", "command", "joint_pos", "joint_vel", "actions"}
-        if not set(meta.observation_names) <= known:
-            raise ValueError(f"unsupported observation terms {sorted(set(meta.observation_names) - known)}")
+        if not set(self.runner.term_names) <= known:
+            raise ValueError(f"unsupported observation terms {sorted(set(self.runner.term_names) - known)}")
         self.meta = meta
         self.num_robots = num_robots
+        joints = meta.joints
         self.spec = PolicySpec(
-            joint_names=list(meta.joint_names),
-            kp=np.asarray(meta.joint_stiffness, dtype=np.float64),
-            kd=np.asarray(meta.joint_damping, dtype=np.float64),
-            default_joint_pos=np.asarray(meta.default_joint_pos, dtype=np.float64),
-            action_scale=np.asarray(meta.action_scale, dtype=np.float64),
-            policy_dt=float(meta.policy_dt),
+            joint_names=list(joints.names),
+            kp=np.asarray(joints.stiffness, dtype=np.float64),
+            kd=np.asarray(joints.damping, dtype=np.float64),
+            default_joint_pos=np.asarray(joints.default_pos, dtype=np.float64),
+            action_scale=np.asarray(joints.action_scale, dtype=np.float64),
+            policy_dt=float(meta.timing.policy_dt),
         )
 
     def reset(self, robots: Sequence[int] | None = None) -> None:
@@ -139,18 +141,8 @@ class StudentOnnxPolicy:
         self.runner.reset(None if robots is None else list(robots))
 
     def act(self, terms: dict[str, np.ndarray]) -> np.ndarray:
-        """Clip, scale and concatenate the terms ``{name: [R, dim]}`` into o_t; return the actions [R, A]."""
-        parts = []
-        for name, clip, scale in zip(
-            self.meta.observation_names, self.meta.observation_clip, self.meta.observation_scale, strict=True
-        ):
-            x = np.asarray(terms[name], dtype=np.float64).reshape(self.num_robots, -1)
-            if clip is not None:
-                x = np.clip(x, clip[0], clip[1])
-            parts.append(x * np.asarray(scale, dtype=np.float64))
-        return np.asarray(self.runner.step(np.concatenate(parts, axis=1).astype(np.float32))).reshape(
-            self.num_robots, -1
-        )
+        """Build o_t from the terms ``{name: [R, dim]}`` by the metadata (clip, scale, order); return actions [R, A]."""
+        return np.asarray(self.runner.step(terms)).reshape(self.num_robots, -1)
 
 
 def policy_problem(path: str | Path) -> str | None:
@@ -170,8 +162,18 @@ def policy_problem(path: str | Path) -> str | None:
 
 
 def load_policy(path: str | Path, num_robots: int = 1) -> MjlabOnnxPolicy | StudentOnnxPolicy:
-    """Return the student runner or mjlab's actor export for ``num_robots`` robots (format from the metadata)."""
+    """Return the metadata-driven runner (gmloco's document present) or mjlab's actor export for ``num_robots``.
+
+    Raises:
+        PolicyMetadataError: If the file has neither gmloco's document nor mjlab's keys (e.g. version-1 metadata).
+    """
     import onnx
 
-    keys = {p.key for p in onnx.load(str(path), load_external_data=False).metadata_props}
-    return StudentOnnxPolicy(path, num_robots) if "format" in keys else MjlabOnnxPolicy(path, num_robots)
+    from gmloco.deploy.export import METADATA_KEY, PolicyMetadata
+
+    props = {p.key: p.value for p in onnx.load(str(path), load_external_data=False).metadata_props}
+    if METADATA_KEY in props:
+        return StudentOnnxPolicy(path, num_robots)
+    if "observation_dims" not in props or "format" in props:
+        PolicyMetadata.from_props(props)  # raises, saying what the file carries instead
+    return MjlabOnnxPolicy(path, num_robots)

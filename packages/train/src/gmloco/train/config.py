@@ -14,6 +14,7 @@ __all__ = [
     "SandFloorCfg",
     "SandTerrainCfg",
     "TerrainName",
+    "contact_force_threshold",
     "deep_sand_terrain",
     "flat_sand_terrain",
     "rough_sand_terrain",
@@ -181,3 +182,10 @@ class GranularTaskCfg:
     """Overrides of reward term weights by name (see ``mdp.rewards``)."""
     play: bool = False
     """Evaluation mode: no noise, no pushes, no curricula, no robot DR."""
+
+
+def contact_force_threshold(task: GranularTaskCfg) -> float:
+    """Return |F| above which a foot is in contact [N]: the task's, else 5 N rigid and 40 N granular (GM-Loco)."""
+    if task.contact_force_threshold is not None:
+        return task.contact_force_threshold
+    return 5.0 if task.contact_model == "rigid" else 40.0

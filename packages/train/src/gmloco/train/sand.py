@@ -18,7 +18,7 @@ from typing import TYPE_CHECKING, Any
 import mujoco
 import torch
 
-from gmloco.train.config import GranularTaskCfg, SandTerrainCfg
+from gmloco.train.config import GranularTaskCfg, SandTerrainCfg, contact_force_threshold
 from gmloco.train.foot_contact import FootContactTracker, SurfaceHeightFn
 
 if TYPE_CHECKING:
@@ -109,9 +109,7 @@ class SandContact:
             self.model = self.coupling.model
             self.materials = MaterialWriter(self.model, task.material, self.device)
             self._eta = self.materials.eta
-        threshold = task.contact_force_threshold
-        if threshold is None:
-            threshold = 5.0 if task.contact_model == "rigid" else 40.0
+        threshold = contact_force_threshold(task)
         self.feet = FootContactTracker(
             env, self.coupling, FEET_FLOOR_SENSOR, FOOT_SITES, FOOT_BODIES, threshold, self.surface_height
         )

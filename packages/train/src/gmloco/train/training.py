@@ -173,7 +173,7 @@ def train(cfg: TrainRunCfg) -> dict[str, float]:
     summary = runner.summary() if remaining > 0 else {"iterations_done": 0.0, "iteration": float(resumed_from)}
     if cfg.export_onnx:
         extra = {"contact_model": cfg.task.contact_model, "terrain": cfg.task.terrain.kind}
-        export_policy_onnx(runner, run_dir / "policy.onnx", run_name=run_dir.name, extra=extra)
+        export_policy_onnx(runner, run_dir / "policy.onnx", cfg.task, run_name=run_dir.name, extra=extra)
     env.close()
     summary.update(resumed_from_iteration=float(resumed_from), wall_seconds=time.monotonic() - start)
     clean = {k: (v if math.isfinite(v) else None) for k, v in summary.items()}

@@ -4,16 +4,31 @@
 * :func:`export_policy_onnx`: one ONNX file, inputs ``obs`` ``[batch, obs_dim]`` and ``history``
   ``[batch, N, obs_dim]``, outputs ``actions`` (+ ``latent``, ``eta``); refuses a model whose encoder would be
   dropped (:class:`EncoderDroppedError`) and checks onnxruntime-vs-torch parity. Needs torch (``export`` extra).
-* :class:`PolicyMetadata`, :func:`read_policy_metadata`: joints, gains, default pose, action scale, observation
-  layout and scaling, history length, policy dt, commit; readable with onnx alone.
-* :class:`OnnxPolicyRunner`: keeps the history buffer and steps the policy with onnxruntime (``export`` extra).
+* :class:`PolicyMetadata` (schema ``gmloco-policy`` version 2), :func:`read_policy_metadata`: observation terms
+  with widths, clip and scale, history length and order, input layout; joints with gains, default pose, action
+  scale and effort limits; physics and policy dt; contact model, foot collider, terrain, materials and robot
+  randomization trained on; command ranges; commit. Readable with onnx alone; a file without it (or of another
+  version) is refused with :class:`PolicyMetadataError`.
+* :class:`OnnxPolicyRunner`: builds o_t from raw terms by the metadata, keeps the history buffer and steps the
+  policy with onnxruntime (``export`` extra).
+* ``gmloco-policy-info <policy.onnx>`` (:mod:`gmloco.deploy.export.info`): prints the metadata.
 
 Importing this package needs neither torch nor onnxruntime.
 """
 
 from gmloco.deploy.export.metadata import (
-    METADATA_FORMAT,
+    METADATA_KEY,
+    SCHEMA_NAME,
+    SCHEMA_VERSION,
+    CommandSpec,
+    ContactSpec,
+    FootColliderSpec,
+    JointSpec,
+    ObservationSpec,
+    ObservationTermSpec,
     PolicyMetadata,
+    PolicyMetadataError,
+    TimingSpec,
     read_policy_metadata,
     write_policy_metadata,
 )
@@ -27,11 +42,21 @@ from gmloco.deploy.export.onnx_export import (
 from gmloco.deploy.export.runner import OnnxPolicyRunner
 
 __all__ = [
-    "METADATA_FORMAT",
+    "METADATA_KEY",
+    "SCHEMA_NAME",
+    "SCHEMA_VERSION",
+    "CommandSpec",
+    "ContactSpec",
     "EncoderDroppedError",
+    "FootColliderSpec",
+    "JointSpec",
+    "ObservationSpec",
+    "ObservationTermSpec",
     "OnnxPolicyRunner",
     "ParityError",
     "PolicyMetadata",
+    "PolicyMetadataError",
+    "TimingSpec",
     "check_export_keeps_encoder",
     "export_policy_onnx",
     "read_policy_metadata",

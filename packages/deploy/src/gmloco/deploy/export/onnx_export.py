@@ -81,7 +81,8 @@ def export_policy_onnx(
     Args:
         model: Policy with an encoder-aware ``as_onnx`` (checked by :func:`check_export_keeps_encoder`).
         path: Output ``.onnx`` file.
-        metadata: Deploy metadata; its ``history_length`` and ``obs_dim`` must match the model's inputs.
+        metadata: Deploy metadata; its layout must be ``"frame_and_history"`` and its history length and frame
+            width must match the model's inputs.
         opset: ONNX opset.
         verify: Compare onnxruntime with torch on random inputs (needs onnxruntime).
         atol: Absolute tolerance of the parity check.
@@ -100,10 +101,11 @@ def export_policy_onnx(
     check_export_keeps_encoder(model, wrapper)
     wrapper = wrapper.to("cpu").eval()
     obs, history = wrapper.get_dummy_inputs()
-    if history.shape[1] != metadata.history_length or obs.shape[-1] != metadata.obs_dim:
+    spec = metadata.observation
+    if spec.layout != "frame_and_history" or history.shape[1] != spec.history_length or obs.shape[-1] != spec.obs_dim:
         raise ValueError(
-            f"Model takes obs {tuple(obs.shape)} and history {tuple(history.shape)}, metadata says obs_dim="
-            f"{metadata.obs_dim}, history_length={metadata.history_length}."
+            f"Model takes obs {tuple(obs.shape)} and history {tuple(history.shape)}, metadata says layout "
+            f"{spec.layout!r}, obs_dim={spec.obs_dim}, history_length={spec.history_length}."
         )
     path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)

@@ -6,8 +6,8 @@
 * Student: :class:`StudentActor` (three 1-D convolutions + MLP over the N-step history) trained by
   :class:`StudentPPO` (DAgger + weighted PPO, frozen teacher) under :class:`StudentRunner`.
 * Configs: :class:`TeacherCfg`, :class:`StudentCfg`, :class:`DistillCfg`, :class:`ObsGroupsCfg`, :class:`PpoCfg`.
-* Export: :func:`policy_metadata_kwargs` maps mjlab's export metadata onto ``gmloco.deploy.export.PolicyMetadata``;
-  :mod:`~gmloco.train.teacher_student.export_student` rebuilds a trained student on the env, exports and checks it.
+* Export: :mod:`~gmloco.train.teacher_student.export_student` rebuilds a trained student on the env, exports it
+  with its deploy metadata (:mod:`gmloco.train.tasks.g1_granular.policy_metadata`) and checks it.
 * Held-out materials: :class:`HeldOutRegionCfg` (a (rho_c, mu_int) rectangle the DR never draws, see
   :func:`redraw_outside`) and :func:`r2_score` for the decoded eta.
 """
@@ -27,7 +27,6 @@ from gmloco.train.teacher_student.config import (
     student_train_entries,
 )
 from gmloco.train.teacher_student.curriculum import LinearRamp
-from gmloco.train.teacher_student.deploy_metadata import policy_metadata_kwargs
 from gmloco.train.teacher_student.heldout import DEFAULT_HELD_OUT, HeldOutRegionCfg, r2_score, redraw_outside
 from gmloco.train.teacher_student.runner import StudentRunner
 from gmloco.train.teacher_student.student import DEFAULT_HISTORY_LENGTH, StudentActor
@@ -56,7 +55,6 @@ __all__ = [
     "TeacherActor",
     "TeacherCfg",
     "TeacherPPO",
-    "policy_metadata_kwargs",
     "r2_score",
     "redraw_outside",
     "student_train_entries",

@@ -12,7 +12,6 @@ mjlab and the env stack are imported inside the functions.
 
 from __future__ import annotations
 
-import math
 import os
 from dataclasses import asdict, replace
 from pathlib import Path
@@ -68,24 +67,25 @@ def build_runner(
     return runner
 
 
-def student_policy_metadata(runner: Any, history_length: int, latent_dim: int, run_path: str, commit: str) -> Any:
-    """Return the student's ``PolicyMetadata`` read from the live env (mjlab base metadata + history, dt, latent)."""
-    from mjlab.rl.exporter_utils import get_base_metadata
+def student_policy_metadata(
+    runner: Any, task: GranularTaskCfg, history_length: int, latent_dim: int, run_path: str, commit: str
+) -> Any:
+    """Return the student's ``PolicyMetadata``: joints and term widths from the live env, the rest from ``task``.
 
-    from gmloco.deploy.export import PolicyMetadata
-    from gmloco.train.teacher_student.deploy_metadata import policy_metadata_kwargs
+    Args:
+        runner: Runner on an env built for (a play-mode variant of) ``task``.
+        task: The training task (its terrain, materials and randomization are recorded as trained on).
+        history_length: N of the student's ``history`` input.
+        latent_dim: Student latent size.
+        run_path: Training run identifier.
+        commit: Git commit of the training code.
+    """
+    from gmloco.train.tasks.g1_granular.policy_metadata import policy_metadata_from_env
 
-    env = runner.env.unwrapped
-    dims = [math.prod(d) for d in env.observation_manager.group_obs_term_dim["actor"]]
-    kwargs = policy_metadata_kwargs(
-        get_base_metadata(env, run_path),
-        observation_dims=dims,
-        history_length=history_length,
-        policy_dt=float(env.step_dt),
-        latent_dim=latent_dim,
-        commit=commit,
-    )
-    return PolicyMetadata(**kwargs)
+    return policy_metadata_from_env(
+        runner.env.unwrapped, task, layout="frame_and_history", history_length=history_length,
+        policy_class="StudentActor", latent_dim=latent_dim, run_path=run_path, commit=commit,
+    )  # fmt: skip
 
 
 def export_student_onnx(runner: Any, path: str | Path, metadata: Any, atol: float = 1e-5) -> tuple[Path, float]:

@@ -10,10 +10,19 @@ from mjlab.utils.noise import UniformNoiseCfg
 from gmloco.train import mdp
 from gmloco.train.config import GranularTaskCfg
 
-__all__ = ["ACTOR_TERMS", "CRITIC_EXTRA_TERMS", "HISTORY_GROUP", "make_observations_cfg"]
+__all__ = ["ACTOR_TERMS", "ACTOR_TERM_DESCRIPTIONS", "CRITIC_EXTRA_TERMS", "HISTORY_GROUP", "make_observations_cfg"]
 
 ACTOR_TERMS = ("base_ang_vel", "projected_gravity", "command", "joint_pos", "joint_vel", "actions")
 """Actor observation terms, in order (29-DoF G1: 3 + 3 + 3 + 29 + 29 + 29 = 96 per frame)."""
+ACTOR_TERM_DESCRIPTIONS = {
+    "base_ang_vel": "IMU angular velocity (x, y, z) in the pelvis IMU frame [rad/s]",
+    "projected_gravity": "unit gravity direction in the pelvis frame (0, 0, -1 upright) [-]",
+    "command": "velocity command (v_x [m/s], v_y [m/s], omega_z [rad/s]) in the base yaw frame",
+    "joint_pos": "q - q_0 per joint, joints order [rad]",
+    "joint_vel": "joint velocity per joint, joints order [rad/s]",
+    "actions": "the policy's previous raw action (before action_scale), joints order [-]",
+}
+"""What each actor term is (frame, order, SI unit), written into the exported policy's metadata."""
 CRITIC_EXTRA_TERMS = (
     "base_lin_vel",
     "foot_height",

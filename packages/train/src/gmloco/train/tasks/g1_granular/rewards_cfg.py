@@ -4,6 +4,7 @@
 from __future__ import annotations
 
 import math
+from typing import Any
 
 from mjlab.envs import mdp as envs_mdp
 from mjlab.managers.curriculum_manager import CurriculumTermCfg
@@ -14,7 +15,7 @@ from mjlab.tasks.velocity.config.g1.env_cfgs import unitree_g1_rough_env_cfg
 from gmloco.train import mdp
 from gmloco.train.config import GranularTaskCfg
 
-__all__ = ["LOWER_BODY_JOINTS", "UPPER_BODY_JOINTS", "make_curriculum_cfg", "make_rewards_cfg"]
+__all__ = ["LOWER_BODY_JOINTS", "UPPER_BODY_JOINTS", "command_stages", "make_curriculum_cfg", "make_rewards_cfg"]
 
 CMD = "twist"
 """Name of the velocity command term."""
@@ -153,6 +154,16 @@ def make_rewards_cfg(task: GranularTaskCfg) -> dict[str, RewardTermCfg]:
     return {name: term for name, term in rewards.items() if term.weight != 0.0}
 
 
+def command_stages(task: GranularTaskCfg) -> list[dict[str, Any]]:
+    """GM-Loco's command-range stages: from env step ``step`` on, ``lin_vel_x`` [m/s] and ``ang_vel_z`` [rad/s]."""
+    step2, step3 = (round(s * task.curriculum_scale) for s in task.command_stage_steps)
+    return [
+        {"step": 0, "lin_vel_x": (-1.0, 1.0), "ang_vel_z": (-0.5, 0.5)},
+        {"step": step2, "lin_vel_x": (-1.0, 1.7), "ang_vel_z": (-0.7, 0.7)},
+        {"step": step3, "lin_vel_x": (-1.0, 2.5), "ang_vel_z": (-1.0, 1.0)},
+    ]
+
+
 def make_curriculum_cfg(task: GranularTaskCfg, rewards: dict[str, RewardTermCfg]) -> dict[str, CurriculumTermCfg]:
     """Floor-depth levels, command-range stages and tracking ramps (GM-Loco schedule)."""
     if task.play:
@@ -161,16 +172,10 @@ def make_curriculum_cfg(task: GranularTaskCfg, rewards: dict[str, RewardTermCfg]
     if task.contact_model != "rigid" and task.terrain.floor.curriculum:
         cur["sand_floor_levels"] = CurriculumTermCfg(func=mdp.sand_floor_levels, params={"command_name": CMD})
     if task.command_curriculum:
-        step2, step3 = (round(s * task.curriculum_scale) for s in task.command_stage_steps)
-        stages = [
-            {"step": 0, "lin_vel_x": (-1.0, 1.0), "ang_vel_z": (-0.5, 0.5)},
-            {"step": step2, "lin_vel_x": (-1.0, 1.7), "ang_vel_z": (-0.7, 0.7)},
-            {"step": step3, "lin_vel_x": (-1.0, 2.5), "ang_vel_z": (-1.0, 1.0)},
-        ]
         from mjlab.tasks.velocity import mdp as vel_mdp
 
         cur["command_vel"] = CurriculumTermCfg(
-            func=vel_mdp.commands_vel, params={"command_name": CMD, "velocity_stages": stages}
+            func=vel_mdp.commands_vel, params={"command_name": CMD, "velocity_stages": command_stages(task)}
         )
     ramp_steps = round(task.reward_ramp_steps * task.curriculum_scale)
     if ramp_steps > 0:

@@ -1,0 +1,101 @@
+# SPDX-License-Identifier: Apache-2.0
+"""Deploy metadata from the training task: effort limits, collider, threshold, stages; upgrading version-1 files."""
+
+from __future__ import annotations
+
+import json
+from dataclasses import asdict, replace
+from pathlib import Path
+
+import onnx
+import pytest
+from onnx import TensorProto, helper
+
+from gmloco.deploy.export import METADATA_KEY, JointSpec, PolicyMetadata, read_policy_metadata
+from gmloco.deploy.logs.g1 import G1_JOINT_NAMES
+from gmloco.train.tasks.g1_granular import g1_granular_task
+from gmloco.train.tasks.g1_granular.policy_metadata import granular_policy_metadata, joint_spec
+from gmloco.train.tasks.g1_granular.upgrade_metadata import upgrade_policy_dir
+
+DIMS = [3, 3, 3, 29, 29, 29]
+"""Per-frame widths of the G1 actor terms."""
+
+
+def _joints() -> JointSpec:
+    """G1 joints with placeholder gains."""
+    return joint_spec(G1_JOINT_NAMES, [1.0] * 29, [0.1] * 29, [0.0] * 29, 0.25)
+
+
+def test_metadata_follows_the_training_task() -> None:
+    """Take effort limits, collider, threshold, command stages and timing from the task.
+
+    Hand values: knee 139, hip pitch 88, ankle 2 x 25, wrist pitch 5 N m; box faces; 40 N granular threshold;
+    stages at 0.1 x (240k, 360k) env steps; 200 Hz physics x 4 = 50 Hz policy; JSON round trip exact.
+    """
+    task = replace(g1_granular_task("rft3d"), foot_faces="box", curriculum_scale=0.1)
+    meta = granular_policy_metadata(
+        task,
+        _joints(),
+        DIMS,
+        layout="frame_and_history",
+        history_length=50,
+        policy_class="StudentActor",
+    )
+    limits = dict(zip(meta.joints.names, meta.joints.effort_limit, strict=True))
+    assert (limits["left_knee_joint"], limits["right_hip_pitch_joint"]) == (139.0, 88.0)
+    assert (limits["left_ankle_roll_joint"], limits["left_wrist_pitch_joint"]) == (50.0, 5.0)
+    assert meta.contact.foot_collider.faces == "box" and meta.contact.contact_force_threshold == 40.0
+    assert [s["step"] for s in meta.command.stages] == [0, 24_000, 36_000]
+    assert (meta.timing.physics_dt, meta.timing.decimation, meta.timing.policy_dt) == (0.005, 4, 0.02)
+    assert [t.name for t in meta.observation.terms][:3] == ["base_ang_vel", "projected_gravity", "command"]
+    assert PolicyMetadata.from_props(meta.to_props()) == meta
+
+
+def test_rigid_policy_records_the_rigid_threshold_and_the_sole() -> None:
+    """Rigid contact: 5 N threshold; the collider (kept for logging) stays the sole whatever foot_faces says."""
+    task = replace(g1_granular_task("rigid"), foot_faces="box")
+    meta = granular_policy_metadata(
+        task, _joints(), DIMS, layout="term_stacked", history_length=5, policy_class="MLPModel"
+    )
+    assert meta.contact.model == "rigid" and meta.contact.contact_force_threshold == 5.0
+    assert meta.contact.foot_collider.faces == "sole"
+
+
+def _v1_policy(folder: Path, history: int = 50) -> None:
+    """A one-node ONNX with version-1 student entries, and a train_cfg.json whose task lacks ``foot_faces``."""
+    x = helper.make_tensor_value_info("x", TensorProto.FLOAT, [1])
+    y = helper.make_tensor_value_info("y", TensorProto.FLOAT, [1])
+    model = helper.make_model(helper.make_graph([helper.make_node("Identity", ["x"], ["y"])], "g", [x], [y]))
+    v1 = {
+        "joint_names": list(G1_JOINT_NAMES), "joint_stiffness": [40.0] * 29, "joint_damping": [2.0] * 29,
+        "default_joint_pos": [0.1] * 29, "action_scale": [0.25] * 29, "observation_dims": DIMS,
+        "history_length": history, "policy_dt": 0.02, "latent_dim": 16, "commit": "abc", "run_path": "r/model_1.pt",
+        "format": "gmloco-student-policy/1", "observation_names": ["a"], "other": "kept",
+    }  # fmt: skip
+    for key, value in v1.items():
+        model.metadata_props.append(onnx.StringStringEntryProto(key=key, value=json.dumps(value)))
+    onnx.save(model, str(folder / "policy.onnx"))
+    task = asdict(g1_granular_task())
+    del task["foot_faces"]
+    (folder / "train_cfg.json").write_text(json.dumps({"task": task, "history_length": 50}))
+
+
+def test_upgrade_refuses_a_missing_task_field_then_writes_the_document(tmp_path: Path) -> None:
+    """Without foot_faces the upgrade is refused; given it, the file carries the document and no version-1 entry."""
+    _v1_policy(tmp_path)
+    with pytest.raises(ValueError, match="foot_faces"):
+        upgrade_policy_dir(tmp_path)
+    upgrade_policy_dir(tmp_path, {"foot_faces": "sole"})
+    meta = read_policy_metadata(tmp_path / "policy.onnx")
+    assert meta.joints.stiffness == [40.0] * 29 and meta.commit == "abc" and meta.observation.history_length == 50
+    assert meta.contact.foot_collider.faces == "sole" and meta.latent_dim == 16
+    keys = {p.key for p in onnx.load(str(tmp_path / "policy.onnx")).metadata_props}
+    assert keys == {METADATA_KEY, "other"}
+    assert json.loads((tmp_path / "policy.json").read_text()) == meta.to_dict()
+
+
+def test_upgrade_refuses_disagreeing_facts(tmp_path: Path) -> None:
+    """A file whose history length differs from its train_cfg.json is not upgraded."""
+    _v1_policy(tmp_path, history=40)
+    with pytest.raises(ValueError, match="history length"):
+        upgrade_policy_dir(tmp_path, {"foot_faces": "sole"})
