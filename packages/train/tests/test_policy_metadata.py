@@ -51,6 +51,26 @@ def test_metadata_follows_the_training_task() -> None:
     assert PolicyMetadata.from_props(meta.to_props()) == meta
 
 
+def test_metadata_states_the_heading_rule() -> None:
+    """The yaw-target task records its k (2/s here) and the correction; mjlab's heading envs record their 0.5/s."""
+    kw = {"layout": "frame_and_history", "history_length": 50, "policy_class": "StudentActor"}
+    target = replace(g1_granular_task("rft3d"), yaw_command="yaw_target", heading_stiffness=2.0)
+    cmd = granular_policy_metadata(target, _joints(), DIMS, **kw).command  # type: ignore[arg-type]
+    assert (cmd.yaw_command, cmd.heading_stiffness) == ("yaw_target", 2.0)
+    assert "clip(omega_z + 2 * wrap(yaw_target - yaw)" in cmd.description
+    envs = replace(target, yaw_command="heading_envs")
+    cmd = granular_policy_metadata(envs, _joints(), DIMS, **kw).command  # type: ignore[arg-type]
+    assert (cmd.yaw_command, cmd.heading_stiffness) == ("heading_envs", 0.5)
+
+
+def test_committed_students_state_mjlab_heading_envs() -> None:
+    """The committed students were trained before the yaw target: their metadata says heading envs, k = 0.5/s."""
+    root = Path(__file__).resolve().parents[3] / "artifacts"
+    for name in ("gm_loco_student_td", "gm_loco_student_clr50"):
+        cmd = read_policy_metadata(root / name / "policy.onnx").command
+        assert (cmd.yaw_command, cmd.heading_stiffness) == ("heading_envs", 0.5), name
+
+
 def test_rigid_policy_records_the_rigid_threshold_and_the_sole() -> None:
     """Rigid contact: 5 N threshold; the collider (kept for logging) stays the sole whatever foot_faces says."""
     task = replace(g1_granular_task("rigid"), foot_faces="box")

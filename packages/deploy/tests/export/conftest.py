@@ -139,7 +139,7 @@ def tiny_metadata(
         "contact": m.ContactSpec(
             "rft3d", collider, 40.0, {"kind": "flat"}, {"mu_int": [0.2, 0.9]}, {"push_velocity": 1.0}
         ),
-        "command": m.CommandSpec("twist", [-1.0, 1.0], [-0.5, 0.5], [-0.5, 0.5]),
+        "command": m.CommandSpec("twist", [-1.0, 1.0], [-0.5, 0.5], [-0.5, 0.5], "yaw_target", 1.0),
         "policy_class": "StudentActor",
         "latent_dim": LATENT,
         "commit": "0123abc",

@@ -53,7 +53,11 @@ def test_metadata_round_trips_through_props_and_onnx(
 
 
 def test_validation_names_the_inconsistent_field(make_metadata: Callable[..., PolicyMetadata]) -> None:
-    """Wrong per-joint length, zero history, a history order other than oldest-first, policy_dt != dt * decimation."""
+    """Refuse each inconsistency by name.
+
+    Wrong per-joint length, zero history, a history order other than oldest-first, policy_dt != dt * decimation,
+    an unknown heading rule, a negative heading stiffness.
+    """
     meta = make_metadata()
     with pytest.raises(PolicyMetadataError, match="damping"):
         replace(meta, joints=replace(meta.joints, damping=[1.0])).validate()
@@ -63,6 +67,10 @@ def test_validation_names_the_inconsistent_field(make_metadata: Callable[..., Po
         replace(meta, observation=replace(meta.observation, history_order="newest_first")).validate()  # type: ignore[arg-type]
     with pytest.raises(PolicyMetadataError, match="policy_dt"):
         replace(meta, timing=replace(meta.timing, decimation=2)).validate()
+    with pytest.raises(PolicyMetadataError, match="yaw_command 'heading'"):
+        replace(meta, command=replace(meta.command, yaw_command="heading")).validate()
+    with pytest.raises(PolicyMetadataError, match="heading_stiffness -1"):
+        replace(meta, command=replace(meta.command, heading_stiffness=-1.0)).validate()
 
 
 def test_from_props_refuses_missing_legacy_and_unknown_versions(make_metadata: Callable[..., PolicyMetadata]) -> None:

@@ -27,7 +27,7 @@ def _metadata(alg: StudentPPO) -> object:
         joints=m.JointSpec(["a_joint", "b_joint"], [40.0] * 2, [2.0] * 2, [0.0] * 2, [0.25] * 2, [88.0] * 2),
         timing=m.TimingSpec(0.005, 4, 0.02),
         contact=m.ContactSpec("rft3d", collider, 40.0, {}, {}, {}),
-        command=m.CommandSpec("twist", [-1.0, 1.0], [-0.5, 0.5], [-0.5, 0.5]),
+        command=m.CommandSpec("twist", [-1.0, 1.0], [-0.5, 0.5], [-0.5, 0.5], "yaw_target", 1.0),
         policy_class="StudentActor",
         latent_dim=alg.actor.latent_dim,
     )

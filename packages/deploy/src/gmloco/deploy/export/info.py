@@ -66,6 +66,7 @@ def _task_lines(meta: PolicyMetadata) -> list[str]:
         f"  robot randomization: {json.dumps(c.robot_randomization)}",
         f"command {cmd.name!r}: lin_vel_x {_fmt(cmd.lin_vel_x)} m/s, lin_vel_y {_fmt(cmd.lin_vel_y)} m/s, "
         f"ang_vel_z {_fmt(cmd.ang_vel_z)} rad/s; {cmd.description}",
+        f"  heading rule: {cmd.yaw_command}, heading stiffness {cmd.heading_stiffness:g} 1/s",
     ]
     lines += [f"  stage from env step {s['step']}: {json.dumps({k: v for k, v in s.items() if k != 'step'})}"
               for s in cmd.stages]  # fmt: skip

@@ -4,7 +4,7 @@
 Everything a runner needs that is not in the network is here: the observation terms in order with their
 widths, clip and scale, the history length and order, the input layout, the joints with PD gains, default pose,
 action scale and effort limits, physics and policy periods, the contact model with its foot collider, the terrain,
-materials and robot randomization trained on, and the command ranges. The document sits under one key
+materials and robot randomization trained on, and the command ranges with the heading rule. The document sits under one key
 (:data:`METADATA_KEY`); its ``schema`` / ``schema_version`` fields say how to read it, and a reader refuses a
 file without it or with a version it does not know (:class:`PolicyMetadataError`).
 """
@@ -24,6 +24,7 @@ __all__ = [
     "METADATA_KEY",
     "SCHEMA_NAME",
     "SCHEMA_VERSION",
+    "YAW_COMMANDS",
     "CommandSpec",
     "ContactSpec",
     "FootColliderSpec",
@@ -45,6 +46,9 @@ METADATA_KEY = "gmloco_policy"
 """ONNX ``metadata_props`` key holding the JSON document."""
 _LEGACY_FORMAT_KEY = "format"
 """Key of the version-1 student metadata (one JSON value per field), which lacks contact, timing and commands."""
+
+YAW_COMMANDS = ("yaw_target", "heading_envs")
+"""Heading rules a policy can be trained with (:attr:`CommandSpec.yaw_command`)."""
 
 InputLayout = Literal["frame_and_history", "term_stacked"]
 """How observation frames reach the network (see :class:`ObservationSpec`)."""
@@ -176,6 +180,14 @@ class CommandSpec:
     """Range of the lateral velocity command [m/s]."""
     ang_vel_z: list[float]
     """Initial range of the yaw-rate command [rad/s]."""
+    yaw_command: str
+    """Heading rule trained with. ``"yaw_target"``: a yaw target integrates the commanded w_z every policy step
+    (re-snapped to the heading when the error passes pi/2) and the observed yaw rate is
+    ``w_z_obs = clip(w_z + heading_stiffness * wrap(yaw_target - yaw), ang_vel_z range)``, so a runner must apply
+    the same correction; ``"heading_envs"``: mjlab's heading envs (a share of the envs steered toward a random
+    heading with ``heading_stiffness``, the rest commanded w_z directly), so a runner may command w_z directly."""
+    heading_stiffness: float
+    """k of the heading correction [1/s] (0: the policy sees the raw w_z)."""
     stages: list[dict[str, Any]] = field(default_factory=list)
     """Curriculum stages ``{"step": env steps, "lin_vel_x": [..], "ang_vel_z": [..]}``: from ``step`` on, the
     ranges widen to the stage's (empty: the initial ranges throughout)."""
@@ -241,6 +253,12 @@ class PolicyMetadata:
             )
         if t.physics_dt <= 0.0 or t.decimation < 1 or not math.isclose(t.policy_dt, t.physics_dt * t.decimation):
             raise PolicyMetadataError(f"timing {t}: need physics_dt > 0, decimation >= 1, policy_dt = their product.")
+        c = self.command
+        if c.yaw_command not in YAW_COMMANDS or not c.heading_stiffness >= 0.0:
+            raise PolicyMetadataError(
+                f"command: yaw_command {c.yaw_command!r} (need one of {list(YAW_COMMANDS)}), heading_stiffness "
+                f"{c.heading_stiffness} (need >= 0)."
+            )
 
     def to_dict(self) -> dict[str, Any]:
         """Return the JSON document (nested plain data)."""

@@ -3,7 +3,7 @@
 
 Everything but the joints and the per-term widths comes from the training task config, through the same factories
 that built the training env (:func:`make_g1_granular_env_cfg`, :func:`contact_model_cfg`): observation clip and
-scale, physics dt and decimation, command ranges and stages, contact model and foot collider, terrain, materials
+scale, physics dt and decimation, command ranges, stages and heading rule, contact model and foot collider, terrain, materials
 and robot randomization. Joints (order, kp/kd, default pose, action scale) come from the live env
 (:func:`policy_metadata_from_env`) or, for a file exported before, from its own older metadata; effort limits
 from mjlab's G1 actuator configs.
@@ -121,23 +121,31 @@ def _contact_spec(task: GranularTaskCfg) -> ContactSpec:
 
 
 def _command_spec(task: GranularTaskCfg, env_cfg: ManagerBasedRlEnvCfg) -> CommandSpec:
-    """The ``twist`` command's initial ranges, curriculum stages and meaning."""
+    """The ``twist`` command's initial ranges, curriculum stages, heading rule and meaning."""
     from gmloco.train.tasks.g1_granular.rewards_cfg import command_stages
 
     cmd = env_cfg.commands["twist"]
     r = cmd.ranges  # type: ignore[attr-defined]
-    heading = getattr(cmd, "heading_command", False)
-    how = (
-        f"omega_z = clip({cmd.heading_control_stiffness:g} * wrap(heading - yaw)) for the heading-commanded envs "  # type: ignore[attr-defined]
-        "in training; a runner may command omega_z directly"
-        if heading
-        else "omega_z commanded directly"
-    )
+    if task.yaw_command == "yaw_target":
+        k = float(task.heading_stiffness)
+        how = (
+            f"the observed omega_z is clip(omega_z + {k:g} * wrap(yaw_target - yaw), ang_vel_z range), where yaw_target "
+            "integrates the commanded omega_z every policy step and snaps to the heading at reset and when the error "
+            "passes pi/2; a runner applies the same correction"
+        )
+    else:
+        k = float(cmd.heading_control_stiffness)  # type: ignore[attr-defined]
+        how = (
+            f"omega_z = clip({k:g} * wrap(heading - yaw)) for the heading-commanded envs in training; a runner may "
+            "command omega_z directly"
+        )
     return CommandSpec(
         name="twist",
         lin_vel_x=list(r.lin_vel_x),
         lin_vel_y=list(r.lin_vel_y),
         ang_vel_z=list(r.ang_vel_z),
+        yaw_command=task.yaw_command,
+        heading_stiffness=k,
         stages=_plain(command_stages(task)) if task.command_curriculum else [],
         description=f"the 'command' term is (v_x [m/s], v_y [m/s], omega_z [rad/s]) in the base yaw frame; {how}",
     )

@@ -6,7 +6,8 @@ policy's ``train_cfg.json`` (the training task) and the file's version-1 entries
 action scale, term widths, history length, latent size, commit and run, all read from the live env at export),
 adds the G1 effort limits and everything the task determines, then rewrites ``policy.onnx`` (atomically, the
 version-1 entries removed) and ``policy.json``. A task field missing from ``train_cfg.json`` is refused unless
-``--set`` gives it (e.g. ``foot_faces=sole`` for runs trained before that field existed). Exit 2 on bad input.
+``--set`` gives it (e.g. ``foot_faces=sole`` or ``yaw_command=heading_envs`` for runs trained before that field
+existed; a value is read as JSON where it parses, else as a string). Exit 2 on bad input.
 """
 
 from __future__ import annotations
@@ -102,13 +103,21 @@ def upgrade_policy_dir(folder: Path, overrides: Mapping[str, Any] | None = None)
     return path
 
 
+def _value(text: str) -> Any:
+    """A ``--set`` value: JSON where it parses (``0.5``, ``[1, 2]``), else the text (``sole``)."""
+    try:
+        return json.loads(text)
+    except json.JSONDecodeError:
+        return text
+
+
 def main(argv: Sequence[str] | None = None) -> int:
     """Upgrade each given policy folder; return the exit code."""
     parser = argparse.ArgumentParser(description=(__doc__ or "").splitlines()[0])
     parser.add_argument("folders", nargs="+", type=Path, help="folders holding policy.onnx and train_cfg.json")
     parser.add_argument("--set", action="append", default=[], help="task field absent from train_cfg.json, key=value")
     args = parser.parse_args(argv)
-    overrides = dict(item.split("=", 1) for item in args.set)
+    overrides = {key: _value(text) for key, text in (item.split("=", 1) for item in args.set)}
     for folder in args.folders:
         try:
             print(upgrade_policy_dir(folder, overrides))
