@@ -28,8 +28,9 @@ class ChirpCfg:
     """Start frequency [Hz]."""
     f_end: float = 6.0
     """End frequency, reached at ``duration`` [Hz]."""
-    duration: float = 3.0
-    """Sweep length [s]; the sweep holds ``f_end`` after it."""
+    duration: float = 2.0
+    """Sweep length [s]; the sweep then starts again from ``f_start``, phase-continuous, so every stretch of a
+    long recording (and every held-out block of the analysis) sees high frequencies."""
     amplitude: float = 0.15
     """Hip, knee and ankle-pitch amplitude below ``f_knee`` [rad]; ankle roll and waist get ``small_amplitude``."""
     small_amplitude: float = 0.08
@@ -64,14 +65,15 @@ class ChirpMotion:
     def frequency(self, t: float) -> float:
         """Instantaneous sweep frequency [Hz] at time ``t`` [s]."""
         c = self.cfg
-        return c.f_start * (c.f_end / c.f_start) ** (min(t, c.duration) / c.duration)
+        return c.f_start * (c.f_end / c.f_start) ** ((t % c.duration) / c.duration)
 
     def _phase(self, t: float) -> float:
-        """Sweep phase [rad]: the integral of ``2 pi f`` (exponential sweep, then constant ``f_end``)."""
+        """Sweep phase [rad]: the integral of ``2 pi f`` over the completed sweeps and the current one."""
         c = self.cfg
         k = np.log(c.f_end / c.f_start) / c.duration
-        ts = min(t, c.duration)
-        return 2.0 * np.pi * (c.f_start * np.expm1(k * ts) / k + c.f_end * max(0.0, t - c.duration))
+        sweeps, ts = divmod(t, c.duration)
+        per_sweep = c.f_start * np.expm1(k * c.duration) / k
+        return 2.0 * np.pi * (sweeps * per_sweep + c.f_start * np.expm1(k * ts) / k)
 
     def targets(self, t: float, quat: np.ndarray, gyro: np.ndarray) -> np.ndarray:
         """Return joint position targets [rad], shape [29] (the IMU arguments are not used)."""
