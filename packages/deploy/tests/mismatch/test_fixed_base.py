@@ -134,3 +134,15 @@ def test_sample_logs_stay_free() -> None:
         rec = read_recording(path)
         assert rec.support == "free" and not rec.fixed_base
         assert not [i for i in check_recording(rec, raise_on_error=False) if i.check == "support"], path.name
+
+
+def test_welded_pose_follows_logged_odometry() -> None:
+    """With ``/odometry`` logged, the welded pelvis takes the logged orientation (the truth's tilted gantry pose)."""
+    rec, _ = generate(EpisodeCfg(duration=2.5, seed=7, support="fixed", odometry=True, chirp=ChirpCfg(duration=2.5)))
+    assert rec.base_quat is not None
+    rp = Replayer(rec)
+    starts = rp.segment_starts()[:5]
+    base = rp.base({}, starts)
+    assert base.source == "welded"
+    np.testing.assert_allclose(base.quat, rec.base_quat[starts], atol=1e-12)
+    assert not np.allclose(base.quat[0], [1.0, 0.0, 0.0, 0.0], atol=1e-4)  # the nuisance tilt is there
