@@ -45,7 +45,8 @@ class RunMetadata:
     control_rate_hz: float = 50.0
     """Nominal rate of the controller (command, policy and eta topics) [Hz]."""
     support: str = "none"
-    """External support of the robot: ``"none"``, ``"gantry"``, or the simulator's virtual harness with its gains."""
+    """External support of the robot: ``"none"``, ``"gantry"`` or ``"fixed"`` (pelvis held still; the mismatch replay
+    welds it), or the simulator's virtual harness with its gains."""
     created_utc: str = ""
     """ISO-8601 UTC creation time; empty for reproducible sample files."""
     notes: str = ""

@@ -19,9 +19,9 @@ from typing import Any
 import numpy as np
 
 from gmloco.deploy.mismatch.frames import quat_rotate
-from gmloco.deploy.mismatch.g1model import SOLE_POINTS
+from gmloco.deploy.mismatch.g1model import FIXED_BASE_HEIGHT, SOLE_POINTS
 
-__all__ = ["BaseEstCfg", "BaseTrajectory", "estimate_base", "odometry_base"]
+__all__ = ["BaseEstCfg", "BaseTrajectory", "estimate_base", "odometry_base", "welded_base"]
 
 
 @dataclass
@@ -53,7 +53,7 @@ class BaseTrajectory:
     foot_height: np.ndarray
     """Lowest sole-point height per foot (left, right) [m], shape [N, 2]."""
     source: str
-    """``"odometry"`` or ``"leg_odometry"``."""
+    """``"odometry"``, ``"leg_odometry"`` or ``"welded"`` (a gantry or fixed pelvis)."""
 
 
 def _foot_ids(model: Any) -> list[int]:
@@ -138,3 +138,22 @@ def odometry_base(
         fh,
         "odometry",
     )
+
+
+def welded_base(quat: np.ndarray) -> BaseTrajectory:
+    """Pose of a welded pelvis per segment: the mean of its orientation samples, at rest at ``FIXED_BASE_HEIGHT``.
+
+    A held pelvis touches nothing but its support, so its position does not enter the dynamics (uniform gravity);
+    only its orientation does (the direction of gravity in the pelvis frame).
+
+    Args:
+        quat: Pelvis orientation samples (w, x, y, z) over each segment, shape [S, W, 4].
+    """
+    q = np.asarray(quat, float)
+    q = q * np.where(np.sum(q * q[:, :1], axis=-1, keepdims=True) < 0.0, -1.0, 1.0)  # one hemisphere per row
+    mean = q.mean(axis=1)
+    mean /= np.linalg.norm(mean, axis=1, keepdims=True)
+    s = len(mean)
+    pos = np.zeros((s, 3))
+    pos[:, 2] = FIXED_BASE_HEIGHT
+    return BaseTrajectory(pos, mean, np.zeros((s, 3)), np.zeros((s, 3)), np.zeros((s, 2)), "welded")

@@ -6,6 +6,7 @@ from __future__ import annotations
 import argparse
 import json
 import sys
+from dataclasses import replace
 from pathlib import Path
 
 __all__ = ["main"]
@@ -34,12 +35,23 @@ def _parser() -> argparse.ArgumentParser:
         help="nominal ground: 'plane' (MuJoCo soft contact) or 'sand[:MATERIAL]' (the project's 3D-RFT sand, "
         "default material dry_sand; gmloco.contact.MATERIAL_PRESETS)",
     )
+    p.add_argument(
+        "--support",
+        choices=("free", "gantry", "fixed"),
+        default=None,
+        help="how the pelvis was held, overriding the run metadata's 'support': free (on its own feet) or gantry / "
+        "fixed (pelvis welded in place, only the joints move)",
+    )
     p.add_argument("--no-plots", action="store_true", help="skip matplotlib plots")
     return p
 
 
 def main(argv: list[str] | None = None) -> int:
-    """Run the analysis; exit code 0 for a report (any verdict), 2 for unreadable input."""
+    """Run the analysis; exit code 0 for a report on valid input, 2 for unreadable or invalid input.
+
+    Every contract finding is printed; an ``invalid_input`` verdict (any contract error) still writes its report,
+    which says what is wrong, and exits with 2.
+    """
     from rich.console import Console
     from rich.markup import escape
     from rich.progress import Progress
@@ -66,7 +78,13 @@ def main(argv: list[str] | None = None) -> int:
         console.print(
             "[yellow]--sim given: the simulated log is checked for its contract only; residuals come from replay at the real states (short horizons), which a free-running sim log cannot provide."
         )
-        read_recording(args.sim)
+        try:
+            read_recording(args.sim)
+        except (OSError, ValueError) as exc:
+            console.print(f"[red]cannot read {args.sim}: {exc}")
+            return 2
+    if args.support is not None:
+        rec = replace(rec, support=args.support)
     try:  # the physics step and the time spans follow the recording's rate (MPM recordings are 50 Hz, a G1 500 Hz)
         ground, material = parse_ground(args.ground)
         replay = replay_cfg_for_rate(1.0 / rec.dt, ground, material, args.horizon)
@@ -80,9 +98,12 @@ def main(argv: list[str] | None = None) -> int:
         res = analyze(rec, cfg, lambda msg, f: prog.update(task, completed=f, description=msg))
     write_report(res, args.out, plots=not args.no_plots)
     r = res.report
+    for issue in r.get("contract", []):
+        colour = "red" if issue["severity"] == "error" else "yellow"
+        console.print(f"[{colour}]contract {issue['severity']} [{issue['check']}]: {issue['message']}")
     console.print(f"verdict: [bold]{r['verdict']}[/bold]" + (f", winner {r['winner']}" if r.get("winner") else ""))
     print(json.dumps({"verdict": r["verdict"], "winner": r.get("winner"), "report": str(args.out / "report.json")}))
-    return 0
+    return 2 if r["verdict"] == "invalid_input" else 0
 
 
 if __name__ == "__main__":

@@ -1,5 +1,10 @@
 # SPDX-License-Identifier: Apache-2.0
-"""Data-contract checks: joint map, units, time base, gaps. Failures are reported as such, never as physics."""
+"""Data-contract checks: joint map, units, time base, gaps, support. Failures are reported as such, never as physics.
+
+Severity ``error`` is a contract doubt: the analysis stops with the verdict ``invalid_input`` (exit code 2 from
+the command line). Severity ``warning`` is a condition the analysis handles and states (gap-filled samples
+skipped, a missing or derived channel left out of the residual).
+"""
 
 from __future__ import annotations
 
@@ -13,7 +18,15 @@ import numpy as np
 from gmloco.deploy.mismatch.frames import quat_conj, quat_mul, quat_to_mat
 from gmloco.deploy.mismatch.recording import Recording
 
-__all__ = ["ContractCfg", "ContractError", "ContractIssue", "JointMapError", "check_recording", "joint_ranges"]
+__all__ = [
+    "ContractCfg",
+    "ContractError",
+    "ContractIssue",
+    "JointMapError",
+    "base_motion",
+    "check_recording",
+    "joint_ranges",
+]
 
 
 @dataclass
@@ -21,7 +34,7 @@ class ContractIssue:
     """One finding of a contract check."""
 
     check: str
-    """Check name (``joint_map``, ``units``, ``time_base``, ``gaps``, ``channels``, ``length``)."""
+    """Check name (``joint_map``, ``units``, ``time_base``, ``gaps``, ``channels``, ``length``, ``support``)."""
     severity: Literal["error", "warning"]
     """Errors stop the analysis; warnings are reported."""
     message: str
@@ -76,6 +89,21 @@ class ContractCfg:
     quat_rate_ratio: float = 3.0
     """One reading decides on the rate test when its gyro misfit is this many times smaller than the other's and
     below half the gyro activity [-]."""
+    motion_window: float = 0.02
+    """Moving-average window of the joint velocities and the IMU before the support check (removes sensor
+    noise) [s]."""
+    legs_active: float = 2.0
+    """RMS leg and waist joint acceleration above which the legs move enough to test the support [rad/s^2]."""
+    still_acc_per_joint_acc: float = 0.02
+    """A free pelvis whose legs accelerate is shaken by them: the IMU is still when its specific force varies
+    less than this per unit of joint acceleration (RMS) [m/rad]. Free G1 recordings (standing with arm motion,
+    stepping, walking, the policy on sand) show 0.24-0.59; a pelvis held while the legs chirp 0.001."""
+    still_gyro: float = 0.05
+    """... and when its gyro varies less than this (RMS about the median) [rad/s]."""
+    moving_gyro: float = 0.05
+    """A held pelvis moves when the gyro varies more than this (RMS about the median) [rad/s]."""
+    moving_acc: float = 0.3
+    """... or when the specific force varies more than this (RMS about the median) [m/s^2]."""
 
 
 @lru_cache(maxsize=1)
@@ -374,6 +402,66 @@ def _channels(rec: Recording) -> list[ContractIssue]:
     return issues
 
 
+def _moving_average(x: np.ndarray, w: int) -> np.ndarray:
+    """Moving average over ``w`` samples ('valid' part), shape [N - w + 1, C]."""
+    c = np.concatenate([np.zeros((1, x.shape[1])), np.cumsum(x, axis=0)])
+    return (c[w:] - c[:-w]) / w
+
+
+def base_motion(rec: Recording, cfg: ContractCfg) -> dict[str, float]:
+    """How much the pelvis and the legs move: RMS variations of the smoothed IMU, and of the joint accelerations.
+
+    Returns:
+        ``acc_rms`` [m/s^2] and ``gyro_rms`` [rad/s] about their medians, and ``joint_acc_rms`` [rad/s^2] of the
+        legs and waist (central difference of the smoothed joint velocities).
+    """
+    w = int(max(1, min(rec.n // 4, round(cfg.motion_window / rec.dt))))
+    acc, gyro = _moving_average(rec.imu_acc, w), _moving_average(rec.imu_gyro, w)
+    dq = _moving_average(rec.dq[:, :15], w)
+    qdd = (dq[2 * w :] - dq[: -2 * w]) / (2 * w * rec.dt) if len(dq) > 2 * w else np.zeros((1, 15))
+    dev = lambda x: float(np.sqrt(np.mean(np.sum((x - np.median(x, axis=0)) ** 2, axis=1))))  # noqa: E731
+    return {"acc_rms": dev(acc), "gyro_rms": dev(gyro), "joint_acc_rms": float(np.sqrt(np.mean(qdd**2)))}
+
+
+def _support(rec: Recording, cfg: ContractCfg) -> list[ContractIssue]:
+    """The support the replay will simulate against what the IMU says about the pelvis.
+
+    A free pelvis is shaken by legs that accelerate, whether the feet stand on the ground or swing; an IMU that
+    stays still meanwhile says the pelvis is held, and a free replay would let it fall. A held pelvis (gantry,
+    fixed) must not move. A recording whose legs barely move tests nothing here: a robot standing still on its
+    feet and one hanging still look alike to the IMU.
+    """
+    m = base_motion(rec, cfg)
+    detail = {k: round(v, 4) for k, v in m.items()} | {"support": rec.support}
+    if rec.support == "free":
+        still = m["acc_rms"] < cfg.still_acc_per_joint_acc * m["joint_acc_rms"] and m["gyro_rms"] < cfg.still_gyro
+        if m["joint_acc_rms"] > cfg.legs_active and still:
+            return [
+                ContractIssue(
+                    "support",
+                    "error",
+                    f"support is 'free' but the IMU says the pelvis is still (specific force varies "
+                    f"{m['acc_rms']:.3f} m/s^2 RMS, gyro {m['gyro_rms']:.4f} rad/s) while the leg and waist joints "
+                    f"accelerate at {m['joint_acc_rms']:.1f} rad/s^2 RMS: the pelvis was held, and a free replay "
+                    "would let the simulated robot fall. Write support='gantry' (or 'fixed') in the run metadata, "
+                    "or pass --support gantry",
+                    detail,
+                )
+            ]
+    elif m["gyro_rms"] > cfg.moving_gyro or m["acc_rms"] > cfg.moving_acc:
+        return [
+            ContractIssue(
+                "support",
+                "error",
+                f"support is '{rec.support}' but the IMU says the pelvis moves (gyro varies {m['gyro_rms']:.3f} "
+                f"rad/s RMS, specific force {m['acc_rms']:.2f} m/s^2): a welded replay would hold it still. Write "
+                "support='none' in the run metadata for a robot on its own feet, or pass --support free",
+                detail,
+            )
+        ]
+    return []
+
+
 def check_recording(rec: Recording, cfg: ContractCfg | None = None, raise_on_error: bool = True) -> list[ContractIssue]:
     """Run every contract check.
 
@@ -385,6 +473,8 @@ def check_recording(rec: Recording, cfg: ContractCfg | None = None, raise_on_err
     issues = _channels(rec)
     if not any(i.severity == "error" for i in issues):
         issues += _time_base(rec, cfg) + _units(rec, cfg) + _joint_map(rec, cfg)
+    if not any(i.severity == "error" for i in issues):
+        issues += _support(rec, cfg)
     errors = [i for i in issues if i.severity == "error"]
     if raise_on_error and errors:
         cls = JointMapError if any(i.check == "joint_map" for i in errors) else ContractError

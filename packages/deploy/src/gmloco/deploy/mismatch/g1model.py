@@ -21,6 +21,7 @@ from gmloco.deploy.logs.g1 import G1_JOINT_NAMES
 from gmloco.deploy.mismatch.sand import SandCfg
 
 __all__ = [
+    "FIXED_BASE_HEIGHT",
     "G1_ARMATURE",
     "G1_EFFORT_LIMIT",
     "SOLE_POINTS",
@@ -92,6 +93,14 @@ class G1SimCfg:
     have no MuJoCo contact; the replay applies the sand forces, :mod:`gmloco.deploy.mismatch.sand`)."""
     sand: SandCfg = field(default_factory=SandCfg)
     """Sand medium and RFT settings (``ground="sand"``)."""
+    fixed_base: bool = False
+    """Weld the pelvis to the world (a gantry or a stand): the floating-base joint is removed, so ``qpos`` and
+    ``qvel`` hold the 29 joints only, the pelvis hangs at ``FIXED_BASE_HEIGHT`` (its pose is
+    ``model.body_pos`` / ``body_quat`` of the pelvis, settable between steps) and the feet touch nothing."""
+
+
+FIXED_BASE_HEIGHT = 1.5
+"""Pelvis height of a fixed-base model [m]: the extended legs (0.75 m) clear the floor with any tilt."""
 
 
 def build_model(cfg: G1SimCfg | None = None, spec_edit: Any = None) -> Any:
@@ -113,7 +122,7 @@ def build_model(cfg: G1SimCfg | None = None, spec_edit: Any = None) -> Any:
     for g in spec.geoms:
         if g.name.endswith("_collision"):
             foot = "_foot" in g.name
-            g.contype = 1 if foot and cfg.ground == "plane" else 0
+            g.contype = 1 if foot and cfg.ground == "plane" and not cfg.fixed_base else 0
             g.conaffinity = 0  # feet collide with the floor only, never with each other
             if foot:
                 g.condim = 3
@@ -123,10 +132,13 @@ def build_model(cfg: G1SimCfg | None = None, spec_edit: Any = None) -> Any:
     for j in spec.joints:
         if j.name in G1_JOINT_NAMES:
             j.armature = _MOTORS[_motor(j.name)][0]
+    if cfg.fixed_base:
+        spec.delete(spec.joint("floating_base_joint"))
+        spec.body("pelvis").pos = [0.0, 0.0, FIXED_BASE_HEIGHT]
     if spec_edit is not None:
         spec_edit(spec)
     model = spec.compile()
-    names = tuple(model.joint(i).name for i in range(1, model.njnt))
+    names = tuple(model.joint(i).name for i in range(0 if cfg.fixed_base else 1, model.njnt))
     if names != G1_JOINT_NAMES:
         raise RuntimeError(f"MJCF joint order {names} differs from G1_JOINT_NAMES")
     return model

@@ -8,7 +8,7 @@ from typing import Any
 
 import numpy as np
 
-from gmloco.deploy.mismatch.recording import Recording
+from gmloco.deploy.mismatch.recording import Recording, support_from_label
 
 __all__ = ["read_recording", "write_recording"]
 
@@ -44,10 +44,14 @@ def read_recording(path: str | Path, rate_hz: float | None = None) -> Recording:
     Args:
         path: MCAP file in the project schema (``packages/deploy/SCHEMA.md``).
         rate_hz: Grid rate [Hz]; the metadata's ``lowstate_rate_hz`` by default.
+
+    Raises:
+        ValueError: an unknown ``support`` label, besides the reader's own errors.
     """
     from gmloco.deploy.logs.reader import read_log
 
     log = read_log(path)
+    support = support_from_label(log.metadata.support)
     rate = rate_hz or float(log.metadata.lowstate_rate_hz)
     ts, q = log.signal("lowstate.q")
     t = np.arange(ts[0], ts[-1] + 0.5 / rate, 1.0 / rate)
@@ -88,15 +92,25 @@ def read_recording(path: str | Path, rate_hz: float | None = None) -> Recording:
         base_quat=base_quat,
         base_linvel=base_linvel,
         base_angvel=base_angvel,
+        support=support,
     )
 
 
 def write_recording(rec: Recording, path: str | Path, controller: str = "unknown", overwrite: bool = False) -> Path:
-    """Write a :class:`Recording` as a G1 MCAP log (``gmloco.deploy.logs.G1LogWriter``); invalid samples are dropped."""
+    """Write a :class:`Recording` as a G1 MCAP log (``gmloco.deploy.logs.G1LogWriter``); invalid samples are dropped.
+
+    The metadata's ``support`` is ``none`` for a free base, else the recording's ``gantry`` or ``fixed``.
+    """
     from gmloco.deploy.logs.metadata import RunMetadata
     from gmloco.deploy.logs.writer import G1LogWriter, LogWriterCfg
 
-    meta = RunMetadata(controller=controller, source="real", contact_model="hardware", lowstate_rate_hz=1.0 / rec.dt)
+    meta = RunMetadata(
+        controller=controller,
+        source="real",
+        contact_model="hardware",
+        lowstate_rate_hz=1.0 / rec.dt,
+        support="none" if rec.support == "free" else rec.support,
+    )
     valid = rec.valid_mask()
     odom = rec.odometry()
     with G1LogWriter(path, meta, LogWriterCfg(overwrite=overwrite)) as w:

@@ -1,7 +1,8 @@
 # SPDX-License-Identifier: Apache-2.0
 """Localisation: which signal, joint, gait phase and time window differ beyond the noise floor.
 
-Cells are (signal, joint or axis, phase of the joint's own foot; left foot for trunk/arm/IMU channels). A cell's
+Cells are (signal, joint or axis, phase of the joint's own foot; left foot for trunk/arm/IMU channels; for a held
+pelvis, the joint's own motion label and the busiest joint's for IMU channels, ``segmentation.motion_phases``). A cell's
 statistic is its mean normalised residual energy (1 at the floor); its p-value treats
 ``energy * n_eff_cell`` as chi-square with ``n_eff_cell`` degrees of freedom, where ``n_eff_cell`` scales the
 cell's sample count by the recording's ``n_eff / n``. Benjamini-Hochberg controls the false-discovery rate
@@ -42,26 +43,33 @@ def localize(
     window_s: float = 1.0,
     q_max: float = 0.01,
     min_ratio: float = 1.5,
+    labels: tuple[str, ...] = PHASES,
+    columns: np.ndarray | None = None,
 ) -> dict:
     """Return flagged cells and time windows plus the full signal x phase energy table.
 
     Args:
         r: Normalised residuals, shape [S, P, C].
         names: Channel names ``signal:joint``, length C.
-        phases: Phase codes at the compare points, shape [S, P, 2].
+        phases: Phase codes (indices into ``labels``) at the compare points, shape [S, P, K].
         times: Compare-point times [s], shape [S, P].
         n_ratio: ``n_eff / n`` of the recording.
         window_s: Time-window length [s].
+        q_max: Largest FDR q-value of a flagged cell or window.
+        min_ratio: Smallest energy ratio of a flagged cell or window.
+        labels: Phase names; the foot phases :data:`PHASES` by default.
+        columns: Column of ``phases`` that labels each channel, shape [C]; by default the channel's foot
+            (0 left, 1 right).
         q_max: FDR level.
         min_ratio: Smallest energy ratio reported as a mismatch.
     """
     from scipy.stats import chi2
 
-    foot = _foot_of_channel(names)
+    foot = _foot_of_channel(names) if columns is None else columns
     cells, table = [], {}
     for c, name in enumerate(names):
         ph = phases[:, :, foot[c]]
-        for k, pname in enumerate(PHASES):
+        for k, pname in enumerate(labels):
             m = ph == k
             if m.sum() < 5:
                 continue

@@ -15,8 +15,14 @@ from gmloco.deploy.mismatch.effects import EFFECTS, check_effect_ids
 from gmloco.deploy.mismatch.localize import localize
 from gmloco.deploy.mismatch.problem import FloorCfg, Problem, effective_samples
 from gmloco.deploy.mismatch.recording import Recording
-from gmloco.deploy.mismatch.replay import ReplayCfg, Replayer, channel_names
-from gmloco.deploy.mismatch.segmentation import SegmentationCfg, segment_phases
+from gmloco.deploy.mismatch.replay import N_CHANNELS, ReplayCfg, Replayer, channel_names
+from gmloco.deploy.mismatch.segmentation import (
+    MOTION_PHASES,
+    PHASES,
+    SegmentationCfg,
+    motion_phases,
+    segment_phases,
+)
 
 __all__ = ["AnalysisCfg", "AnalysisResult", "analyze"]
 
@@ -71,6 +77,23 @@ def _mirror_error(rec: Recording, cfg: AnalysisCfg) -> ContractIssue | None:
             {"energy_as_labelled": e[0], "energy_swapped": e[1]},
         )
     return None
+
+
+def _phases(
+    rec: Recording, rp: Replayer, cfg: SegmentationCfg
+) -> tuple[np.ndarray, tuple[str, ...], np.ndarray | None]:
+    """Phase codes per sample [N, K], their labels, and the phase column of each output channel.
+
+    A free robot gets foot phases (swing, touchdown, stance, liftoff; ``columns`` None: the channel's foot). A held
+    robot touches nothing: each joint channel gets its joint's motion label (hold, low_freq, high_freq) and the IMU
+    channels that of the busiest leg or waist joint (column 29).
+    """
+    if not rec.fixed_base:
+        return segment_phases(rp.base({}, np.arange(rec.n)).foot_height, rec.dt, cfg), PHASES, None
+    per_joint = motion_phases(rec.q_cmd, rec.dt, cfg)
+    codes = np.concatenate([per_joint, per_joint[:, :15].max(axis=1, keepdims=True)], axis=1)
+    columns = np.concatenate([np.tile(np.arange(29), 3), np.full(N_CHANNELS - 87, 29)])
+    return codes, MOTION_PHASES, columns
 
 
 def _invalid(issues: list[ContractIssue], rec: Recording | None, t0: float) -> AnalysisResult:
@@ -141,11 +164,10 @@ def analyze(
         ranked = sorted(ranked + extra, key=lambda h: (not h.passed, -h.heldout_gain))
         decision = decide(pb, r0, ranked, cfg.attribution)
     say("localisation", 0.9)
-    base_all = rp.base({}, np.arange(rec.n))
-    phases_all = segment_phases(base_all.foot_height, rec.dt, cfg.segmentation)
+    phases_all, labels, columns = _phases(rec, rp, cfg.segmentation)
     idx = pb.starts[:, None] + rp.offsets[None, :]
     names = channel_names(rec.joint_names)
-    loc = localize(r0, names, phases_all[idx], rec.t[idx], n_eff / r0[pb.train].size)
+    loc = localize(r0, names, phases_all[idx], rec.t[idx], n_eff / r0[pb.train].size, labels=labels, columns=columns)
     winner = next((h for h in ranked if h.spec.id == decision["winner"]), None)
     # confirm() sets theta on every ranked hypothesis, so a winner always has a fit.
     params = {winner.spec.id: winner.theta} if winner is not None and winner.theta is not None else {}
@@ -161,6 +183,7 @@ def analyze(
         "names": names,
         "times": rec.t[idx],
         "phases": phases_all[idx],
+        "phase_labels": labels,
         "winner": winner,
         "table": loc["table"],
         "held": pb.held,

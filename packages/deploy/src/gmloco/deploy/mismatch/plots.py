@@ -24,10 +24,11 @@ def make_plots(result: Any, out: Path) -> list[Path]:
     names = a["names"]
     # 1. signal x phase heat map of the nominal residual energy (1 = noise floor)
     keys = sorted({n for n, _ in a["table"]}, key=names.index)[:58]
-    mat = np.array([[a["table"].get((n, p), np.nan) for p in PHASES] for n in keys])
+    labels = a.get("phase_labels", PHASES)
+    mat = np.array([[a["table"].get((n, p), np.nan) for p in labels] for n in keys])
     fig, ax = plt.subplots(figsize=(5, 10))
     im = ax.imshow(np.log10(mat), aspect="auto", cmap="magma")
-    ax.set_xticks(range(len(PHASES)), PHASES)
+    ax.set_xticks(range(len(labels)), labels)
     ax.set_yticks(range(len(keys)), keys, fontsize=5)
     fig.colorbar(im, label="log10 residual energy / floor")
     paths.append(_save(fig, out / "heatmap.png"))

@@ -9,12 +9,43 @@ logs package's reader) or directly from arrays (tests, benchmark generator).
 from __future__ import annotations
 
 from dataclasses import dataclass, field, replace
+from typing import Literal
 
 import numpy as np
 
 from gmloco.deploy.logs.g1 import G1_JOINT_NAMES
 
-__all__ = ["Recording"]
+__all__ = ["SUPPORTS", "Recording", "Support", "support_from_label"]
+
+Support = Literal["free", "gantry", "fixed"]
+"""How the pelvis is held: ``free`` (a floating base on its own feet), ``gantry`` (hanging from a rigid gantry)
+or ``fixed`` (bolted to a stand). Gantry and fixed are the same to the replay: the pelvis does not move."""
+
+SUPPORTS: tuple[str, ...] = ("free", "gantry", "fixed")
+"""Every :data:`Support` value."""
+
+
+def support_from_label(label: str) -> Support:
+    """Map the run metadata's ``support`` label (``packages/deploy/SCHEMA.md``) to a :data:`Support`.
+
+    ``none`` (or empty) is a free base; the simulator's ``virtual_gantry(...)`` is a roll/pitch spring on a robot
+    that stands on its own feet, so it is a free base too.
+
+    Raises:
+        ValueError: an unknown label (a typo must not silently become a free base).
+    """
+    s = label.strip().lower()
+    if s in ("", "none", "free"):
+        return "free"
+    if s in ("gantry", "fixed"):
+        return "gantry" if s == "gantry" else "fixed"
+    if s.startswith("virtual_gantry("):
+        return "free"
+    raise ValueError(
+        f"run metadata support={label!r} is not one of none, free, gantry, fixed or virtual_gantry(...): say how "
+        "the pelvis was held (gantry or fixed: pelvis does not move; none: the robot stands on its own feet), or "
+        "override it with gmloco-mismatch --support"
+    )
 
 
 @dataclass
@@ -59,6 +90,13 @@ class Recording:
     """Joint order of every per-joint array."""
     meta: dict[str, str] = field(default_factory=dict)
     """Free-form metadata (source file, controller, material)."""
+    support: Support = "free"
+    """How the pelvis is held (run metadata ``support``); the replay welds a gantry or fixed pelvis in place."""
+
+    @property
+    def fixed_base(self) -> bool:
+        """Whether the pelvis is held in place (``support`` is ``gantry`` or ``fixed``)."""
+        return self.support != "free"
 
     @property
     def n(self) -> int:

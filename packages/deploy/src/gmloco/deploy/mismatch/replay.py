@@ -5,7 +5,9 @@ For every segment start ``k0`` the simulator is reset to the *real* state at ``k
 from odometry or leg odometry, :mod:`gmloco.deploy.mismatch.baseest`), the *logged* LowCmd is applied through
 the motor PD law for ``horizon`` samples, and the simulated measurements are compared with the logged ones
 (R1 short-horizon output error, ``shared/reference/mismatch-discovery.md`` section 3.2). Short horizons keep a
-closed-loop policy or a fall from hiding the local signature. Every candidate effect is applied here (actuator,
+closed-loop policy or a fall from hiding the local signature. A recording whose pelvis is held (``support`` gantry
+or fixed) is replayed with the pelvis welded to its logged orientation: only the joints move, and the simulated
+gyro and accelerometer are those of a pelvis at rest. Every candidate effect is applied here (actuator,
 sensor, model edits) or in :mod:`gmloco.deploy.mismatch.terrain`, and all are exactly nominal at zero.
 """
 
@@ -16,7 +18,7 @@ from typing import Any
 
 import numpy as np
 
-from gmloco.deploy.mismatch.baseest import BaseEstCfg, BaseTrajectory, estimate_base, odometry_base
+from gmloco.deploy.mismatch.baseest import BaseEstCfg, BaseTrajectory, estimate_base, odometry_base, welded_base
 from gmloco.deploy.mismatch.effects import EFFECTS, effect
 from gmloco.deploy.mismatch.frames import quat_conj, quat_from_roll_pitch, quat_mul, quat_to_mat
 from gmloco.deploy.mismatch.g1model import G1_ARMATURE, G1_EFFORT_LIMIT, SOLE_POINTS, G1SimCfg, build_model
@@ -236,6 +238,8 @@ class _Seg:
     """Motor torque of the current step [N*m]."""
     w_imu: np.ndarray = field(default_factory=lambda: np.zeros(3))
     """Pelvis angular velocity at the last compare point [rad/s]."""
+    pelvis_quat: np.ndarray | None = None
+    """Orientation (w, x, y, z) of a welded pelvis; ``None`` for a floating base."""
 
 
 class Replayer:
@@ -245,12 +249,20 @@ class Replayer:
         """Build the nominal model and cache what every replay needs."""
         import mujoco
 
-        self.cfg = cfg or ReplayCfg()
+        cfg = cfg or ReplayCfg()
+        self.fixed = rec.fixed_base
+        """Whether the pelvis is welded (the recording's ``support`` is gantry or fixed)."""
+        if self.fixed:  # a held robot touches nothing: the ground, plane or sand, plays no part
+            cfg = replace(cfg, sim=replace(cfg.sim, fixed_base=True, ground="plane"))
+        self.cfg = cfg
         self.rec = rec
         self.model = build_model(self.cfg.sim)
+        self._jq = slice(0 if self.fixed else 7, None)  # joint coordinates in qpos
+        self._jv = slice(0 if self.fixed else 6, None)  # joint dofs in qvel and the dof_* arrays
         self.data = mujoco.MjData(self.model)
         m = self.model
         self._torso = m.body("torso_link").id
+        self._pelvis = m.body("pelvis").id
         self._mass0 = float(m.body_mass[self._torso])
         self._inertia0 = m.body_inertia[self._torso].copy()
         self._feet = [m.body(f"{s}_ankle_roll_link").id for s in ("left", "right")]
@@ -337,6 +349,11 @@ class Replayer:
     def _estimate(self, h: _Hyp, starts: np.ndarray) -> BaseTrajectory:
         """Run the base estimator (or wrap odometry) at ``starts``."""
         r = self.rec
+        if self.fixed:
+            qm = quat_from_roll_pitch(float(h.mis[0]), float(h.mis[1]))
+            src = r.base_quat if r.base_quat is not None else quat_mul(r.imu_quat, quat_conj(qm))
+            win = np.clip(starts[:, None] + np.arange(self.cfg.horizon + 1)[None, :], 0, r.n - 1)
+            return welded_base(src[win])
         q_true = r.q[starts] - h.offset
         odom = r.odometry()
         if odom is not None:
@@ -407,8 +424,8 @@ class Replayer:
         import mujoco
 
         m = self.model
-        m.dof_armature[6:] = G1_ARMATURE * (1.0 + h.arm_scale)
-        m.dof_frictionloss[6:] = h.tau_c * self._w
+        m.dof_armature[self._jv] = G1_ARMATURE * (1.0 + h.arm_scale)
+        m.dof_frictionloss[self._jv] = h.tau_c * self._w
         m.body_mass[self._torso] = self._mass0 + h.dmass
         m.body_inertia[self._torso] = self._inertia0 * (self._mass0 + h.dmass) / self._mass0
         mujoco.mj_setConst(m, self.data)
@@ -466,14 +483,15 @@ class Replayer:
 
         m, r = self.model, self.rec
         mujoco.mj_resetData(m, d)
-        d.qpos[2] = base.pos[s, 2]
-        d.qpos[3:7] = base.quat[s]
-        d.qpos[7:] = r.q[k0] - h.offset
-        d.qvel[:3] = base.linvel[s]
-        d.qvel[3:6] = base.angvel[s]
-        d.qvel[6:] = r.dq[k0]
+        if not self.fixed:
+            d.qpos[2] = base.pos[s, 2]
+            d.qpos[3:7] = base.quat[s]
+            d.qvel[:3] = base.linvel[s]
+            d.qvel[3:6] = base.angvel[s]
+        d.qpos[self._jq] = r.q[k0] - h.offset
+        d.qvel[self._jv] = r.dq[k0]
         qc, dqc, tff = self._commands(k0, h.delay)
-        return _Seg(d, k0, qc, dqc, tff)
+        return _Seg(d, k0, qc, dqc, tff, pelvis_quat=base.quat[s] if self.fixed else None)
 
     def _seg_pre(self, h: _Hyp, seg: _Seg, j: int, at_compare: bool) -> None:
         """First half of a physics step of one segment: kinematics, motor torques (PD on the encoders)."""
@@ -483,38 +501,46 @@ class Replayer:
         k = seg.k0 + j
         kp, kd = r.kp[k], r.kd[k]
         # Damping enters qfrc_passive in mj_step1 and the implicit Euler update in mj_step2: set it first.
-        m.dof_damping[6:] = h.gain * kd + h.b * self._w
+        m.dof_damping[self._jv] = h.gain * kd + h.b * self._w
+        if seg.pelvis_quat is not None:  # segments share the model: put this segment's welded pelvis in place
+            m.body_quat[self._pelvis] = seg.pelvis_quat
         mujoco.mj_step1(m, d)
-        if at_compare:
+        if at_compare and not self.fixed:
             seg.w_imu = d.qvel[3:6].copy()  # angular velocity the gyro sensor saw
-        seg.qm = d.qpos[7:] + h.offset
-        v = d.qvel[6:]
+        seg.qm = d.qpos[self._jq] + h.offset
+        v = d.qvel[self._jv]
         tau = h.gain * (kp * (seg.qc[j] - seg.qm) + kd * (seg.dqc[j] - v)) + seg.tff[j]
         lim = G1_EFFORT_LIMIT if h.droop == 0.0 else G1_EFFORT_LIMIT * np.clip(1.0 - h.droop * np.abs(v), 0.0, None)
         seg.tau = np.clip(tau, -lim, lim)
         # The -kd*dq part is integrated implicitly through dof_damping (Euler integrator), so add it back.
-        d.qfrc_applied[6:] = seg.tau + h.gain * kd * v
+        d.qfrc_applied[self._jv] = seg.tau + h.gain * kd * v
 
     def _seg_post(self, h: _Hyp, seg: _Seg, j: int, out: np.ndarray | None) -> None:
         """Second half of the physics step; write the simulated measurements into ``out`` [N_CHANNELS] if given."""
         import mujoco
 
         m, d = self.model, seg.d
-        m.dof_damping[6:] = h.gain * self.rec.kd[seg.k0 + j] + h.b * self._w
+        m.dof_damping[self._jv] = h.gain * self.rec.kd[seg.k0 + j] + h.b * self._w
         mujoco.mj_step2(m, d)
         if out is None:
             return
         rmis_t = h.rmis_t
         out[:29] = seg.qm
-        out[29:58] = d.qvel[6:]
+        out[29:58] = d.qvel[self._jv]
         out[58:87] = seg.tau
-        out[87:90] = rmis_t @ d.sensordata[0:3] + h.gyro_bias
-        out[90:93] = rmis_t @ d.sensordata[6:9]
+        if seg.pelvis_quat is None:
+            gyro, acc = d.sensordata[0:3], d.sensordata[6:9]
+        else:  # MuJoCo computes no sensor on a world-welded body: a pelvis at rest senses -gravity, no rotation
+            gyro, acc = np.zeros(3), d.xmat[self._pelvis].reshape(3, 3).T @ -m.opt.gravity
+        out[87:90] = rmis_t @ gyro + h.gyro_bias
+        out[90:93] = rmis_t @ acc
         # simulated gyro output minus the simulated IMU frame's own angular velocity
         out[93:96] = out[87:90] - rmis_t @ seg.w_imu
 
     def _ground(self, h: _Hyp, datas: list, reset: bool) -> None:
         """Write the ground wrench (sand forces, or terrain effects on the plane) into each ``xfrc_applied``."""
+        if self.fixed:  # a held robot touches nothing
+            return
         if self.sand is not None:
             self._sand_wrench(h.terrain, datas, reset)
         elif h.terrain.active():

@@ -8,7 +8,8 @@
 * ``nearest``: when ``unexplained``, the best passing library effect that nonetheless left a held-out residual
   above the floor (it absorbs part of an out-of-library effect), else null.
 * ``contract``: list of ``{check, severity, message, detail}`` (joint map, units, time base, gaps, length).
-* ``recording``: ``{duration_s, rate_hz, base_state: odometry|leg_odometry, segments, n_eff}``.
+* ``recording``: ``{duration_s, rate_hz, support: free|gantry|fixed, base_state: odometry|leg_odometry|welded,
+  segments, n_eff}``.
 * ``noise_floor``: ``{source, per_signal: {q, dq, tau_est, gyro, acc}}`` (median sigma per signal, SI units).
 * ``mismatch``: ``{nominal_energy_ratio, residual_ratio, explained_fraction, cells: [...], windows: [...]}``
   (``residual_ratio``: held-out residual energy per element left by the best passing effect, floor = 1); a cell is
@@ -143,7 +144,8 @@ def build_report(
         "recording": {
             "duration_s": float(rec.t[-1] - rec.t[0]),
             "rate_hz": 1.0 / rec.dt,
-            "base_state": "odometry" if rec.has_odometry else "leg_odometry",
+            "support": rec.support,
+            "base_state": "welded" if rec.fixed_base else "odometry" if rec.has_odometry else "leg_odometry",
             "segments": len(pb.starts),
             "heldout_segments": int(pb.held.sum()),
             "n_eff": n_eff,

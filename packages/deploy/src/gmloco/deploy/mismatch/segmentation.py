@@ -6,6 +6,9 @@ A foot is in stance while its lowest sole point is within ``stance_height`` of t
 samples are labelled ``swing``, ``touchdown`` (first ``td_window`` of stance), ``liftoff`` (last
 ``lo_window`` of stance) or ``stance``. Sinkage on sand biases height-based detection; the hysteresis band
 absorbs a few millimetres of it.
+
+A held pelvis (``support`` gantry or fixed) touches nothing, so contact phases mean nothing there:
+:func:`motion_phases` labels each joint by its commanded motion instead (``hold``, ``low_freq``, ``high_freq``).
 """
 
 from __future__ import annotations
@@ -14,10 +17,12 @@ from dataclasses import dataclass
 
 import numpy as np
 
-__all__ = ["PHASES", "SegmentationCfg", "segment_phases"]
+__all__ = ["MOTION_PHASES", "PHASES", "SegmentationCfg", "motion_phases", "segment_phases"]
 
 PHASES: tuple[str, ...] = ("swing", "touchdown", "stance", "liftoff")
 """Per-foot phase labels, indexed by the integer codes returned by :func:`segment_phases`."""
+MOTION_PHASES: tuple[str, ...] = ("hold", "low_freq", "high_freq")
+"""Per-joint labels of a held robot, indexed by the codes of :func:`motion_phases`."""
 
 
 @dataclass
@@ -32,6 +37,13 @@ class SegmentationCfg:
     """Touchdown window after contact onset [s]."""
     lo_window: float = 0.06
     """Lift-off window before contact release [s]."""
+    motion_window: float = 0.5
+    """Window over which a joint command's speed and frequency are measured (held pelvis) [s]: half a period of
+    1 Hz, so the estimate is exact at 1 Hz and never reaches ``split_frequency`` below it."""
+    hold_speed: float = 0.02
+    """A joint whose commanded speed (RMS over the window) is below this holds still [rad/s]."""
+    split_frequency: float = 2.0
+    """Commanded motion above this local frequency is ``high_freq`` [Hz]."""
 
 
 def segment_phases(foot_height: np.ndarray, dt: float, cfg: SegmentationCfg | None = None) -> np.ndarray:
@@ -64,3 +76,28 @@ def segment_phases(foot_height: np.ndarray, dt: float, cfg: SegmentationCfg | No
                 lab[seg] = np.where(stance[seg], 3, lab[seg])
         out[:, f] = lab
     return out
+
+
+def motion_phases(q_cmd: np.ndarray, dt: float, cfg: SegmentationCfg | None = None) -> np.ndarray:
+    """Label each joint's samples by its commanded motion, for a robot that touches nothing, shape [N, J].
+
+    The local frequency of the command is ``sqrt(<qdd^2> / <qd^2>) / 2 pi`` over ``motion_window`` (exact for a
+    sinusoid, ``A sin(w t)``: the ratio is ``w^2``); codes index :data:`MOTION_PHASES`: ``hold`` where the RMS
+    commanded speed is below ``hold_speed``, else ``low_freq`` or ``high_freq`` about ``split_frequency``.
+
+    Args:
+        q_cmd: Commanded joint positions [rad], shape [N, J].
+        dt: Sample period [s].
+        cfg: Thresholds.
+    """
+    cfg = cfg or SegmentationCfg()
+    n = len(q_cmd)
+    qd = np.gradient(q_cmd, dt, axis=0) if n > 1 else np.zeros_like(q_cmd)
+    qdd = np.gradient(qd, dt, axis=0) if n > 1 else np.zeros_like(q_cmd)
+    w = int(min(n, max(1, round(cfg.motion_window / dt))))
+    kernel = np.ones(w) / w
+    smooth = lambda x: np.apply_along_axis(lambda c: np.convolve(c, kernel, mode="same"), 0, x)  # noqa: E731
+    v2, a2 = smooth(qd**2), smooth(qdd**2)
+    freq = np.sqrt(a2 / np.maximum(v2, 1e-300)) / (2.0 * np.pi)
+    out = np.where(freq > cfg.split_frequency, 2, 1)
+    return np.where(np.sqrt(v2) < cfg.hold_speed, 0, out)

@@ -9,7 +9,8 @@ Usage::
 Without ``--params`` the benchmark's mid strength is used (the sand suite's with ``--sand``). ``--sand`` makes the
 recording on the project's 3D-RFT sand with the walking policy (``artifacts/ppo_rft3d/policy.onnx``) and logs
 odometry, as the sand suite does (``--motion composite``: stand, three speeds and a turn, 18 s); analyse it with ``gmloco-mismatch --ground sand``. Only the channels a G1 logs are written (LowState,
-LowCmd, IMU; no odometry unless ``--odometry``). Give the MCAP to ``gmloco-mismatch --real``; keep the key away
+LowCmd, IMU; no odometry unless ``--odometry``). ``--chirp`` makes the in-air identification stage instead: the pelvis
+held on a gantry (metadata ``support=gantry``), PD-tracked joint chirps on the legs and waist. Give the MCAP to ``gmloco-mismatch --real``; keep the key away
 from it.
 """
 
@@ -24,6 +25,7 @@ __all__ = ["main"]
 
 def main(argv: list[str] | None = None) -> None:
     """Generate the recording and write the MCAP and the key."""
+    from gmloco.deploy.mismatch.benchmark.chirp import ChirpCfg
     from gmloco.deploy.mismatch.benchmark.episodes import MID, OOL, SAND_MID, SAND_OOL
     from gmloco.deploy.mismatch.benchmark.generator import EpisodeCfg, generate
     from gmloco.deploy.mismatch.benchmark.policy_motion import MOTIONS, motion_cfg
@@ -39,10 +41,13 @@ def main(argv: list[str] | None = None) -> None:
     p.add_argument("--seed", type=int, default=100)
     p.add_argument("--odometry", action="store_true", help="also log ground-truth base odometry")
     p.add_argument("--sand", action="store_true", help="walking policy on 3D-RFT dry sand, with odometry")
+    p.add_argument("--chirp", action="store_true", help="pelvis held on a gantry, joint chirps (in-air stage)")
     p.add_argument("--motion", choices=sorted(MOTIONS), default="walk", help="with --sand: walk (1 m/s) or composite")
     p.add_argument("--out", type=Path, required=True, help="MCAP to write")
     p.add_argument("--key", type=Path, required=True, help="truth key JSON (keep it where the tool cannot read it)")
     a = p.parse_args(argv)
+    if a.chirp and a.sand:
+        p.error("--chirp holds the robot in the air: it touches no sand; leave out --sand")
     table = {**SAND_MID, **SAND_OOL} if a.sand else {**MID, **OOL}
     params = json.loads(a.params) if a.params else table.get(a.effect, {})
     duration = a.duration if a.duration is not None else MOTIONS[a.motion] if a.sand else 9.0
@@ -54,10 +59,12 @@ def main(argv: list[str] | None = None) -> None:
             odometry=a.odometry or a.sand,
             ground="sand" if a.sand else "plane",
             policy=motion_cfg(a.motion) if a.sand else None,
+            support="gantry" if a.chirp else "free",
+            chirp=ChirpCfg() if a.chirp else None,
         )
     )
     a.out.parent.mkdir(parents=True, exist_ok=True)
-    write_recording(rec, a.out, controller="policy:ppo_rft3d" if a.sand else "scripted_step", overwrite=True)
+    write_recording(rec, a.out, controller=rec.meta["controller"] if not a.sand else "policy:ppo_rft3d", overwrite=True)
     a.key.parent.mkdir(parents=True, exist_ok=True)
     a.key.write_text(json.dumps(key, indent=2))
     print(json.dumps({"mcap": str(a.out), "key": str(a.key), "duration_s": rec.n * rec.dt}))
