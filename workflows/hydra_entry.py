@@ -167,8 +167,9 @@ def _smoke_needed(overrides: Sequence[str], multirun: bool, config_name: str) ->
         return not chosen and not _cuda_available()
     cfg = compose_checked(config_name, overrides, keep_hydra=True)
     smoke = "scale" not in cfg.hydra.runtime.choices and not _cuda_available()
-    if smoke:  # the run directory is judged with the config that will run
-        cfg = compose_checked(config_name, [*overrides, SMOKE_OVERRIDE])
+    # The run directory is judged with the config that will run, without the hydra node (its sweep paths only
+    # resolve inside a running job)
+    cfg = compose_checked(config_name, [*overrides, SMOKE_OVERRIDE] if smoke else list(overrides))
     problem = run_dir_problem(cfg, stage_registry.STAGES)
     if problem is not None:
         raise ConfigInputError(*problem)
