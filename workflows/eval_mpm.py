@@ -20,12 +20,16 @@ walks as the accepted one does: ``python -m gmloco.eval.convergence`` (``docs/mp
 
 from __future__ import annotations
 
+import threading
+from collections.abc import Callable, Iterator
+from contextlib import contextmanager
 from dataclasses import replace
 from pathlib import Path
 from typing import TYPE_CHECKING
 
 from omegaconf import DictConfig
 
+from pipeline_report import say, stage_bar
 from stage_registry import StageIncompleteError
 
 if TYPE_CHECKING:
@@ -51,6 +55,7 @@ def eval_cfg(cfg: DictConfig) -> G1EvalCfg:
         base,
         policy_path=str(Path(str(s.policy_dir)) / str(s.policy_file)),
         out_dir=str(s.out_dir),
+        policy_name=str(s.policy_name),
         terrains=tuple(str(t) for t in s.terrains),
         scenarios=tuple(str(x) for x in s.scenarios),  # type: ignore[arg-type]
         speeds=tuple(float(v) for v in s.speeds),
@@ -86,16 +91,56 @@ def eval_cfg(cfg: DictConfig) -> G1EvalCfg:
     return out
 
 
+def _episodes_logged(log: Path) -> int:
+    """Complete lines of ``episodes.jsonl`` (one per finished episode); 0 before the file exists."""
+    try:
+        return log.read_bytes().count(b"\n")
+    except OSError:
+        return 0
+
+
+@contextmanager
+def _watch_episodes(log: Path, update: Callable[[float], None], period_s: float = 0.5) -> Iterator[None]:
+    """Drive ``update`` with the episode count of ``log`` every ``period_s`` seconds while the block runs.
+
+    The evaluation appends one line per finished episode (its resume state), so the file is the progress; reading
+    it keeps the eval package free of console code.
+    """
+    stop = threading.Event()
+
+    def poll() -> None:
+        while not stop.wait(period_s):
+            update(_episodes_logged(log))
+
+    thread = threading.Thread(target=poll, name="eval_mpm-progress", daemon=True)
+    thread.start()
+    try:
+        yield
+    finally:
+        stop.set()
+        thread.join()
+
+
 def run(cfg: DictConfig) -> dict[str, float]:
     """Evaluate ``<policy_dir>/<policy_file>`` on MPM sand; raise ``StageIncompleteError`` at the time box.
 
     With ``eval_mpm.gpus`` set, over those GPUs (one process each, every cell split into one share per GPU).
     """
+    from gmloco.eval.g1_eval import episode_specs
     from gmloco.eval.g1_eval import run as run_eval
     from gmloco.eval.g1_eval_gpus import run_on_gpus
 
     gpus = [str(g) for g in cfg.eval_mpm.get("gpus", [])]
-    metrics, complete = run_on_gpus(eval_cfg(cfg), gpus) if gpus else run_eval(eval_cfg(cfg))
+    ecfg = eval_cfg(cfg)
+    log = Path(ecfg.out_dir) / "episodes.jsonl"
+    done = _episodes_logged(log) if ecfg.resume else 0
+    if done:
+        say(f"  eval_mpm: resumed from {log} ({done} episodes)")
+    with (
+        stage_bar("MPM episodes", len(episode_specs(ecfg)), "episodes") as update,
+        _watch_episodes(log, update),
+    ):
+        metrics, complete = run_on_gpus(ecfg, gpus) if gpus else run_eval(ecfg)
     if not complete:
         raise StageIncompleteError(
             f"time box reached after {int(metrics.get('all/num_episodes', 0))} episodes; episodes.jsonl kept"

@@ -142,13 +142,11 @@ def _cuda_available() -> bool:
 
 
 def _announce_smoke() -> None:
-    """Say loudly that this is not a full-scale run."""
-    console.rule("[bold yellow]SMOKE SCALE")
+    """Say in one line that this is not a full-scale run, and how to get one."""
     console.print(
-        "[yellow]No CUDA device found (torch.cuda.is_available() is False), so this run uses the smoke scale "
-        f"([bold]{SMOKE_OVERRIDE}[/], conf/scale/smoke.yaml): tiny env counts and a few iterations that check "
-        "every implemented stage end to end in minutes. It does not produce a trained policy. "
-        "Pass +scale=full to force full scale.[/]"
+        f"[bold yellow]SMOKE SCALE[/][yellow] ({SMOKE_OVERRIDE}): no CUDA device, so tiny sizes that check every stage "
+        "end to end in minutes and train no usable policy; +scale=full forces full scale.[/]",
+        soft_wrap=True,
     )
 
 

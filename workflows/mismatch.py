@@ -24,6 +24,8 @@ from typing import Any
 
 from omegaconf import DictConfig
 
+from pipeline_report import stage_bar
+
 __all__ = ["main", "run"]
 
 
@@ -67,7 +69,8 @@ def run(cfg: DictConfig) -> dict[str, Any]:
     rec = read_recording(str(section.real))
     if section.duration_s is not None:
         rec = rec.slice(0, min(rec.n, round(float(section.duration_s) / rec.dt)))
-    result = analyze(rec, _analysis_cfg(section, 1.0 / rec.dt))
+    with stage_bar("mismatch fits", 1.0, "%") as update:
+        result = analyze(rec, _analysis_cfg(section, 1.0 / rec.dt), lambda msg, frac: update(frac, f"mismatch: {msg}"))
     write_report(result, Path(section.out_dir), plots=bool(section.plots))
     return _metrics(result.report) | {"recording_s": float(rec.n * rec.dt)}
 

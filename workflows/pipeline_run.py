@@ -19,9 +19,19 @@ from omegaconf import DictConfig, OmegaConf
 
 import stage_registry
 from manifest import Manifest, StageStatus
-from pipeline_report import print_header, print_summary, stage_progress
-from run_dir import RunDir, atomic_write_json, atomic_write_yaml, config_hash, seed_everything, write_git_state
+from pipeline_report import console, print_ending, print_header, say, stage_line, stage_progress
+from run_dir import (
+    RunDir,
+    atomic_write_json,
+    atomic_write_text,
+    atomic_write_yaml,
+    config_hash,
+    seed_everything,
+    write_git_state,
+)
 from run_guard import run_dir_problem
+from run_log import job_log_path, library_output_to
+from run_summary import SMOKE_CONSOLE_NOTE, headline, summary_markdown
 from schemas import REPO_ROOT
 from stage_hashing import hashable_config, stage_hashes
 from stage_registry import StageSpec
@@ -113,9 +123,11 @@ def run_pipeline(
     manifest.config_hash = config_hash(hashable_config(cfg, [s.name for s in registry]))
     manifest.invocations.append(_invocation(cfg, git, manifest.config_hash))
     manifest.save()
-    info = {**resolved, "git_commit": git["commit"], "scale": manifest.invocations[-1]["scale"]}
+    log = job_log_path(layout.root)
+    info = {**resolved, "git_commit": git["commit"], "scale": manifest.invocations[-1]["scale"], "log": log.name}
     print_header(info)
-    outcomes = _run_stages(cfg, registry, manifest, resolved)
+    with library_output_to(log, console):
+        outcomes = _run_stages(cfg, registry, manifest, resolved)
     code = exit_code(outcomes)
     summary = {
         "exp_name": cfg.exp_name,
@@ -129,7 +141,9 @@ def run_pipeline(
         "exit_code": code,
     }
     atomic_write_json(layout.summary_json, summary)
-    print_summary(summary["stages"], cfg.run_dir, _resume_hint(cfg, code))
+    hint = _resume_hint(cfg, code)
+    atomic_write_text(layout.summary_md, summary_markdown(summary, registry, manifest, log.name, hint))
+    print_ending(str(layout.summary_md), hint, [SMOKE_CONSOLE_NOTE] if info["scale"] == "smoke" else [])
     return summary
 
 
@@ -143,16 +157,16 @@ def _run_stages(
     outcomes: list[StageOutcome] = []
     try:
         with stage_progress() as progress:
-            task = progress.add_task("pipeline", total=len(registry))
+            task = progress.add_task("pipeline", total=len(registry), count=f"0/{len(registry)} stages")
             for step, spec in enumerate(registry):
                 progress.update(task, description=spec.name)
                 outcome = runner.run_stage(spec)
                 outcomes.append(outcome)
                 if outcome.status is StageStatus.DONE:
                     tracker.log_stage(step, spec.name, outcome.metrics, outcome.duration_s)
-                progress.console.print(f"  {spec.name}: {outcome.status.value} {outcome.message}".rstrip())
-                progress.advance(task)
-            progress.update(task, description="pipeline")
+                if outcome.status is not StageStatus.DISABLED:
+                    say(stage_line(outcome.to_dict(), headline(spec.name, outcome.metrics)))
+                progress.update(task, advance=1, count=f"{step + 1}/{len(registry)} stages")
     finally:
         tracker.close()
     return outcomes

@@ -17,6 +17,7 @@ from typing import Any
 
 from omegaconf import DictConfig, OmegaConf
 
+from pipeline_report import say, stage_bar
 from stage_registry import StageIncompleteError
 
 __all__ = [
@@ -141,6 +142,14 @@ def _start_fresh(run_dir: Path) -> None:
         p.unlink(missing_ok=True)
 
 
+def _announce_resume(name: str, folder: Path) -> None:
+    """Say which checkpoint a stage continues from, when its folder holds one (``train`` resumes from it)."""
+    found = [(int(m.group(1)), p) for p in folder.glob("model_*.pt") if (m := _CHECKPOINT.match(p.name))]
+    if found:
+        iteration, path = max(found)
+        say(f"  {name}: resumed from {path} (iteration {iteration})")
+
+
 def run_training(cfg: DictConfig, name: str, **run_cfg: Any) -> dict[str, float | None]:
     """Run ``gmloco.train.train`` for stage ``name``; raise ``StageIncompleteError`` when its time box stopped it.
 
@@ -158,19 +167,23 @@ def run_training(cfg: DictConfig, name: str, **run_cfg: Any) -> dict[str, float 
     out = Path(section.out_dir)
     if not section.resume:
         _start_fresh(out)
-    metrics = train(
-        TrainRunCfg(
-            num_envs=int(section.num_envs),
-            max_iterations=int(section.max_iterations),
-            max_minutes=None if section.max_minutes is None else float(section.max_minutes),
-            seed=int(cfg.seed),
-            device=torch_device(str(cfg.device)),
-            run_dir=str(out),
-            save_interval=int(section.save_interval),
-            num_steps_per_env=int(section.num_steps_per_env),
-            **run_cfg,
+    _announce_resume(name, out)
+    total = int(section.max_iterations)
+    with stage_bar(f"{name} iterations", total, "iterations") as update:
+        metrics = train(
+            TrainRunCfg(
+                num_envs=int(section.num_envs),
+                max_iterations=total,
+                max_minutes=None if section.max_minutes is None else float(section.max_minutes),
+                seed=int(cfg.seed),
+                device=torch_device(str(cfg.device)),
+                run_dir=str(out),
+                save_interval=int(section.save_interval),
+                num_steps_per_env=int(section.num_steps_per_env),
+                **run_cfg,
+            ),
+            on_iteration=lambda done, _total: update(done),
         )
-    )
     if metrics.get("stopped_by_deadline"):
         it, total = int(metrics["iteration"]), int(section.max_iterations)
         raise StageIncompleteError(f"time box reached at iteration {it} of {total}; checkpoint model_{it}.pt saved")

@@ -149,7 +149,7 @@ def write_git_state(repo: str | os.PathLike[str], dest_dir: str | os.PathLike[st
 
 @dataclass(frozen=True)
 class RunDir:
-    """Layout of one run directory: ``<root>/{config.yaml, manifest.json, summary.json, git/, tb/, <stage>/}``."""
+    """Layout of one run directory: ``<root>/{config.yaml, manifest.json, summary.json, summary.md, git/, tb/, <stage>/}``."""
 
     root: Path
     """Absolute path of the run directory."""
@@ -166,8 +166,13 @@ class RunDir:
 
     @property
     def summary_json(self) -> Path:
-        """Summary of the latest invocation (what the console table shows)."""
+        """Summary of the latest invocation: every stage's status and metrics."""
         return self.root / "summary.json"
+
+    @property
+    def summary_md(self) -> Path:
+        """What each stage produced and its key numbers, for a reader."""
+        return self.root / "summary.md"
 
     @property
     def tensorboard_dir(self) -> Path:

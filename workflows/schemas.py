@@ -270,6 +270,8 @@ class EvalMpmCfg(StageCfg):
     """Folder holding ``policy.onnx``."""
     policy_file: str = "policy.onnx"
     """File in ``policy_dir`` (gmloco student export or mjlab actor export)."""
+    policy_name: str = _interp("${exp_name}")
+    """The policy's name in the tables and figures (the experiment that trained it, by default)."""
     num_episodes: int = ranged(100, ge=1)
     """Episodes per (policy, terrain, scenario); the paper uses 100."""
     episode_s: float = ranged(10.0, gt=0)

@@ -100,6 +100,8 @@ class G1EvalCfg:
     """Exported policy: gmloco student format (``obs`` + ``history``) or mjlab's actor export (``obs`` only)."""
     out_dir: str = "results/mpm_eval"
     """Output folder."""
+    policy_name: str = ""
+    """The policy's name in tables and figures; empty: the name of the policy file's folder."""
     terrains: tuple[str, ...] = ("dry_sand",)
     """Terrains (``gmloco.eval.mpm.window_terrain.terrain_cfg`` names: a preset medium, ``<medium>_rough``,
     ``<medium>_deep``, ``transition``)."""
@@ -976,7 +978,7 @@ def write_outputs(
     from gmloco.eval.figures_mpm import write_figures
     from gmloco.eval.tables_mpm import write_tables
 
-    policy = Path(cfg.policy_path).parent.name or Path(cfg.policy_path).stem
+    policy = cfg.policy_name or Path(cfg.policy_path).parent.name or Path(cfg.policy_path).stem
     tables = write_tables(rows, out, policy)
     try:  # the GPU image may lack matplotlib: the numbers must not be lost for a figure
         figures, note = (write_figures(rows, out, policy, cfg.episode_s, run_dirs) if rows else []), ""

@@ -13,6 +13,7 @@ import json
 import math
 import os
 import time
+from collections.abc import Callable
 from dataclasses import asdict, dataclass, field
 from pathlib import Path
 from typing import Any, Literal
@@ -133,11 +134,12 @@ def _warm_start_encoder(runner: Any, path: str, run_dir: Path) -> None:
     (run_dir / "warm_start.json").write_text(json.dumps(record, indent=1))
 
 
-def train(cfg: TrainRunCfg) -> dict[str, float]:
+def train(cfg: TrainRunCfg, on_iteration: Callable[[int, int], None] | None = None) -> dict[str, float]:
     """Train (or resume) PPO on the granular G1 task and return summary metrics.
 
     Args:
         cfg: The run configuration.
+        on_iteration: Called after each PPO iteration with (iterations done in total, ``max_iterations``).
 
     Returns:
         ``iterations_done`` (this call), ``iteration`` (total), ``mean_reward``, ``mean_episode_length``,
@@ -169,7 +171,7 @@ def train(cfg: TrainRunCfg) -> dict[str, float]:
     resumed_from = runner.current_learning_iteration
     remaining = cfg.max_iterations - resumed_from
     if remaining > 0:
-        runner.learn(remaining, init_at_random_ep_len=checkpoint is None, deadline=deadline)
+        runner.learn(remaining, init_at_random_ep_len=checkpoint is None, deadline=deadline, on_iteration=on_iteration)
     summary = runner.summary() if remaining > 0 else {"iterations_done": 0.0, "iteration": float(resumed_from)}
     if cfg.export_onnx:
         extra = {"contact_model": cfg.task.contact_model, "terrain": cfg.task.terrain.kind}

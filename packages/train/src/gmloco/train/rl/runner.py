@@ -7,6 +7,7 @@ import os
 import re
 import statistics
 import time
+from collections.abc import Callable
 from pathlib import Path
 
 import torch
@@ -36,7 +37,11 @@ class GmlocoOnPolicyRunner(MjlabOnPolicyRunner):
     """Number of most recent ``model_*.pt`` files kept in the run directory."""
 
     def learn(  # type: ignore[override]
-        self, num_learning_iterations: int, init_at_random_ep_len: bool = False, deadline: float | None = None
+        self,
+        num_learning_iterations: int,
+        init_at_random_ep_len: bool = False,
+        deadline: float | None = None,
+        on_iteration: Callable[[int, int], None] | None = None,
     ) -> None:
         """Run PPO iterations until ``num_learning_iterations`` are done or ``deadline`` is near.
 
@@ -45,6 +50,8 @@ class GmlocoOnPolicyRunner(MjlabOnPolicyRunner):
             init_at_random_ep_len: Randomize initial episode lengths (fresh runs).
             deadline: ``time.monotonic()`` value by which the call must have saved and returned; the loop
                 stops when one more iteration (1.5x the slowest so far) would cross it.
+            on_iteration: Called after each iteration with (iterations done in total, the run's last iteration),
+                e.g. to drive a progress bar.
         """
         if init_at_random_ep_len:
             self.env.episode_length_buf = torch.randint_like(
@@ -64,6 +71,8 @@ class GmlocoOnPolicyRunner(MjlabOnPolicyRunner):
             self.current_learning_iteration = it + 1
             if it % self.cfg["save_interval"] == 0:
                 self.save_checkpoint()
+            if on_iteration is not None:
+                on_iteration(it + 1, start_it + num_learning_iterations)
         self.save_checkpoint()
         self.logger.stop_logging_writer()
 
