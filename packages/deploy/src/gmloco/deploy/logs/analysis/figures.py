@@ -34,6 +34,12 @@ def _label(r: RunAnalysis) -> str:
     return f"{r.summary['controller']} / {r.summary['material']} ({r.summary['file']})"
 
 
+def _legend_below(ax: Any) -> None:
+    """Legend under the axes, clear of the data, with room made for it (run labels carry file names, long)."""
+    ax.figure.set_layout_engine("constrained")
+    ax.figure.legend(fontsize=5, loc="outside lower left", frameon=False)
+
+
 def fig_velocity_tracking(runs: list[RunAnalysis], path: Path) -> Path:
     """Measured vs commanded forward speed, one marker per command segment, per controller."""
     plt = _plt()
@@ -54,7 +60,7 @@ def fig_velocity_tracking(runs: list[RunAnalysis], path: Path) -> Path:
     lim = [min(ax.get_xlim()[0], ax.get_ylim()[0]), max(ax.get_xlim()[1], ax.get_ylim()[1])]
     ax.plot(lim, lim, "k--", lw=0.8, label="ideal")
     ax.set(xlabel="commanded $v_x$ [m/s]", ylabel="measured $v_x$ [m/s]", title="Velocity tracking")
-    ax.legend(fontsize=5)
+    _legend_below(ax)
     return _save(fig, path)
 
 
@@ -70,7 +76,7 @@ def fig_ankle_torque(runs: list[RunAnalysis], path: Path) -> Path:
             (line,) = ax.plot(x, m, lw=1.2, label=f"{_label(r)} (n={len(prof)})")
             ax.fill_between(x, m - s, m + s, color=line.get_color(), alpha=0.2)
     ax.set(xlabel="stance [%]", ylabel="ankle pitch $\\tau_{est}$ [N m]", title="Ankle-pitch torque during stance")
-    ax.legend(fontsize=5)
+    _legend_below(ax)
     return _save(fig, path)
 
 
@@ -89,7 +95,7 @@ def fig_clearance(runs: list[RunAnalysis], path: Path) -> Path:
                 label=f"{foot}: {_label(r)}",
             )
     ax.set(xlabel="time [s]", ylabel="swing clearance [cm]", title="Swing-foot clearance (FK, vs stance sole)")
-    ax.legend(fontsize=5)
+    _legend_below(ax)
     return _save(fig, path)
 
 
@@ -143,16 +149,17 @@ def fig_eta(runs: list[RunAnalysis], path: Path) -> Path | None:
         for k in range(eta.shape[1]):
             ax.plot(r.series["t"], eta[:, k], lw=1, label=f"{_label(r)} eta[{k}] {names}")
     ax.set(xlabel="time [s]", ylabel="decoded $\\eta$", title="Student's decoded terrain parameters")
-    ax.legend(fontsize=5)
+    _legend_below(ax)
     return _save(fig, path)
 
 
 def _save(fig: Any, path: Path) -> Path:
-    """Save and close a figure."""
+    """Save and close a figure; the saved area grows to hold every label and legend (long run names)."""
     import matplotlib.pyplot as plt
 
-    fig.tight_layout()
-    fig.savefig(path)
+    if fig.get_layout_engine() is None:
+        fig.tight_layout()
+    fig.savefig(path, bbox_inches="tight")
     plt.close(fig)
     return path
 
