@@ -119,3 +119,48 @@ def test_upgrade_refuses_disagreeing_facts(tmp_path: Path) -> None:
     _v1_policy(tmp_path, history=40)
     with pytest.raises(ValueError, match="history length"):
         upgrade_policy_dir(tmp_path, {"foot_faces": "sole"})
+
+
+def _mjlab_policy(folder: Path, history: int = 5) -> None:
+    """A one-node ONNX with an mjlab actor export's comma-joined entries, a train_cfg.json and a manifest.json."""
+    x = helper.make_tensor_value_info("obs", TensorProto.FLOAT, [1, 480])
+    y = helper.make_tensor_value_info("actions", TensorProto.FLOAT, [1, 480])
+    model = helper.make_model(helper.make_graph([helper.make_node("Identity", ["obs"], ["actions"])], "g", [x], [y]))
+    entries = {
+        "run_path": "ppo_rft3d", "joint_names": ",".join(G1_JOINT_NAMES), "joint_stiffness": ",".join(["40.0"] * 29),
+        "joint_damping": ",".join(["2.0"] * 29), "default_joint_pos": ",".join(["0.1"] * 29), "action_scale": "0.25",
+        "observation_names": "base_ang_vel,projected_gravity,command,joint_pos,joint_vel,actions",
+        "observation_dims": ",".join(f"{d:.3f}" for d in DIMS), "observation_history_length": str(history),
+        "policy_dt": "0.02", "contact_model": "rft3d",
+    }  # fmt: skip
+    for key, value in entries.items():
+        model.metadata_props.append(onnx.StringStringEntryProto(key=key, value=value))
+    onnx.save(model, str(folder / "policy.onnx"))
+    task = asdict(g1_granular_task())
+    (folder / "train_cfg.json").write_text(json.dumps({"task": task, "history_length": 0}))
+    (folder / "manifest.json").write_text(json.dumps({"chunks": [{"commit": "aaa"}, {"commit": "bbb"}]}))
+
+
+def test_upgrade_of_an_mjlab_export_keeps_its_entries_and_adds_the_document(tmp_path: Path) -> None:
+    """PPO export: term-stacked MLP document, 5 frames, commit of the last chunk; mjlab's keys stay for mjlab tools."""
+    _mjlab_policy(tmp_path)
+    upgrade_policy_dir(tmp_path)
+    meta = read_policy_metadata(tmp_path / "policy.onnx")
+    assert (meta.observation.layout, meta.observation.history_length, meta.policy_class) == (
+        "term_stacked",
+        5,
+        "MLPModel",
+    )
+    assert meta.commit == "bbb" and meta.joints.action_scale == [0.25] * 29 and meta.joints.stiffness == [40.0] * 29
+    assert [t.dim for t in meta.observation.terms] == DIMS
+    keys = {p.key for p in onnx.load(str(tmp_path / "policy.onnx")).metadata_props}
+    assert METADATA_KEY in keys and "observation_history_length" in keys
+    with pytest.raises(ValueError, match="neither"):  # a second upgrade finds the document and refuses
+        upgrade_policy_dir(tmp_path)
+
+
+def test_upgrade_of_an_mjlab_export_refuses_a_different_history(tmp_path: Path) -> None:
+    """A file stacking 4 frames for a task of 5 is not upgraded."""
+    _mjlab_policy(tmp_path, history=4)
+    with pytest.raises(ValueError, match="stacked history 4"):
+        upgrade_policy_dir(tmp_path)

@@ -1,11 +1,18 @@
 # SPDX-License-Identifier: Apache-2.0
-"""Rewrite a version-1 student ONNX's metadata as the versioned document, from facts beside it.
+"""Add the versioned metadata document to an ONNX policy exported before it existed, from facts beside it.
 
 ``python -m gmloco.train.tasks.g1_granular.upgrade_metadata <policy_dir> [--set key=value ...]`` reads the
-policy's ``train_cfg.json`` (the training task) and the file's version-1 entries (joints, kp/kd, default pose,
-action scale, term widths, history length, latent size, commit and run, all read from the live env at export),
-adds the G1 effort limits and everything the task determines, then rewrites ``policy.onnx`` (atomically, the
-version-1 entries removed) and ``policy.json``. A task field missing from ``train_cfg.json`` is refused unless
+policy's ``train_cfg.json`` (the training task) and the file's own older entries, adds the G1 effort limits and
+everything the task determines, then rewrites ``policy.onnx`` (atomically) and ``policy.json``. Two older forms:
+
+* a version-1 student (``format: gmloco-student-policy/1``, JSON values: joints, kp/kd, default pose, action
+  scale, term widths, history length, latent size, commit and run, read from the live env at export); its
+  version-1 entries are replaced by the document;
+* an mjlab actor export (PPO; comma-joined values: joints, kp/kd, default pose, action scale, term names and
+  widths, stacked history length, policy dt, contact model); its mjlab entries are kept beside the document, as
+  :func:`gmloco.train.rl.export.export_policy_onnx` writes them, and the commit is the last training chunk's in
+  ``manifest.json``.
+ A task field missing from ``train_cfg.json`` is refused unless
 ``--set`` gives it (e.g. ``foot_faces=sole`` or ``yaw_command=heading_envs`` for runs trained before that field
 existed; a value is read as JSON where it parses, else as a string). Exit 2 on bad input.
 """
@@ -31,6 +38,9 @@ _V1_KEYS = ("joint_names", "joint_stiffness", "joint_damping", "default_joint_po
             "observation_names", "observation_dims", "observation_scale", "observation_clip", "history_length",
             "policy_dt", "history_padding", "latent_dim", "commit", "run_path", "format")  # fmt: skip
 """Entries of the version-1 student metadata."""
+_MJLAB_KEYS = ("joint_names", "joint_stiffness", "joint_damping", "default_joint_pos", "action_scale",
+               "observation_names", "observation_dims", "observation_history_length", "policy_dt", "run_path")  # fmt: skip
+"""Entries of mjlab's actor export (``gmloco.train.rl.export.policy_metadata``) that the upgrade reads."""
 _NESTED: dict[str, type] = {"terrain": SandTerrainCfg, "floor": SandFloorCfg, "material": MaterialRangeCfg,
                             "robot_dr": RobotDrCfg}  # fmt: skip
 """Dataclass-valued fields of the task config."""
@@ -65,32 +75,86 @@ def task_from_dict(doc: Mapping[str, Any], overrides: Mapping[str, Any] | None =
     return _build(GranularTaskCfg, {**doc, **(overrides or {})}, "task.")
 
 
+def _floats(text: str) -> list[float]:
+    """An mjlab comma-joined value as floats."""
+    return [float(x) for x in text.split(",")]
+
+
+def _student_meta(props: Mapping[str, str], cfg: Mapping[str, Any], overrides: Mapping[str, Any] | None) -> Any:
+    """The document of a version-1 student from its JSON entries and ``train_cfg.json``."""
+    from gmloco.train.tasks.g1_granular.policy_metadata import granular_policy_metadata, joint_spec
+
+    v1 = {k: json.loads(v) for k, v in props.items() if k in _V1_KEYS}
+    if v1["history_length"] != cfg["history_length"]:
+        raise ValueError(f"history length {v1['history_length']} (file) != {cfg['history_length']} (train_cfg).")
+    joints = joint_spec(v1["joint_names"], v1["joint_stiffness"], v1["joint_damping"],
+                        v1["default_joint_pos"], v1["action_scale"])  # fmt: skip
+    meta = granular_policy_metadata(
+        task_from_dict(cfg["task"], overrides), joints, v1["observation_dims"], layout="frame_and_history",
+        history_length=v1["history_length"], policy_class="StudentActor", latent_dim=v1["latent_dim"],
+        run_path=v1["run_path"], commit=v1["commit"],
+    )  # fmt: skip
+    if abs(meta.timing.policy_dt - v1["policy_dt"]) > 1e-9:
+        raise ValueError(f"policy dt {v1['policy_dt']} (file) != {meta.timing.policy_dt} (task).")
+    return meta
+
+
+def _mjlab_meta(
+    props: Mapping[str, str], cfg: Mapping[str, Any], overrides: Mapping[str, Any] | None, commit: str
+) -> Any:
+    """The document of an mjlab actor export (PPO, ``term_stacked``) from its entries and ``train_cfg.json``."""
+    from gmloco.train.tasks.g1_granular.policy_metadata import granular_policy_metadata, joint_spec
+
+    missing = [k for k in _MJLAB_KEYS if k not in props]
+    if missing:
+        raise ValueError(f"the file lacks the mjlab export entries {missing}.")
+    task = task_from_dict(cfg["task"], overrides)
+    history = int(props["observation_history_length"])
+    if history != task.policy_history_length:
+        raise ValueError(f"stacked history {history} (file) != {task.policy_history_length} (train_cfg task).")
+    if props.get("contact_model", task.contact_model) != task.contact_model:
+        raise ValueError(f"contact model {props['contact_model']} (file) != {task.contact_model} (train_cfg task).")
+    scale = _floats(props["action_scale"])
+    joints = joint_spec(props["joint_names"].split(","), _floats(props["joint_stiffness"]),
+                        _floats(props["joint_damping"]), _floats(props["default_joint_pos"]),
+                        scale[0] if len(scale) == 1 else scale)  # fmt: skip
+    dims = [round(d) for d in _floats(props["observation_dims"])]
+    meta = granular_policy_metadata(task, joints, dims, layout="term_stacked", history_length=history,
+                                    policy_class="MLPModel", run_path=props["run_path"], commit=commit)  # fmt: skip
+    names = props["observation_names"].split(",")
+    if names != [t.name for t in meta.observation.terms]:
+        raise ValueError(f"actor terms {names} (file) != {[t.name for t in meta.observation.terms]} (task).")
+    if abs(meta.timing.policy_dt - float(props["policy_dt"])) > 1e-9:
+        raise ValueError(f"policy dt {props['policy_dt']} (file) != {meta.timing.policy_dt} (task).")
+    return meta
+
+
+def _training_commit(folder: Path) -> str:
+    """Commit of the last training chunk in ``folder/manifest.json`` ('unknown' without one)."""
+    path = folder / "manifest.json"
+    chunks = json.loads(path.read_text()).get("chunks", []) if path.exists() else []
+    return str(chunks[-1].get("commit", "unknown")) if chunks else "unknown"
+
+
 def upgrade_policy_dir(folder: Path, overrides: Mapping[str, Any] | None = None) -> Path:
     """Rewrite ``folder/policy.onnx`` (+ ``policy.json``) with the versioned document; return the ONNX path.
 
     Raises:
-        ValueError: If the file has no version-1 entries, or the facts disagree (history length, inputs).
+        ValueError: If the file has neither version-1 student nor mjlab export entries, or the facts disagree
+            (history length, actor terms, policy dt, contact model).
     """
-    from gmloco.deploy.export import write_policy_metadata
-    from gmloco.train.tasks.g1_granular.policy_metadata import granular_policy_metadata, joint_spec
+    from gmloco.deploy.export import METADATA_KEY, write_policy_metadata
 
     path, cfg = folder / "policy.onnx", json.loads((folder / "train_cfg.json").read_text())
     model = onnx.load(str(path))
-    props = {p.key: json.loads(p.value) for p in model.metadata_props if p.key in _V1_KEYS}
-    if props.get("format") != "gmloco-student-policy/1":
-        raise ValueError(f"{path} has no version-1 student metadata to upgrade.")
-    if props["history_length"] != cfg["history_length"]:
-        raise ValueError(f"history length {props['history_length']} (file) != {cfg['history_length']} (train_cfg).")
-    joints = joint_spec(props["joint_names"], props["joint_stiffness"], props["joint_damping"],
-                        props["default_joint_pos"], props["action_scale"])  # fmt: skip
-    meta = granular_policy_metadata(
-        task_from_dict(cfg["task"], overrides), joints, props["observation_dims"], layout="frame_and_history",
-        history_length=props["history_length"], policy_class="StudentActor", latent_dim=props["latent_dim"],
-        run_path=props["run_path"], commit=props["commit"],
-    )  # fmt: skip
-    if abs(meta.timing.policy_dt - props["policy_dt"]) > 1e-9:
-        raise ValueError(f"policy dt {props['policy_dt']} (file) != {meta.timing.policy_dt} (task).")
-    kept = [p for p in model.metadata_props if p.key not in _V1_KEYS]
+    props = {p.key: p.value for p in model.metadata_props}
+    if props.get("format") == json.dumps("gmloco-student-policy/1"):
+        meta, dropped = _student_meta(props, cfg, overrides), set(_V1_KEYS)
+    elif "observation_history_length" in props and METADATA_KEY not in props:
+        meta, dropped = _mjlab_meta(props, cfg, overrides, _training_commit(folder)), set()
+    else:
+        raise ValueError(f"{path} has neither version-1 student metadata nor an mjlab export's to upgrade.")
+    kept = [p for p in model.metadata_props if p.key not in dropped]
     del model.metadata_props[:]
     model.metadata_props.extend(kept)
     tmp = folder / ".policy.onnx.upgrade.tmp"
