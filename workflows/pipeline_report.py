@@ -131,7 +131,12 @@ def stage_line(row: dict[str, Any], headline: str) -> str:
     """One console line for a finished stage: name, status, time, then its headline numbers or its message."""
     style = STATUS_STYLE[StageStatus(row["status"])]
     status = f"[{style}]{row['status']:<8}[/]"
-    detail = headline if row["status"] == StageStatus.DONE.value and headline else _details(row)
+    if headline and row["status"] == StageStatus.DONE.value:
+        detail = headline
+    elif headline and row["status"] == StageStatus.SKIPPED.value:
+        detail = f"{row['message']}: {headline}"
+    else:
+        detail = _details(row)
     return f"  {row['stage']:<14}{status} {row['duration_s']:7.1f} s  {escape(detail)}".rstrip()
 
 

@@ -150,7 +150,7 @@ class StageRunner:
             return StageOutcome(name, StageStatus.DISABLED, "not in 'stages'", spec.issues)
         if name not in self.forced and self._satisfied(name):
             rec = self.manifest.stages[name]
-            msg = f"done earlier for config {h}"
+            msg = f"already done for config {h}"
             return StageOutcome(name, StageStatus.SKIPPED, msg, spec.issues, 0.0, rec.metrics, len(rec.outputs))
         outcome = self._attempt(spec, h)
         self.manifest.save()

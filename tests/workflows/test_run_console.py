@@ -98,3 +98,17 @@ def test_stage_helpers_are_silent_outside_a_pipeline(capfd: pytest.CaptureFixtur
         update(1)
     out, err = capfd.readouterr()
     assert out == err == ""
+
+
+def test_training_stage_announces_the_checkpoint_it_resumes_from(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """The newest model_<it>.pt is named with its iteration (10 > 3: numeric, not lexical, order); none: silence."""
+    from policy_training import _announce_resume
+
+    _announce_resume("distill", tmp_path)
+    assert capsys.readouterr().err == ""
+    for it in (3, 10):
+        (tmp_path / f"model_{it}.pt").write_bytes(b"")
+    _announce_resume("distill", tmp_path)
+    assert f"distill: resumed from {tmp_path / 'model_10.pt'} (iteration 10)" in capsys.readouterr().err
