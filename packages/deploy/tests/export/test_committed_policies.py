@@ -67,8 +67,8 @@ def test_committed_policy_runs_from_its_metadata_alone(path: Path) -> None:
         actions = runner.step(terms)
         frames.append(_frame(meta, terms))
     assert actions.shape == (ENVS, 29) and np.isfinite(actions).all()
-    session = ort.InferenceSession(str(path), providers=["CPUExecutionProvider"])
-    names = [i.name for i in session.get_inputs()]
+    runtime = ort.InferenceSession(str(path), providers=["CPUExecutionProvider"])
+    names = [i.name for i in runtime.get_inputs()]
     feeds = _inputs(meta, frames, names)
-    expected = np.concatenate([session.run(None, {k: v[e : e + 1] for k, v in feeds.items()})[0] for e in range(ENVS)])
+    expected = np.concatenate([runtime.run(None, {k: v[e : e + 1] for k, v in feeds.items()})[0] for e in range(ENVS)])
     np.testing.assert_allclose(actions, expected[:, :29], atol=1e-5)
