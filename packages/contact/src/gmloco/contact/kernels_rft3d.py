@@ -18,6 +18,13 @@ from gmloco.contact.kernels_geometry import (
     tile_block_dim,
     write_element,
 )
+from gmloco.contact.kernels_rft3d_ext import (
+    RftExtParams,
+    ext_depth_law,
+    ext_lateral,
+    ext_vertical_force,
+    ext_within_crater,
+)
 from gmloco.contact.kernels_state import (
     AT_REST_EMA,
     AT_REST_UNLOADING,
@@ -152,6 +159,8 @@ def rft3d_elastic_force(
     coeffs: RFT3DCoeffs,
     rest: AtRestParams,
     tau_rev: float,
+    ext: RftExtParams,
+    w: int,
 ) -> wp.vec3:
     """Return the elastic-branch force inside the crater: static alpha on d_eff plus crater friction [N].
 
@@ -161,7 +170,7 @@ def rft3d_elastic_force(
     baselines, and the spring holds a static tangential load).
     """
     alpha_s = rft3d_alpha(rft3d_generic(n, G_HAT, coeffs), n, xi, mu_surf, G_HAT, 0)
-    d_eff = elastic_depth(depth, depth_max, -v[2], rest, tau_rev)
+    d_eff = ext_depth_law(elastic_depth(depth, depth_max, -v[2], rest, tau_rev), ext, w)
     f = alpha_s * (d_eff * area)
     return f + crater_friction(f, n, v, offset, mu_surf, rest.tangential_damping * area, rest.stick_distance)
 
@@ -186,6 +195,7 @@ class RFT3DModel:
     v_eps: float
     sign_fix: int
     rest: AtRestParams
+    ext: RftExtParams
 
 
 @wp.func
@@ -202,6 +212,10 @@ def rft3d_element_force(
 ) -> wp.vec3:
     """Return one submerged element's force [N]: elastic branch inside its crater, else plastic RFT; EMA filter.
 
+    The extension terms (:mod:`~gmloco.contact.kernels_rft3d_ext`) act where they are on: plastic unloading in
+    place of the crater branches, the depth law on both branches' depth, the lateral scale on the resistive force,
+    then the vertical overburden and added-mass forces.
+
     ``kin`` = rows (x, n, v) of :func:`foot_point_kinematics`; ``mat`` = (rho_c, mu_int, mu_surf). The state is
     read only where a branch needs it (z_max always; tau_r and the anchor in the elastic branch; the EMA fields
     in ``"ema"`` mode).
@@ -212,15 +226,23 @@ def rft3d_element_force(
     area = m.areas[p]
     xi = media_scaling(mat[0], mat[1], m.gravity)
     depth_max = state.depth_max[w, f, p]
+    ext = m.ext
     force = wp.vec3(0.0)
-    if rest.mode == AT_REST_UNLOADING and depth > 0.0 and depth < depth_max:
+    if ext_within_crater(depth, depth_max, ext, w):
+        force = wp.vec3(0.0)  # (c) plastic unloading: no force until z_max is re-reached
+    elif rest.mode == AT_REST_UNLOADING and depth > 0.0 and depth < depth_max:
         offset = wp.vec3(0.0)
         if rest.stick_distance > 0.0:
             offset = kin[0] - state.anchor[w, f, p]
         tau_rev = state.ema_tau[w, f, p]
-        force = rft3d_elastic_force(n, v, offset, depth, depth_max, area, xi, mat[2], coeffs, rest, tau_rev)
+        force = rft3d_elastic_force(n, v, offset, depth, depth_max, area, xi, mat[2], coeffs, rest, tau_rev, ext, w)
     else:
-        force = rft3d_plastic_force(n, v, depth, area, xi, mat[2], coeffs, m.v_eps, m.sign_fix)
+        d_law = ext_depth_law(depth, ext, w)  # (a) depth law (= depth when off)
+        force = rft3d_plastic_force(n, v, d_law, area, xi, mat[2], coeffs, m.v_eps, m.sign_fix)
+    force = ext_lateral(force, ext, w)  # (b) lateral scale
+    if ext.overburden != 0 or ext.added_mass != 0:  # (d) overburden at lift-off, (e) added mass
+        f_z = ext_vertical_force(n, v, state.vel_prev[w, f, p], depth, area, mat[0], m.gravity, ext, w)
+        force = force + wp.vec3(0.0, 0.0, f_z)
     return at_rest_filter(force, v, depth, rest, state, w, f, p, 0)
 
 
@@ -304,6 +326,7 @@ def rft3d_model(model: Any) -> Any:  # an RFT3DModel instance (Warp struct)
     m.rho_c, m.mu_int, m.mu_surf = model.rho_c, model.mu_int, model.mu_surf
     m.terrain, m.gravity, m.v_eps = model.terrain, model.cfg.gravity, model.cfg.v_eps
     m.sign_fix, m.rest = int(model.cfg.sign_fix), model.rest
+    m.ext = model.ext
     return m
 
 
