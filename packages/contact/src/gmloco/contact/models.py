@@ -60,6 +60,8 @@ class ContactRFT3D(ContactModel):
         """Per-world extension values [W, 7] in ``EXT_COLUMNS`` order (``RftExtensionsCfg``; set_extensions)."""
         self.ext = make_ext_params(cfg.extensions, self.ext_values)
         """Extension flags, values and physics step as one by-value kernel argument (``RftExtParams``)."""
+        self.ext_on = not cfg.extensions.is_off
+        """Whether the kernels with the extension terms compiled in are launched (else the published model's)."""
 
     @property
     def is_stateful(self) -> bool:
