@@ -114,7 +114,8 @@ def extension_dr_columns(model: Any, ranges: dict[str, tuple[float, float]]) -> 
             raise ValueError(f"rft_extension_ranges: term {name!r} is off in the fitted extensions; nothing to vary")
         if not lo <= hi:
             raise ValueError(f"rft_extension_ranges[{name!r}] = {(lo, hi)}: need lo <= hi")
-        replace(ext, **{name: float(lo)}), replace(ext, **{name: float(hi)})  # validates both ends
+        for bound in (lo, hi):
+            replace(ext, **{name: float(bound)})  # RftExtensionsCfg validates the value
         out[EXT_COLUMNS.index(name)] = (float(lo), float(hi))
     return out
 
