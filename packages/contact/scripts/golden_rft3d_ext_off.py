@@ -1,10 +1,12 @@
 # SPDX-License-Identifier: Apache-2.0
 """Write the golden wrenches of a press-lift-press-drag foot trajectory under the published 3D-RFT.
 
-Run against the contact package *without* the extension terms to pin that ``RftExtensionsCfg()`` (all off) leaves
-the model bit for bit unchanged (``tests/test_rft3d_extensions.py::test_extensions_off_equal_golden``):
+Run against a contact package without the extension terms (commit 446cd8e) to pin that ``RftExtensionsCfg()`` (all
+off) leaves the model bit for bit unchanged (``tests/test_rft3d_extensions.py::test_extensions_off_equal_golden``):
 
-    python packages/contact/scripts/golden_rft3d_ext_off.py packages/contact/tests/golden_data/rft3d_extensions_off
+    mkdir -p /tmp/c && git archive 446cd8e packages/contact/src | tar -x -C /tmp/c
+    PYTHONPATH=/tmp/c/packages/contact/src python packages/contact/scripts/golden_rft3d_ext_off.py \
+        packages/contact/tests/golden_data/rft3d_extensions_off
 """
 
 from __future__ import annotations

@@ -56,7 +56,8 @@ TERMS: dict[str, RftExtensionsCfg] = {
 def test_extensions_off_equal_golden(device: str, case: str, fused: bool) -> None:
     """With every term off the wrenches and point forces equal those of the model without the terms, bit for bit.
 
-    Golden data: ``scripts/golden_rft3d_ext_off.py`` run on the contact package before the terms existed.
+    Golden data: ``scripts/golden_rft3d_ext_off.py`` run on the contact package of commit 446cd8e (no extension
+    terms).
     """
     tag = f"{case}_{'fused' if fused else 'unfused'}"
     wrench, points = golden.run_model(golden.CASES[case], fused)

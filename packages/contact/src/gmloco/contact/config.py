@@ -59,7 +59,7 @@ class _AtRestCfg:
 
 @dataclass(frozen=True)
 class RftExtensionsCfg:
-    """Candidate terms beyond 3D-RFT (Agarwal, Goldman & Kamrin, PNAS 2023); every default is today's 3D-RFT.
+    """Candidate terms beyond 3D-RFT (Agarwal, Goldman & Kamrin, PNAS 2023); every default is the published 3D-RFT.
 
     Each term is off at its neutral value and then leaves the force bit for bit unchanged (the kernels skip it).
     The per-world values (all fields but ``footprint_radius`` and ``dt``) can be domain-randomized through
@@ -113,7 +113,7 @@ class RftExtensionsCfg:
 
     @property
     def is_off(self) -> bool:
-        """Whether every term is at its neutral value (the model is today's 3D-RFT)."""
+        """Whether every term is at its neutral value (the model is the published 3D-RFT)."""
         return self == RftExtensionsCfg(depth_ref=self.depth_ref, unloading_tolerance=self.unloading_tolerance,
                                         dt=self.dt)  # fmt: skip
 

@@ -426,8 +426,9 @@ def _rft3d_foot_wrench_kernel(
     ``max_registers``: the per-thread register cap (``None``: the compiler's choice); see :data:`FUSED_VARIANTS`.
     ``ext``: compile the extension terms in (:func:`rft3d_element_ext`); without them the kernel is the published
     model's and carries none of their code. ptxas -v for sm_90 at block 160 and cap 96 (NVRTC 13.4 PTX, ptxas 13.0):
-    the training kernel ``rft3d_foot_step_kernel_nopoints`` uses 94 registers and no spills without the terms (as
-    before they existed) and 96 registers with 16 B of spill stores with them; compile-level evidence, not a timing.
+    the training kernel ``rft3d_foot_step_kernel_nopoints`` uses 94 registers and no spills without the terms (as at
+    commit 446cd8e, which has no terms) and 96 registers with 16 B of spill stores with them; compile-level
+    evidence, not a timing.
     """
 
     @wp.kernel(name=name, module="unique", enable_backward=False, cuda_max_registers=max_registers)
