@@ -63,6 +63,7 @@ class ContactModelName(str, Enum):
     cone_single = "cone_single"
     cone_multi = "cone_multi"
     rigid = "rigid"
+    rft3d_calibrated = "rft3d_calibrated"
 
 
 class ScaleName(str, Enum):

@@ -30,12 +30,15 @@ def test_deep_terrain_has_a_fixed_30_cm_bed() -> None:
 
 
 def test_registry_ids() -> None:
-    """Every (granular model, terrain) pair, the rigid baseline and the default id are registered in mjlab."""
+    """Every (granular model, terrain) pair, the rigid baseline and the default id are registered in mjlab.
+
+    Five granular models (four of GM-Loco and the calibrated 3D-RFT) on three terrains, rigid on flat, the default.
+    """
     from mjlab.tasks.registry import list_tasks, load_env_cfg
 
     from gmloco.train.tasks.registry import TASK_IDS
 
-    assert len(TASK_IDS) == 4 * 3 + 2 and set(TASK_IDS) <= set(list_tasks())
+    assert len(TASK_IDS) == 5 * 3 + 2 and set(TASK_IDS) <= set(list_tasks())
     cfg = load_env_cfg("Gmloco-Velocity-Granular-G1")
     assert cfg.events["sand_contact"].params["task"].contact_model == "rft3d"
     assert cfg.decimation == 4 and cfg.sim.mujoco.timestep == pytest.approx(0.005)

@@ -14,6 +14,7 @@ from gmloco.contact.config import (
     ContactModelCfg,
     ContactRFT3DCfg,
     ContactRigidCfg,
+    RftExtensionsCfg,
 )
 from gmloco.contact.materials import (
     DR_RANGES_CODE,
@@ -65,6 +66,7 @@ __all__ = [
     "ContactRigidCfg",
     "DrRanges",
     "MaterialCfg",
+    "RftExtensionsCfg",
     "TerrainCfg",
     "box_collider",
     "eta",

@@ -20,6 +20,7 @@ __all__ = [
     "ContactModelCfg",
     "ContactRFT3DCfg",
     "ContactRigidCfg",
+    "RftExtensionsCfg",
 ]
 
 AtRestMode = Literal["none", "unloading", "ema"]
@@ -57,6 +58,72 @@ class _AtRestCfg:
 
 
 @dataclass(frozen=True)
+class RftExtensionsCfg:
+    """Candidate terms beyond 3D-RFT (Agarwal, Goldman & Kamrin, PNAS 2023); every default is the published 3D-RFT.
+
+    Each term is off at its neutral value and then leaves the force bit for bit unchanged (the kernels skip it).
+    The per-world values (all fields but ``footprint_radius`` and ``dt``) can be domain-randomized through
+    ``ContactRFT3D.set_extensions``. Reference: :mod:`gmloco.contact.reference.rft3d_extensions`.
+    """
+
+    depth_exponent: float = 1.0
+    """(a) Depth law exponent n: the depth in F = alpha d dS becomes d_ref (d / d_ref)^n [-]; 1 = linear (off)."""
+    depth_ref: float = 0.05
+    """(a) Reference depth d_ref at which the power law equals the linear law [m]."""
+    depth_saturation: float = 0.0
+    """(a) Saturation depth d_s: the (power-law) depth becomes d_s tanh(d / d_s) [m]; 0 = no saturation (off)."""
+    lateral_scale: float = 1.0
+    """(b) Factor on the horizontal (x, y) components of each element's resistive force [-]; 1 = off."""
+    plastic_unloading: bool = False
+    """(c) Plastic unloading: inside its crater (0 < d < z_max - unloading_tolerance) an element carries no force
+    until it re-reaches its maximum depth z_max (replaces the elastic branch of ``at_rest="unloading"``)."""
+    unloading_tolerance: float = 1.0e-4
+    """(c) Depth band below z_max still on the loading branch [m] (as the cone model's eps_f)."""
+    footprint_radius: float = 0.0
+    """(c) Footprint memory: after lift-off an element keeps z_max while its horizontal distance from where it last
+    reached z_max is below this radius [m], so stepping back into the footprint meets no sand above its bottom
+    (with ``plastic_unloading``); 0 = z_max is forgotten out of contact (off)."""
+    overburden: float = 0.0
+    """(d) Overburden / suction at lift-off: a rising (v_z > 0), submerged, downward-facing element is pulled down by
+    c_ob rho_c g d |n_z| dS [-], the weight of the grain column above it times c_ob; 0 = off."""
+    added_mass: float = 0.0
+    """(e) Added mass of the moving grains: a penetrating (v_z < 0), submerged, downward-facing element gets
+    F_z = c_am rho_c |n_z| dS (v_z^2 - d a_z), i.e. -d(m_a v_z)/dt with m_a = c_am rho_c |n_z| dS d
+    (Katsuragi & Durian 2007 inertial drag) and a_z by finite difference over ``dt`` [-]; 0 = off."""
+    dt: float = 0.005
+    """Physics step of the finite-difference acceleration of ``added_mass`` [s] (state update once per step)."""
+
+    def __post_init__(self) -> None:
+        """Refuse values outside each term's physical range (a message per field)."""
+        checks = {
+            "depth_exponent": self.depth_exponent > 0.0,
+            "depth_ref": self.depth_ref > 0.0,
+            "depth_saturation": self.depth_saturation >= 0.0,
+            "lateral_scale": self.lateral_scale >= 0.0,
+            "unloading_tolerance": self.unloading_tolerance >= 0.0,
+            "footprint_radius": self.footprint_radius >= 0.0,
+            "overburden": self.overburden >= 0.0,
+            "added_mass": self.added_mass >= 0.0,
+            "dt": self.dt > 0.0,
+        }
+        for name, ok in checks.items():
+            value = getattr(self, name)
+            if not (ok and math.isfinite(value)):
+                raise ValueError(f"RftExtensionsCfg.{name}={value}: out of range (see its docstring)")
+
+    @property
+    def is_off(self) -> bool:
+        """Whether every term is at its neutral value (the model is the published 3D-RFT)."""
+        return self == RftExtensionsCfg(depth_ref=self.depth_ref, unloading_tolerance=self.unloading_tolerance,
+                                        dt=self.dt)  # fmt: skip
+
+    @property
+    def stateful(self) -> bool:
+        """Whether a term reads per-element memory (z_max, footprint, previous velocity)."""
+        return self.plastic_unloading or self.footprint_radius > 0.0 or self.added_mass > 0.0
+
+
+@dataclass(frozen=True)
 class ContactRFT3DCfg(_AtRestCfg):
     """3D resistive force theory (Agarwal, Goldman & Kamrin, PNAS 2023) on a sampled foot collider."""
 
@@ -78,6 +145,9 @@ class ContactRFT3DCfg(_AtRestCfg):
     stick_distance: float = 0.002
     """Mobilization distance s0 of the static friction [m]: the tangential slip at which the stick spring reaches
     the Coulomb force mu |F_n| (project choice, README "Static friction in the crater")."""
+    extensions: RftExtensionsCfg = field(default_factory=RftExtensionsCfg)
+    """Candidate terms beyond 3D-RFT (depth law, lateral scale, plastic unloading, overburden, added mass); the
+    default is every term off, i.e. the published model."""
 
 
 @dataclass(frozen=True)

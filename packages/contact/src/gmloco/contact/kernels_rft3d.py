@@ -18,6 +18,13 @@ from gmloco.contact.kernels_geometry import (
     tile_block_dim,
     write_element,
 )
+from gmloco.contact.kernels_rft3d_ext import (
+    RftExtParams,
+    ext_depth_law,
+    ext_lateral,
+    ext_vertical_force,
+    ext_within_crater,
+)
 from gmloco.contact.kernels_state import (
     AT_REST_EMA,
     AT_REST_UNLOADING,
@@ -144,24 +151,21 @@ def rft3d_elastic_force(
     n: wp.vec3,
     v: wp.vec3,
     offset: wp.vec3,
-    depth: float,
-    depth_max: float,
+    d_eff: float,
     area: float,
     xi: float,
     mu_surf: float,
     coeffs: RFT3DCoeffs,
     rest: AtRestParams,
-    tau_rev: float,
 ) -> wp.vec3:
     """Return the elastic-branch force inside the crater: static alpha on d_eff plus crater friction [N].
 
-    d_eff is the unloading line with Kelvin-Voigt and impact damping (:func:`impact_damping`); the tangential
+    d_eff is the unloading line with Kelvin-Voigt and impact damping (:func:`elastic_depth`); the tangential
     part is :func:`crater_friction` (stick spring on ``offset`` = x - anchor, viscous term c_t dS v_t, Coulomb
     cap mu |F.n|; the viscous cap alone keeps the explicit coupling stable, like GM-Loco's k_f for its
     baselines, and the spring holds a static tangential load).
     """
     alpha_s = rft3d_alpha(rft3d_generic(n, G_HAT, coeffs), n, xi, mu_surf, G_HAT, 0)
-    d_eff = elastic_depth(depth, depth_max, -v[2], rest, tau_rev)
     f = alpha_s * (d_eff * area)
     return f + crater_friction(f, n, v, offset, mu_surf, rest.tangential_damping * area, rest.stick_distance)
 
@@ -186,6 +190,7 @@ class RFT3DModel:
     v_eps: float
     sign_fix: int
     rest: AtRestParams
+    ext: RftExtParams
 
 
 @wp.func
@@ -217,10 +222,55 @@ def rft3d_element_force(
         offset = wp.vec3(0.0)
         if rest.stick_distance > 0.0:
             offset = kin[0] - state.anchor[w, f, p]
-        tau_rev = state.ema_tau[w, f, p]
-        force = rft3d_elastic_force(n, v, offset, depth, depth_max, area, xi, mat[2], coeffs, rest, tau_rev)
+        d_eff = elastic_depth(depth, depth_max, -v[2], rest, state.ema_tau[w, f, p])
+        force = rft3d_elastic_force(n, v, offset, d_eff, area, xi, mat[2], coeffs, rest)
     else:
         force = rft3d_plastic_force(n, v, depth, area, xi, mat[2], coeffs, m.v_eps, m.sign_fix)
+    return at_rest_filter(force, v, depth, rest, state, w, f, p, 0)
+
+
+@wp.func
+def rft3d_element_force_ext(
+    kin: wp.mat33,
+    depth: float,
+    mat: wp.vec3,
+    coeffs: RFT3DCoeffs,
+    m: RFT3DModel,
+    state: ElementState,
+    w: int,
+    f: int,
+    p: int,
+) -> wp.vec3:
+    """Return :func:`rft3d_element_force` with the extension terms (:mod:`~gmloco.contact.kernels_rft3d_ext`) [N].
+
+    Plastic unloading in place of the crater branches, the depth law on both branches' depth, the lateral scale on
+    the resistive force, then the vertical overburden and added-mass forces; each skipped where its flag is off.
+    Compiled only into the kernels of models with a term on (:func:`rft3d_element_kernel_func`), so the published
+    model's kernels carry none of this code (registers).
+    """
+    n = kin[1]
+    v = kin[2]
+    rest = m.rest
+    ext = m.ext
+    area = m.areas[p]
+    xi = media_scaling(mat[0], mat[1], m.gravity)
+    depth_max = state.depth_max[w, f, p]
+    force = wp.vec3(0.0)
+    if ext_within_crater(depth, depth_max, ext, w):
+        force = wp.vec3(0.0)  # (c) plastic unloading: no force until z_max is re-reached
+    elif rest.mode == AT_REST_UNLOADING and depth > 0.0 and depth < depth_max:
+        offset = wp.vec3(0.0)
+        if rest.stick_distance > 0.0:
+            offset = kin[0] - state.anchor[w, f, p]
+        d_eff = ext_depth_law(elastic_depth(depth, depth_max, -v[2], rest, state.ema_tau[w, f, p]), ext, w)
+        force = rft3d_elastic_force(n, v, offset, d_eff, area, xi, mat[2], coeffs, rest)
+    else:
+        d_law = ext_depth_law(depth, ext, w)  # (a) depth law
+        force = rft3d_plastic_force(n, v, d_law, area, xi, mat[2], coeffs, m.v_eps, m.sign_fix)
+    force = ext_lateral(force, ext, w)  # (b) lateral scale
+    if ext.overburden != 0 or ext.added_mass != 0:  # (d) overburden at lift-off, (e) added mass
+        f_z = ext_vertical_force(n, v, state.vel_prev[w, f, p], depth, area, mat[0], m.gravity, ext, w)
+        force = force + wp.vec3(0.0, 0.0, f_z)
     return at_rest_filter(force, v, depth, rest, state, w, f, p, 0)
 
 
@@ -263,38 +313,76 @@ def rft3d_element(  # noqa: ANN202 (returns the tuple wp.vec3, float, wp.mat33; 
     return force, depth, kin
 
 
-@wp.kernel
-def rft3d_point_force_kernel(
-    # Model:
+@wp.func
+def rft3d_element_ext(  # noqa: ANN202 (returns the tuple wp.vec3, float, wp.mat33; Warp infers it)
     coeffs: RFT3DCoeffs,
-    model: RFT3DModel,
-    # Data in:
-    foot_pos_in: wp.array2d[wp.vec3],
-    foot_mat_in: wp.array2d[wp.mat33],
-    foot_lin_vel_in: wp.array2d[wp.vec3],
-    foot_ang_vel_in: wp.array2d[wp.vec3],
-    state_in: ElementState,
-    # Data out:
-    point_force_out: wp.array3d[wp.vec3],
-    point_depth_out: wp.array3d[float],
-    point_vel_out: wp.array3d[wp.vec3],
-    nan_count_out: wp.array[int],
-) -> None:
-    """Compute one element's 3D-RFT force, depth and velocity for [world, foot, point] (reference path)."""
-    w, f, p = wp.tid()
-    pos = foot_pos_in[w, f]
-    rot = foot_mat_in[w, f]
-    lin_vel = foot_lin_vel_in[w, f]
-    ang_vel = foot_ang_vel_in[w, f]
+    m: RFT3DModel,
+    state: ElementState,
+    pos: wp.vec3,
+    rot: wp.mat33,
+    lin_vel: wp.vec3,
+    ang_vel: wp.vec3,
+    w: int,
+    f: int,
+    p: int,
+):
+    """Return :func:`rft3d_element` with the extension terms (:func:`rft3d_element_force_ext`)."""
+    kin = foot_point_kinematics(pos, rot, lin_vel, ang_vel, m.points_b[p], m.normals_b[p])
+    x = kin[0]
+    depth = terrain_height(m.terrain, x[0], x[1]) - x[2]
     force = wp.vec3(0.0)
-    depth = 0.0
-    v = wp.vec3(0.0)
-    if foot_inputs_finite(pos, rot, lin_vel, ang_vel):
-        force, depth, kin = rft3d_element(coeffs, model, state_in, pos, rot, lin_vel, ang_vel, w, f, p)
-        v = kin[2]
-    else:
-        wp.atomic_add(nan_count_out, 0, 1)
-    write_element(force, depth, v, point_force_out, point_depth_out, point_vel_out, w, f, p)
+    if element_active(depth, m.rest):
+        mat = point_material(m.terrain, m.rho_c, m.mu_int, m.mu_surf, w, x[0])
+        force = rft3d_element_force_ext(kin, depth, mat, coeffs, m, state, w, f, p)
+    return force, depth, kin
+
+
+def _rft3d_point_kernel(ext: bool) -> wp.Kernel:
+    """Return the per-point 3D-RFT kernel, with (``ext``) or without the extension terms compiled in."""
+
+    @wp.kernel(name="rft3d_point_force_kernel_ext" if ext else "rft3d_point_force_kernel", module="unique")
+    def rft3d_point_force_kernel(
+        # Model:
+        coeffs: RFT3DCoeffs,
+        model: RFT3DModel,
+        # Data in:
+        foot_pos_in: wp.array2d[wp.vec3],
+        foot_mat_in: wp.array2d[wp.mat33],
+        foot_lin_vel_in: wp.array2d[wp.vec3],
+        foot_ang_vel_in: wp.array2d[wp.vec3],
+        state_in: ElementState,
+        # Data out:
+        point_force_out: wp.array3d[wp.vec3],
+        point_depth_out: wp.array3d[float],
+        point_vel_out: wp.array3d[wp.vec3],
+        nan_count_out: wp.array[int],
+    ) -> None:
+        """Compute one element's 3D-RFT force, depth and velocity for [world, foot, point] (reference path)."""
+        w, f, p = wp.tid()
+        pos = foot_pos_in[w, f]
+        rot = foot_mat_in[w, f]
+        lin_vel = foot_lin_vel_in[w, f]
+        ang_vel = foot_ang_vel_in[w, f]
+        force = wp.vec3(0.0)
+        depth = 0.0
+        v = wp.vec3(0.0)
+        if foot_inputs_finite(pos, rot, lin_vel, ang_vel):
+            if wp.static(ext):
+                force, depth, kin = rft3d_element_ext(coeffs, model, state_in, pos, rot, lin_vel, ang_vel, w, f, p)
+            else:
+                force, depth, kin = rft3d_element(coeffs, model, state_in, pos, rot, lin_vel, ang_vel, w, f, p)
+            v = kin[2]
+        else:
+            wp.atomic_add(nan_count_out, 0, 1)
+        write_element(force, depth, v, point_force_out, point_depth_out, point_vel_out, w, f, p)
+
+    return rft3d_point_force_kernel
+
+
+rft3d_point_force_kernel = _rft3d_point_kernel(False)
+"""Per-point kernel of the published model (extension terms off)."""
+rft3d_point_force_kernel_ext = _rft3d_point_kernel(True)
+"""Per-point kernel with the extension terms compiled in."""
 
 
 def rft3d_model(model: Any) -> Any:  # an RFT3DModel instance (Warp struct)
@@ -304,13 +392,14 @@ def rft3d_model(model: Any) -> Any:  # an RFT3DModel instance (Warp struct)
     m.rho_c, m.mu_int, m.mu_surf = model.rho_c, model.mu_int, model.mu_surf
     m.terrain, m.gravity, m.v_eps = model.terrain, model.cfg.gravity, model.cfg.v_eps
     m.sign_fix, m.rest = int(model.cfg.sign_fix), model.rest
+    m.ext = model.ext
     return m
 
 
 def eval_rft3d_point_forces(model: Any, inputs: tuple, nan_count_out: wp.array) -> None:
     """Launch :func:`rft3d_point_force_kernel` over [num_worlds, num_feet, num_points]."""
     wp.launch(
-        rft3d_point_force_kernel,
+        rft3d_point_force_kernel_ext if model.ext_on else rft3d_point_force_kernel,
         dim=model.point_depth.shape,
         inputs=[model.coeffs, rft3d_model(model), *point_kernel_data(model, inputs)],
         outputs=[model.point_force, model.point_depth, model.point_vel, nan_count_out],
@@ -318,7 +407,9 @@ def eval_rft3d_point_forces(model: Any, inputs: tuple, nan_count_out: wp.array) 
     )
 
 
-def _rft3d_foot_wrench_kernel(advance: bool, points: bool, name: str, max_registers: int | None) -> wp.Kernel:
+def _rft3d_foot_wrench_kernel(
+    advance: bool, points: bool, name: str, max_registers: int | None, ext: bool = False
+) -> wp.Kernel:
     """Return the fused 3D-RFT kernel, compiled with (advance=True) or without the state update.
 
     ``points`` False leaves out the per-point outputs (``point_force`` / ``point_depth`` / ``point_vel``, 28 B of
@@ -333,6 +424,11 @@ def _rft3d_foot_wrench_kernel(advance: bool, points: bool, name: str, max_regist
     by default: on an H100 (4,096 worlds, 150 points) the uncapped compute kernel took 85.7 us against 70.4 us
     capped (``results/benchmarks``, fourth run).
     ``max_registers``: the per-thread register cap (``None``: the compiler's choice); see :data:`FUSED_VARIANTS`.
+    ``ext``: compile the extension terms in (:func:`rft3d_element_ext`); without them the kernel is the published
+    model's and carries none of their code. ptxas -v for sm_90 at block 160 and cap 96 (NVRTC 13.4 PTX, ptxas 13.0):
+    the training kernel ``rft3d_foot_step_kernel_nopoints`` uses 94 registers and no spills without the terms (as at
+    commit 446cd8e, which has no terms) and 96 registers with 16 B of spill stores with them; compile-level
+    evidence, not a timing.
     """
 
     @wp.kernel(name=name, module="unique", enable_backward=False, cuda_max_registers=max_registers)
@@ -378,7 +474,10 @@ def _rft3d_foot_wrench_kernel(advance: bool, points: bool, name: str, max_regist
             depth = 0.0
             kin = wp.mat33(0.0)
             if finite:
-                force, depth, kin = rft3d_element(coeffs, model, state_out, pos, rot, lin_vel, ang_vel, w, f, p)
+                if wp.static(ext):
+                    force, depth, kin = rft3d_element_ext(coeffs, model, state_out, pos, rot, lin_vel, ang_vel, w, f, p)
+                else:
+                    force, depth, kin = rft3d_element(coeffs, model, state_out, pos, rot, lin_vel, ang_vel, w, f, p)
                 if element_active(depth, model.rest):
                     force_sum += force
                     # tau_com = sum (p_i - p_com) x F_i, as foot_wrench_kernel (x = pos + R p_b)
@@ -412,28 +511,30 @@ Same source, same results bit for bit (only register allocation differs); ``"def
 compute_and_update_state() launch unless a model's ``fused_variant`` says otherwise (benchmarks).
 """
 
-_FUSED_KERNELS: dict[tuple[bool, bool, int | None], wp.Kernel] = {}
+_FUSED_KERNELS: dict[tuple[bool, bool, int | None, bool], wp.Kernel] = {}
 
 
-def fused_kernel(variant: str, advance: bool, points: bool = True) -> wp.Kernel:
+def fused_kernel(variant: str, advance: bool, points: bool = True, ext: bool = False) -> wp.Kernel:
     """Return the fused kernel of a variant (:data:`FUSED_VARIANTS`), built once per register cap.
 
     Kernels with the default variant's cap keep the plain names; others are suffixed ``_maxreg<cap>`` /
     ``_maxregnone`` (one Warp module each, compiled on first launch). ``points`` False: the kernel without the
-    per-point outputs (suffix ``_nopoints``).
+    per-point outputs (suffix ``_nopoints``). ``ext``: with the extension terms compiled in (suffix ``_ext``).
     """
     if variant not in FUSED_VARIANTS:
         raise ValueError(f"unknown fused variant {variant!r}: {list(FUSED_VARIANTS)}")
     default_cap = FUSED_VARIANTS["default"][advance]
     cap = FUSED_VARIANTS[variant][advance]
-    if (advance, points, cap) not in _FUSED_KERNELS:
+    if (advance, points, cap, ext) not in _FUSED_KERNELS:
         name = "rft3d_foot_step_kernel" if advance else "rft3d_foot_wrench_kernel"
         if cap != default_cap:
             name += f"_maxreg{cap if cap is not None else 'none'}"
         if not points:
             name += "_nopoints"
-        _FUSED_KERNELS[advance, points, cap] = _rft3d_foot_wrench_kernel(advance, points, name, cap)
-    return _FUSED_KERNELS[advance, points, cap]
+        if ext:
+            name += "_ext"
+        _FUSED_KERNELS[advance, points, cap, ext] = _rft3d_foot_wrench_kernel(advance, points, name, cap, ext)
+    return _FUSED_KERNELS[advance, points, cap, ext]
 
 
 rft3d_foot_wrench_kernel = fused_kernel("default", False)
@@ -451,7 +552,7 @@ def eval_rft3d_foot_wrench(model: Any, inputs: tuple, wrench_out: wp.array, adva
     ``model.point_outputs`` False launches the kernel that leaves the per-point outputs unwritten.
     """
     variant = getattr(model, "fused_variant", "default")
-    kernel = fused_kernel(variant, advance, getattr(model, "point_outputs", True))
+    kernel = fused_kernel(variant, advance, getattr(model, "point_outputs", True), model.ext_on)
     dim = (model.num_worlds, model.num_feet)
     wp.launch_tiled(
         kernel,

@@ -51,6 +51,7 @@ class AtRestParams:
     tangential_damping: float
     ema_rate: float
     stick_distance: float
+    footprint_radius: float
 
 
 @wp.struct
@@ -62,6 +63,7 @@ class ElementState:
     force_prev: wp.array3d[wp.vec3]
     vel_prev: wp.array3d[wp.vec3]
     anchor: wp.array3d[wp.vec3]
+    footprint: wp.array3d[wp.vec3]
 
 
 @wp.func
@@ -200,6 +202,14 @@ def advance_stick_anchor(
 
 
 @wp.func
+def footprint_near(footprint: wp.vec3, x: wp.vec3, radius: float) -> bool:
+    """Return whether x lies horizontally within ``radius`` [m] of the footprint position."""
+    dx = x[0] - footprint[0]
+    dy = x[1] - footprint[1]
+    return dx * dx + dy * dy < radius * radius
+
+
+@wp.func
 def advance_element_state(
     state: ElementState,
     rest: AtRestParams,
@@ -215,6 +225,9 @@ def advance_element_state(
 ) -> None:
     """Advance element [w, f, p]'s memory past this substep: stick anchor, z_max, EMA rigidity, velocity, force.
 
+    z_max is reset out of contact, unless footprint memory is on (``rest.footprint_radius`` > 0) and the element
+    is still within that radius of where it last reached z_max (``state.footprint``, written at each new z_max).
+
     ``x``, ``n``, ``vel``, ``depth``: the element's position, normal, velocity and depth this substep (zeros for
     non-finite foot inputs); ``force``: its filtered force this substep, stored only in ``"ema"`` mode. Reads
     and writes element [w, f, p] only, so the thread that owns the element may call it after its own force
@@ -227,6 +240,10 @@ def advance_element_state(
     new_depth_max = 0.0
     if depth > 0.0:
         new_depth_max = wp.max(depth_max, depth)
+        if rest.footprint_radius > 0.0 and depth >= depth_max:
+            state.footprint[w, f, p] = x  # where the element last reached z_max
+    elif rest.footprint_radius > 0.0 and footprint_near(state.footprint[w, f, p], x, rest.footprint_radius):
+        new_depth_max = depth_max  # footprint memory: z_max survives lift-off above the footprint
     if new_depth_max != depth_max:
         state.depth_max[w, f, p] = new_depth_max
     tau = state.ema_tau[w, f, p]
@@ -339,6 +356,7 @@ def reset_state_kernel(
     state_out.force_prev[w, f, p] = wp.vec3(0.0)
     state_out.vel_prev[w, f, p] = wp.vec3(0.0)
     state_out.anchor[w, f, p] = wp.vec3(0.0)
+    state_out.footprint[w, f, p] = wp.vec3(0.0)
 
 
 def eval_reset_state(model: Any, world_ids: wp.array) -> None:

@@ -64,6 +64,8 @@ def make_at_rest_params(cfg: Any) -> Any:  # an AtRestParams instance (Warp stru
     rest.ema_rate = getattr(cfg, "ema_rate", 0.0)
     sticks = getattr(cfg, "static_friction", False) and rest.mode == AT_REST_CODES["unloading"]
     rest.stick_distance = float(cfg.stick_distance) if sticks else 0.0
+    ext = getattr(cfg, "extensions", None)
+    rest.footprint_radius = float(ext.footprint_radius) if ext is not None else 0.0
     return rest
 
 
@@ -88,6 +90,8 @@ class ContactModel:
         force_prev: Previous substep's element force [N], [W, F, P]: kept only in ``at_rest="ema"``, the only
             mode that reads it.
         anchor: Stick anchor of each submerged element, world frame [m], [W, F, P] (3D-RFT static friction).
+        footprint: Where each element last reached its maximum depth, world frame [m], [W, F, P] (3D-RFT footprint
+            memory, ``RftExtensionsCfg.footprint_radius``).
         nan_count: Count of non-finite element inputs seen by compute() (one per element per call), [1].
         eta: Normalized stiffness xi / xi_max of each world's material (paper definition) [-], [W].
         eta_log: Log-scaled normalized stiffness (materials.eta scale="log") [-], [W].
@@ -145,10 +149,12 @@ class ContactModel:
         self.force_prev = wp.zeros(shape, dtype=wp.vec3, device=device)
         self.vel_prev = wp.zeros(shape, dtype=wp.vec3, device=device)
         self.anchor = wp.zeros(shape, dtype=wp.vec3, device=device)
+        self.footprint = wp.zeros(shape, dtype=wp.vec3, device=device)
         self.state = ElementState()
         """The memory above as one kernel argument (the same arrays: views, never reallocated)."""
         self.state.depth_max, self.state.ema_tau, self.state.anchor = self.depth_max, self.ema_tau, self.anchor
         self.state.force_prev, self.state.vel_prev = self.force_prev, self.vel_prev
+        self.state.footprint = self.footprint
         self.nan_count = wp.zeros(1, dtype=int, device=device)
         self._scratch_count = wp.zeros(1, dtype=int, device=device)
 

@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Callable
+from dataclasses import replace
 from typing import Any
 
 import numpy as np
@@ -23,6 +24,7 @@ from gmloco.contact.config import (
 from gmloco.contact.kernels_cone import eval_cone_point_forces
 from gmloco.contact.kernels_rft2d import eval_heuristic_point_forces
 from gmloco.contact.kernels_rft3d import RFT3DCoeffs, eval_rft3d_foot_wrench, eval_rft3d_point_forces
+from gmloco.contact.kernels_rft3d_ext import EXT_COLUMNS, make_ext_params, rft_ext_values
 from gmloco.contact.kernels_state import eval_zero_wrench
 from gmloco.contact.model_base import ContactModel
 from gmloco.contact.terrain import TerrainCfg
@@ -54,6 +56,35 @@ class ContactRFT3D(ContactModel):
         super().__init__(cfg, num_worlds, num_feet, device, terrain, box_collider(cfg.collider))
         self.coeffs = RFT3DCoeffs(np.asarray(resolve_rft3d_coeffs(cfg.coeffs), dtype=np.float32))
         """The 20 x 3 coefficients as a by-value kernel parameter (constant-bank operands, no loads)."""
+        self.ext_values = wp.array(np.repeat(rft_ext_values(cfg.extensions), num_worlds, 0), dtype=float, device=device)
+        """Per-world extension values [W, 7] in ``EXT_COLUMNS`` order (``RftExtensionsCfg``; set_extensions)."""
+        self.ext = make_ext_params(cfg.extensions, self.ext_values)
+        """Extension flags, values and physics step as one by-value kernel argument (``RftExtParams``)."""
+        self.ext_on = not cfg.extensions.is_off
+        """Whether the kernels with the extension terms compiled in are launched (else the published model's)."""
+
+    @property
+    def is_stateful(self) -> bool:
+        """Whether update_state() matters: an at-rest mode, or an extension term that reads element memory."""
+        return self.at_rest_code != 0 or self.cfg.extensions.stateful
+
+    def set_extensions(self, env_ids: Any = None, **values: Any) -> None:
+        """Set per-world extension values in place (domain randomization); the on/off flags stay those of the cfg.
+
+        Args:
+            env_ids: Worlds to update; None = all.
+            **values: ``RftExtensionsCfg`` fields of :data:`EXT_COLUMNS`, each [len(env_ids)] or a scalar.
+        """
+        unknown = set(values) - set(EXT_COLUMNS)
+        if unknown:
+            raise ValueError(f"set_extensions: unknown {sorted(unknown)}; per-world values are {list(EXT_COLUMNS)}")
+        ids = np.arange(self.num_worlds) if env_ids is None else np.asarray(env_ids, dtype=np.int64).ravel()
+        table = self.ext_values.numpy().astype(np.float64)
+        for name, value in values.items():
+            table[ids, EXT_COLUMNS.index(name)] = np.broadcast_to(np.asarray(value, dtype=np.float64), ids.shape)
+        for row in np.unique(table, axis=0):  # each distinct row must be a valid configuration
+            replace(self.cfg.extensions, **{n: float(v) for n, v in zip(EXT_COLUMNS, row, strict=True)})
+        self.ext_values.assign(table)
 
 
 class ContactHeuristicRFT(ContactModel):

@@ -20,8 +20,9 @@ __all__ = [
     "rough_sand_terrain",
 ]
 
-ContactModelName = Literal["rft3d", "heuristic_rft", "cone_multi", "cone_single", "rigid"]
-"""Foot-ground contact model: the four granular models of GM-Loco, or plain rigid contact."""
+ContactModelName = Literal["rft3d", "heuristic_rft", "cone_multi", "cone_single", "rigid", "rft3d_calibrated"]
+"""Foot-ground contact model: the four granular models of GM-Loco, plain rigid contact, or 3D-RFT with the terms
+fitted to MPM sand (``GranularTaskCfg.rft_extensions_file``)."""
 
 TerrainName = Literal["flat", "rough", "deep"]
 """Sand bed: flat soft sand, sinusoidal (rough) free surface, or a 30 cm deep loose bed."""
@@ -131,6 +132,12 @@ class GranularTaskCfg:
     six). With the sole alone a swinging foot that rises or points its toe down meets no sand at any depth; the
     whole box gives 30-80 N of drag at 4-8 cm, as MPM sand does (results/mpm_eval/probes/swing_trip/face_drag.md). Cone and
     rigid models ignore it."""
+    rft_extensions_file: str = "results/sand_calibration/rft3d_calibrated.json"
+    """Fitted ``gmloco.contact.RftExtensionsCfg`` that ``contact_model="rft3d_calibrated"`` reads (written by
+    ``python -m gmloco.eval.calibration.fit_cli --write-default`` only when the held-out error improved)."""
+    rft_extension_ranges: dict[str, tuple[float, float]] = field(default_factory=dict)
+    """Per-env domain randomization of the fitted terms, U[lo, hi] on reset, keyed by the per-world
+    ``RftExtensionsCfg`` fields (``gmloco.contact.kernels_rft3d_ext.EXT_COLUMNS``); empty = the fitted values."""
     terrain: SandTerrainCfg = field(default_factory=flat_sand_terrain)
     """Sand free surface and floor."""
     material: MaterialRangeCfg = field(default_factory=MaterialRangeCfg)

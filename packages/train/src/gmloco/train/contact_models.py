@@ -19,14 +19,33 @@ import gmloco.contact as gc
 from gmloco.contact.materials import validate_material_arrays, xi_max, xi_n
 from gmloco.train.config import ContactModelName, GranularTaskCfg, MaterialRangeCfg, SandTerrainCfg
 
-__all__ = ["MaterialWriter", "build_contact_model", "contact_model_cfg", "contact_terrain_cfg", "reset_model_state"]
+__all__ = [
+    "MaterialWriter",
+    "build_contact_model",
+    "contact_model_cfg",
+    "contact_terrain_cfg",
+    "extension_dr_columns",
+    "reset_model_state",
+]
 
 NUM_FEET = 2
 """Feet per robot that carry a granular wrench."""
 
 
-def contact_model_cfg(name: ContactModelName, foot_faces: Literal["sole", "box"] = "sole") -> Any:
-    """Return the ``gmloco.contact`` config of a named contact model; the RFT models sample ``foot_faces``."""
+def contact_model_cfg(
+    name: ContactModelName, foot_faces: Literal["sole", "box"] = "sole", extensions_file: str | None = None
+) -> Any:
+    """Return the ``gmloco.contact`` config of a named contact model; the RFT models sample ``foot_faces``.
+
+    ``"rft3d_calibrated"`` is 3D-RFT with the fitted ``RftExtensionsCfg`` of ``extensions_file`` (required).
+    """
+    if name == "rft3d_calibrated":
+        if extensions_file is None:
+            raise ValueError("contact_model 'rft3d_calibrated' needs GranularTaskCfg.rft_extensions_file")
+        from gmloco.contact.extensions_io import load_rft_extensions
+
+        ext = load_rft_extensions(extensions_file)
+        return replace(contact_model_cfg("rft3d", foot_faces), extensions=ext)
     table = {
         "rft3d": gc.ContactRFT3DCfg,
         "heuristic_rft": gc.ContactHeuristicRFTCfg,
@@ -53,7 +72,7 @@ def build_contact_model(task: GranularTaskCfg, num_envs: int, device: wp.context
 
     The model skips its per-point outputs (``point_outputs`` False): the environment reads only the foot wrenches.
     """
-    cfg = contact_model_cfg(task.contact_model, task.foot_faces)
+    cfg = contact_model_cfg(task.contact_model, task.foot_faces, task.rft_extensions_file)
     terrain = contact_terrain_cfg(task.terrain)
     model = gc.make_contact_model(cfg, num_envs, NUM_FEET, str(device), terrain=terrain)
     model.point_outputs = False  # training reads only the wrenches (set True before install() to inspect points)
@@ -73,6 +92,34 @@ def reset_model_state(model: Any, env_ids: torch.Tensor) -> None:
     eval_reset_state(model, wp.from_torch(env_ids.to(torch.int32), dtype=wp.int32))
 
 
+def extension_dr_columns(model: Any, ranges: dict[str, tuple[float, float]]) -> dict[int, tuple[float, float]]:
+    """Return ``{column of model.ext_values: (lo, hi)}`` for DR ranges of RFT extension terms, validated.
+
+    Each name must be a per-world ``RftExtensionsCfg`` value whose term is on in the model (its flag is fixed when
+    the model is built), with lo <= hi and both ends valid values.
+    """
+    if not ranges:
+        return {}
+    from gmloco.contact.kernels_rft3d_ext import EXT_COLUMNS
+
+    ext = getattr(getattr(model, "cfg", None), "extensions", None)
+    if ext is None or not hasattr(model, "ext_values"):
+        raise ValueError("rft_extension_ranges need a 3D-RFT contact model (contact_model 'rft3d_calibrated')")
+    neutral = gc.RftExtensionsCfg()
+    out = {}
+    for name, (lo, hi) in ranges.items():
+        if name not in EXT_COLUMNS:
+            raise ValueError(f"rft_extension_ranges: unknown {name!r}; per-world values are {list(EXT_COLUMNS)}")
+        if name in ("overburden", "added_mass", "lateral_scale") and getattr(ext, name) == getattr(neutral, name):
+            raise ValueError(f"rft_extension_ranges: term {name!r} is off in the fitted extensions; nothing to vary")
+        if not lo <= hi:
+            raise ValueError(f"rft_extension_ranges[{name!r}] = {(lo, hi)}: need lo <= hi")
+        for bound in (lo, hi):
+            replace(ext, **{name: float(bound)})  # RftExtensionsCfg validates the value
+        out[EXT_COLUMNS.index(name)] = (float(lo), float(hi))
+    return out
+
+
 class MaterialWriter:
     """Draws per-env materials and writes them into a contact model's per-world arrays in place.
 
@@ -82,8 +129,16 @@ class MaterialWriter:
         device: Torch device of the env.
     """
 
-    def __init__(self, model: Any, ranges: MaterialRangeCfg, device: str) -> None:
+    def __init__(
+        self,
+        model: Any,
+        ranges: MaterialRangeCfg,
+        device: str,
+        extension_ranges: dict[str, tuple[float, float]] | None = None,
+    ) -> None:
         self.ranges = ranges
+        self.extension_ranges = extension_dr_columns(model, extension_ranges or {})
+        """Column of ``model.ext_values`` -> U[lo, hi] of the RFT extension terms drawn per env on reset."""
         self.device = device
         self._xi_n: Any = xi_n  # plain arithmetic: evaluates on torch tensors too
         self._xi_max = float(xi_max())
@@ -94,6 +149,8 @@ class MaterialWriter:
         )
         names = ("rho_c", "mu_int", "mu_surf", "eta", "sigma_flat", "sigma_cone")
         self.views = {n: wp.to_torch(getattr(model, n)) for n in names if hasattr(model, n)}
+        if self.extension_ranges:
+            self.views["ext_values"] = wp.to_torch(model.ext_values)  # [W, 7]
         """Zero-copy torch views of the model's per-world parameter arrays, each [W]."""
         self.pinned: dict[str, torch.Tensor] | None = None
         """Per-env (rho_c, mu_int, mu_surf) used instead of drawing, set by :meth:`pin`."""
@@ -136,6 +193,8 @@ class MaterialWriter:
         for name in ("sigma_flat", "sigma_cone"):
             if name in v:
                 v[name][env_ids] = self._uniform(getattr(r, name), n)
+        for column, bounds in self.extension_ranges.items():
+            v["ext_values"][env_ids, column] = self._uniform(bounds, n)
         # eta = xi_n(rho_c, mu_int) / xi_max, the paper's normalized stiffness (gmloco.contact.eta).
         v["eta"][env_ids] = self._xi_n(v["rho_c"][env_ids], v["mu_int"][env_ids]) / self._xi_max
 

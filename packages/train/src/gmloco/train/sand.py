@@ -107,7 +107,7 @@ class SandContact:
 
             self.coupling = self._install_granular(env, task)
             self.model = self.coupling.model
-            self.materials = MaterialWriter(self.model, task.material, self.device)
+            self.materials = MaterialWriter(self.model, task.material, self.device, task.rft_extension_ranges)
             self._eta = self.materials.eta
         threshold = contact_force_threshold(task)
         self.feet = FootContactTracker(

@@ -3,6 +3,7 @@
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from pathlib import Path
 from typing import Literal
 
@@ -217,8 +218,11 @@ def rft3d_unloading_forces(
     impact_damped: bool | np.ndarray = True,
     anchors: np.ndarray | None = None,
     stick_distance: float = 0.0,
+    depth_law: Callable[[np.ndarray], np.ndarray] | None = None,
 ) -> np.ndarray:
     """Return 3D-RFT forces with the project's elastic unloading branch [N], shape [N, 3].
+
+    ``depth_law`` (``RftExtensionsCfg`` term a) maps the depth of F = alpha d dS on both branches; None = linear.
 
     Elements deeper than their remembered maximum depth z_max (virgin loading) get plain RFT. Inside
     the crater (0 < depth < z_max) the element is on an elastic branch: the static resistance
@@ -243,12 +247,16 @@ def rft3d_unloading_forces(
         coeffs=coeffs,
         v_eps=v_eps,
     )
+    if depth_law is not None:  # F is linear in the depth: rescale to the law's depth
+        plastic = plastic * (depth_law(depth) / np.where(depth > 0.0, depth, 1.0))[:, None]
     static_v = np.tile(G_HAT, (len(n), 1))
     alpha_s = rft3d_alpha(rft3d_generic(n, static_v, coeffs), n, xi_n(rho_c, mu_int), mu_surf)
     d_eff = np.maximum(0.0, depth_max - ratio * (depth_max - depth) - damping * ratio * v[:, 2])
     if unloading_speed > 0.0:
         d_eff = np.where(impact_damped, d_eff * (1.0 - v[:, 2] / unloading_speed), d_eff)
     d_eff = np.clip(d_eff, 0.0, depth_max)
+    if depth_law is not None:
+        d_eff = depth_law(d_eff)
     f_el = alpha_s * (d_eff * areas)[:, None]
     limit = mu_surf * np.abs(np.sum(f_el * n, -1, keepdims=True))
     trial = -tangential_damping * areas[:, None] * _tangential(v, n)

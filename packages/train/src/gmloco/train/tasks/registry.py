@@ -23,6 +23,7 @@ _MODEL_NAMES: dict[ContactModelName, str] = {
     "heuristic_rft": "HeuristicRFT",
     "cone_multi": "ConeMulti",
     "cone_single": "ConeSingle",
+    "rft3d_calibrated": "RFT3DCalibrated",
 }
 _TERRAIN_NAMES: dict[TerrainName, str] = {"flat": "Flat", "rough": "Rough", "deep": "Deep"}
 

@@ -101,7 +101,7 @@ def _contact_spec(task: GranularTaskCfg) -> ContactSpec:
     from gmloco.train.contact_models import contact_model_cfg
     from gmloco.train.sand import FOOT_BODIES
 
-    box = contact_model_cfg(task.contact_model, task.foot_faces).collider
+    box = contact_model_cfg(task.contact_model, task.foot_faces, task.rft_extensions_file).collider
     collider = FootColliderSpec(
         body_names=list(FOOT_BODIES),
         x_range=list(box.x_range),

@@ -1,0 +1,179 @@
+# SPDX-License-Identifier: Apache-2.0
+"""Fit the 3D-RFT extension terms to the fit split of a calibration dataset; judge them on the held-out split.
+
+The model is the float64 reference (:mod:`gmloco.contact.reference.rft3d_extensions`) driven by the recorded sole
+kinematics; ``scipy.optimize.least_squares`` minimizes the force residual over the fit records, divided by the
+single-stance weight. The fit is accepted only if the held-out RMS force error falls below that of the published
+3D-RFT by ``min_improvement``; only then is a new default written.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import tempfile
+from dataclasses import asdict, dataclass, replace
+from pathlib import Path
+from typing import Any, Literal
+
+import numpy as np
+
+from gmloco.contact import MATERIAL_PRESETS, ContactRFT3DCfg, RftExtensionsCfg
+from gmloco.contact.extensions_io import save_rft_extensions
+from gmloco.eval.calibration.dataset import CalibrationDataset, ContractError, check_contract, file_sha256
+from gmloco.eval.calibration.rft_sand import centred_sole_collider, replay_record
+
+__all__ = ["FIT_BOUNDS", "SandFitCfg", "SandFitResult", "fit_extensions", "split_error"]
+
+FIT_BOUNDS: dict[str, tuple[float, float, float]] = {
+    "depth_exponent": (0.3, 3.0, 1.0),
+    "depth_saturation": (0.0, 200.0, 0.0),
+    "lateral_scale": (0.0, 2.0, 1.0),
+    "overburden": (0.0, 10.0, 0.0),
+    "added_mass": (0.0, 10.0, 0.0),
+}
+"""(lower, upper, neutral start) of each fitted value; ``depth_saturation`` is fitted as 1 / d_s [1/m] (0 = off)."""
+
+
+@dataclass(frozen=True)
+class SandFitCfg:
+    """Fit settings."""
+
+    params: tuple[str, ...] = ("depth_exponent", "depth_saturation", "lateral_scale", "overburden", "added_mass")
+    """Extension values to fit (keys of :data:`FIT_BOUNDS`)."""
+    plastic_unloading: Literal["off", "on", "both"] = "both"
+    """Plastic unloading with footprint memory: fixed off / on, or both fitted and the better fit-split one kept."""
+    footprint_radius: float = 0.05
+    """Footprint radius used with plastic unloading [m]."""
+    at_rest: Literal["none", "unloading"] = "unloading"
+    """At-rest mode of the fitted model (the training default: ``"unloading"``)."""
+    resolution: int = 3
+    """Cells per edge of the replayed sole box."""
+    robot: str = "g1"
+    """Robot the fit is for (contract)."""
+    rate_hz: float | None = None
+    """Expected recording rate [Hz] (contract); None accepts the dataset's."""
+    min_improvement: float = 0.0
+    """Relative held-out error reduction required to accept the fit [-] (0: any reduction)."""
+
+
+@dataclass
+class SandFitResult:
+    """Outcome of a fit."""
+
+    extensions: RftExtensionsCfg
+    """Fitted terms."""
+    error_before: dict[str, float]
+    """RMS force error [N] of the published 3D-RFT per split (``fit``, ``heldout``)."""
+    error_after: dict[str, float]
+    """RMS force error [N] of the fitted model per split."""
+    per_record: dict[str, dict[str, float]]
+    """Before / after RMS force error [N] per record, with its split."""
+    accepted: bool
+    """Held-out error improved by at least ``min_improvement``."""
+    cost: float
+    """Final least-squares cost on the fit split."""
+
+
+def _material(ds: CalibrationDataset) -> Any:
+    """Return the dataset's MaterialCfg, checking it against the recorded parameters (contract)."""
+    if ds.material not in MATERIAL_PRESETS:
+        raise ContractError("material", f"unknown material {ds.material!r}")
+    mat = MATERIAL_PRESETS[ds.material]
+    got = {"rho_c": mat.rho_c, "mu_int": mat.mu_int, "mu_surf": mat.mu_surf}
+    if any(abs(got[k] - float(v)) > 1e-6 * max(1.0, abs(float(v))) for k, v in ds.material_params.items()):
+        raise ContractError("material", f"dataset material {ds.material_params} differs from the preset's {got}")
+    return mat
+
+
+def _extensions(x: np.ndarray, cfg: SandFitCfg, plastic: bool) -> RftExtensionsCfg:
+    """Return the RftExtensionsCfg of parameter vector ``x`` (in ``cfg.params`` order)."""
+    values: dict[str, Any] = dict(zip(cfg.params, (float(v) for v in x), strict=True))
+    if "depth_saturation" in values:
+        inv = values.pop("depth_saturation")
+        values["depth_saturation"] = 1.0 / inv if inv > 1e-9 else 0.0
+    if plastic:
+        values.update(plastic_unloading=True, footprint_radius=cfg.footprint_radius)
+    return RftExtensionsCfg(**values)
+
+
+def _replays(ds: CalibrationDataset, ext: RftExtensionsCfg, cfg: SandFitCfg, names: list[str]) -> dict[str, np.ndarray]:
+    """Return the model force [N] [T, 3] of each named record."""
+    model = ContactRFT3DCfg(at_rest=cfg.at_rest, extensions=ext)
+    col = centred_sole_collider(ds.protocol, "box", cfg.resolution)
+    mat = _material(ds)
+    return {n: replay_record(ds.records[n], col, model, mat, ds.protocol.frame_dt) for n in names}
+
+
+def split_error(ds: CalibrationDataset, ext: RftExtensionsCfg, cfg: SandFitCfg) -> tuple[dict, dict]:
+    """Return (RMS force error [N] per split, per record) of a model on the dataset."""
+    forces = _replays(ds, ext, cfg, list(ds.records))
+    per = {n: float(np.sqrt(np.mean(np.sum((forces[n] - ds.records[n].force) ** 2, -1)))) for n in forces}
+    out = {}
+    for split in ("fit", "heldout"):
+        err = [np.sum((forces[n] - ds.records[n].force) ** 2, -1) for n in forces if ds.split[n] == split]
+        out[split] = float(np.sqrt(np.mean(np.concatenate(err)))) if err else float("nan")
+    return out, per
+
+
+def _fit_one(ds: CalibrationDataset, cfg: SandFitCfg, plastic: bool) -> tuple[RftExtensionsCfg, float]:
+    """Least-squares fit of ``cfg.params`` on the fit split with plastic unloading on or off; (terms, cost)."""
+    from scipy.optimize import least_squares
+
+    names = [n for n in ds.records if ds.split[n] == "fit"]
+    data = np.concatenate([ds.records[n].force for n in names])
+    scale = ds.protocol.weight
+
+    def residual(x: np.ndarray) -> np.ndarray:
+        """Force residual of the fit records over the single-stance weight [-]."""
+        forces = _replays(ds, _extensions(x, cfg, plastic), cfg, names)
+        return ((np.concatenate([forces[n] for n in names]) - data) / scale).ravel()
+
+    lo, hi, x0 = (np.array([FIT_BOUNDS[p][i] for p in cfg.params]) for i in range(3))
+    res = least_squares(residual, x0, bounds=(lo, hi), x_scale=np.maximum(hi - lo, 1e-3) / 10, diff_step=1e-4)
+    return _extensions(res.x, cfg, plastic), float(res.cost)
+
+
+def fit_extensions(ds: CalibrationDataset, cfg: SandFitCfg) -> SandFitResult:
+    """Fit on the fit split, compare held-out errors with the published model; contract checked first."""
+    check_contract(ds, cfg.robot, cfg.rate_hz)
+    unknown = set(cfg.params) - set(FIT_BOUNDS)
+    if unknown:
+        raise ValueError(f"unknown fit parameters {sorted(unknown)}: choose from {list(FIT_BOUNDS)}")
+    if not any(v == "fit" for v in ds.split.values()):
+        raise ContractError("split", "the dataset has no fit records")
+    choices = {"off": [False], "on": [True], "both": [False, True]}[cfg.plastic_unloading]
+    fits = [_fit_one(ds, cfg, plastic) for plastic in choices]
+    ext, cost = min(fits, key=lambda f: f[1])
+    before, per_before = split_error(ds, RftExtensionsCfg(), cfg)
+    after, per_after = split_error(ds, ext, cfg)
+    per = {n: {"split": ds.split[n], "before": per_before[n], "after": per_after[n]} for n in ds.records}
+    accepted = bool(after["heldout"] < (1.0 - cfg.min_improvement) * before["heldout"])
+    return SandFitResult(ext, before, after, per, accepted, cost)
+
+
+def write_report(result: SandFitResult, path: str | Path, provenance: dict[str, Any]) -> Path:
+    """Write the fit report JSON atomically."""
+    path = Path(path)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    body = {"accepted": result.accepted, "force_error_before": result.error_before,
+            "force_error_after": result.error_after, "per_record": result.per_record,
+            "extensions": asdict(result.extensions), "cost": result.cost, **provenance}  # fmt: skip
+    fd, tmp = tempfile.mkstemp(dir=path.parent, suffix=".json.tmp")
+    try:
+        with os.fdopen(fd, "w") as fh:
+            json.dump(body, fh, indent=1)
+        os.replace(tmp, path)
+    finally:
+        if os.path.exists(tmp):
+            os.unlink(tmp)
+    return path
+
+
+def write_default(result: SandFitResult, path: str | Path, dataset: str | Path, cfg: SandFitCfg) -> Path | None:
+    """Write the fitted terms as the new default only if the fit was accepted; return the path or None."""
+    if not result.accepted:
+        return None
+    provenance = {"dataset": str(dataset), "dataset_sha256": file_sha256(dataset), "fit": asdict(cfg),
+                  "force_error_before": result.error_before, "force_error_after": result.error_after}  # fmt: skip
+    return save_rft_extensions(replace(result.extensions), path, provenance)
