@@ -131,3 +131,20 @@ def test_injection_code_is_independent_of_hypothesis_code() -> None:
         tree = ast.parse((bench / f).read_text())
         mods = {n.module for n in ast.walk(tree) if isinstance(n, ast.ImportFrom)}
         assert not mods & forbidden, f
+
+
+def test_ground_effects_are_exactly_inert_on_a_held_pelvis() -> None:
+    """On a gantry recording every effect flagged ``ground`` leaves the replay bit for bit nominal."""
+    from gmloco.deploy.mismatch.benchmark.chirp import ChirpCfg
+    from gmloco.deploy.mismatch.benchmark.generator import EpisodeCfg, generate
+    from gmloco.deploy.mismatch.benchmark.truth import TruthEffect
+
+    rec, _ = generate(EpisodeCfg(effect=TruthEffect(), duration=1.0, seed=5, support="gantry", chirp=ChirpCfg()))
+    rp = Replayer(rec, ReplayCfg(horizon=12, stride=4))
+    starts = rp.segment_starts()[:4]
+    nominal = rp.simulate({}, starts)
+    ground = [e for e in EFFECTS if e.ground]
+    assert {e.id for e in ground} == {i for i in EFFECT_IDS if i.startswith("terrain.")}
+    for e in ground:
+        _, hi = e.bounds()
+        np.testing.assert_array_equal(rp.simulate({e.id: hi}, starts), nominal, err_msg=e.id)

@@ -92,6 +92,9 @@ class EffectSpec:
     """Effect ids with similar signatures."""
     excitation: str
     """What a recording needs for the effect to be testable."""
+    ground: bool = False
+    """Whether it acts only through ground contact: on a held pelvis (gantry, fixed), whose replay touches
+    nothing, its sensitivity is exactly zero and screening skips its replays."""
 
     @property
     def size(self) -> int:
@@ -361,6 +364,7 @@ EFFECTS: tuple[EffectSpec, ...] = (
         ("q", "dq", "tau_est", "acc"),
         ("body.mass_error", "terrain.depth_hardening"),
         "Stance phases; sinkage itself needs external sensing.",
+        ground=True,
     ),
     EffectSpec(
         "terrain.depth_hardening",
@@ -372,6 +376,7 @@ EFFECTS: tuple[EffectSpec, ...] = (
         ("q", "dq", "tau_est", "acc"),
         ("terrain.stiffness_scale",),
         "A range of sinkage depths (varying load).",
+        ground=True,
     ),
     EffectSpec(
         "terrain.rate_drag",
@@ -383,6 +388,7 @@ EFFECTS: tuple[EffectSpec, ...] = (
         ("q", "dq", "tau_est", "acc"),
         ("joint.armature",),
         "Touchdowns at varied speeds.",
+        ground=True,
     ),
     EffectSpec(
         "terrain.cohesion",
@@ -394,6 +400,7 @@ EFFECTS: tuple[EffectSpec, ...] = (
         ("q", "dq", "tau_est", "acc"),
         ("terrain.stiffness_scale", "body.mass_error"),
         "Lift-offs (stepping).",
+        ground=True,
     ),
 )
 """The library, in report order."""
