@@ -132,3 +132,27 @@ def test_pattern_search_never_raises_the_energy_and_keeps_bounds() -> None:
     np.testing.assert_allclose(theta, hi)
     assert r @ r < r0 @ r0
     np.testing.assert_allclose(r, pb.resid({spec.id: theta}))
+
+
+def test_workers_do_not_change_the_answer(delay_rec: object) -> None:
+    """Screening and fits in two forked processes give the same numbers as one process, bit for bit."""
+    from gmloco.deploy.mismatch.attribution import AttributionCfg, confirm, screen
+    from gmloco.deploy.mismatch.problem import Problem, effective_samples
+    from gmloco.deploy.mismatch.replay import ReplayCfg, Replayer
+
+    pb = Problem(Replayer(delay_rec, ReplayCfg(horizon=12, stride=4)))  # type: ignore[arg-type]
+    y0 = pb.simulate({})
+    r0 = (pb.y - y0) / pb.sigma * pb.weight
+    n_eff = effective_samples(r0[pb.train])
+    out = []
+    for workers in (1, 2):
+        cfg = AttributionCfg(effects=("actuator.delay", "joint.armature", "imu.gyro_bias"), workers=workers, top_k=2)
+        hyps = screen(pb, r0, y0, n_eff, cfg)
+        ranked = confirm(pb, hyps, r0, cfg)
+        out.append(([h.sens for h in hyps], [(h.spec.id, h.theta, h.ci, h.dbic) for h in ranked]))
+    for a, b in zip(out[0][0], out[1][0], strict=True):
+        np.testing.assert_array_equal(a, b)
+    for (ia, ta, ca, da), (ib, tb, cb, db) in zip(out[0][1], out[1][1], strict=True):
+        assert ia == ib and da == db
+        np.testing.assert_array_equal(ta, tb)
+        np.testing.assert_array_equal(ca, cb)

@@ -23,7 +23,7 @@
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from typing import Any
 
 import numpy as np
@@ -32,7 +32,16 @@ from gmloco.deploy.mismatch.effects import EFFECTS, EffectSpec
 from gmloco.deploy.mismatch.problem import Problem, effective_samples
 from gmloco.deploy.mismatch.replay import CHANNEL_GROUPS
 
-__all__ = ["AttributionCfg", "Hypothesis", "confirm", "decide", "screen", "second_round", "signal_columns"]
+__all__ = [
+    "AttributionCfg",
+    "Hypothesis",
+    "confirm",
+    "decide",
+    "screen",
+    "second_round",
+    "signal_columns",
+    "simulate_many",
+]
 
 
 @dataclass
@@ -69,6 +78,9 @@ class AttributionCfg:
     """Bootstrap seed."""
     effects: tuple[str, ...] | None = None
     """Effect ids to screen (all by default); a subset keeps tests and quick looks fast."""
+    workers: int = 1
+    """Processes that run independent replays (screening columns, Jacobian columns) side by side; results are
+    identical to one process."""
     testable_energy: float = 9.0
     """A tolerance-sized change must move the normalised residual energy by this much to be testable."""
     weak_gain_min: float = 0.15
@@ -131,26 +143,105 @@ def _sim_params(spec: EffectSpec, theta: np.ndarray) -> dict[str, np.ndarray]:
     return {spec.id: np.asarray(theta, float)}
 
 
+_FORKED: Problem | None = None
+"""The problem a forked worker replays (set in the parent just before the pool forks)."""
+
+
+def _forked_simulate(args: tuple[dict[str, np.ndarray], np.ndarray | None]) -> np.ndarray:
+    """Worker side of :func:`simulate_many`."""
+    assert _FORKED is not None
+    return _FORKED.simulate(*args)
+
+
+_FORKED_FITS: tuple[list[Hypothesis], AttributionCfg] | None = None
+"""The candidates and settings forked fit workers read (set in the parent just before the pool forks)."""
+
+
+def _forked_fit(i: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Worker side of :func:`_fit_all`: the nonlinear fit of candidate ``i``."""
+    assert _FORKED is not None and _FORKED_FITS is not None
+    cand, cfg = _FORKED_FITS
+    return _lm(_FORKED, cand[i], cfg)
+
+
+def _fit_all(pb: Problem, cand: list[Hypothesis], cfg: AttributionCfg) -> list[tuple[np.ndarray, ...]]:
+    """Nonlinear fits of every candidate, one forked process per fit when ``cfg.workers`` > 1 (same results)."""
+    global _FORKED, _FORKED_FITS
+    if cfg.workers <= 1 or len(cand) < 2:
+        return [_lm(pb, h, cfg) for h in cand]
+    import multiprocessing
+
+    _FORKED, _FORKED_FITS = pb, (cand, replace(cfg, workers=1))
+    try:
+        with multiprocessing.get_context("fork").Pool(min(cfg.workers, len(cand))) as pool:
+            return pool.map(_forked_fit, range(len(cand)), chunksize=1)
+    finally:
+        _FORKED, _FORKED_FITS = None, None
+
+
+def simulate_many(
+    pb: Problem,
+    plist: list[dict[str, np.ndarray]],
+    mask: np.ndarray | None = None,
+    workers: int = 1,
+    progress: Any = None,
+) -> list[np.ndarray]:
+    """Simulate several parameter sets on the segments of ``mask``, in ``workers`` forked processes.
+
+    Each replay resets the model from its parameters, so the results equal a serial loop bit for bit; ``progress``
+    is called once per finished replay.
+    """
+    global _FORKED
+    if workers <= 1 or len(plist) < 2:
+        out = []
+        for prm in plist:
+            out.append(pb.simulate(prm, mask))
+            if progress:
+                progress()
+        return out
+    import multiprocessing
+
+    _FORKED = pb
+    try:
+        with multiprocessing.get_context("fork").Pool(min(workers, len(plist))) as pool:
+            out = []
+            for y in pool.imap(_forked_simulate, [(prm, mask) for prm in plist]):
+                out.append(y)
+                if progress:
+                    progress()
+    finally:
+        _FORKED = None
+    return out
+
+
 def screen(
     pb: Problem, r0: np.ndarray, y0: np.ndarray, n_eff: float, cfg: AttributionCfg, progress: Any = None
 ) -> list[Hypothesis]:
     """Screen every effect with finite-difference sensitivities at zero (one replay per component)."""
     out = []
     w = pb.weight / pb.sigma
-    for spec in EFFECTS:
-        if cfg.effects is not None and spec.id not in cfg.effects:
+    specs = [spec for spec in EFFECTS if cfg.effects is None or spec.id in cfg.effects]
+    plist, hs = [], []
+    inert = {spec.id for spec in specs if spec.ground and pb.rp.fixed}  # a held robot touches nothing
+    for spec in specs:
+        if spec.id in inert:
             continue
-        steps = spec.flat("fd_step")
-        cols = []
-        for i, h in enumerate(steps):
+        _, hi = spec.bounds()
+        for i, h in enumerate(spec.flat("fd_step")):
             th = np.zeros(spec.size)
-            lo, hi = spec.bounds()
-            h = h if hi[i] >= h else -h
-            th[i] = h
-            cols.append((pb.simulate(_sim_params(spec, th)) - y0) / h * w)
+            th[i] = h if hi[i] >= h else -h
+            plist.append(_sim_params(spec, th))
+            hs.append(th[i])
+    sims = iter(simulate_many(pb, plist, workers=cfg.workers, progress=progress))
+    steps_all = iter(hs)
+    for spec in specs:
+        if spec.id in inert:
+            sens = np.zeros((*y0.shape, spec.size))
             if progress:
-                progress()
-        sens = np.stack(cols, axis=-1)
+                for _ in range(spec.size):
+                    progress()
+        else:
+            sens = np.stack([(next(sims) - y0) / next(steps_all) * w for _ in range(spec.size)], axis=-1)
         tol_energy = np.max(np.sum((sens[pb.train] * spec.flat("tolerance")) ** 2, axis=(0, 1, 2)))
         hyp = Hypothesis(spec, sens, testable=bool(tol_energy >= cfg.testable_energy))
         S = sens[pb.train].reshape(-1, spec.size)
@@ -187,17 +278,17 @@ def _lm(pb: Problem, hyp: Hypothesis, cfg: AttributionCfg) -> tuple[np.ndarray, 
     r = pb.resid(_sim_params(spec, theta), m).ravel()
     if spec.size == 1:
         theta, r = _grid_start(pb, spec, theta, r)
-    theta, r, J = _lm_iterate(pb, spec, theta, r, cfg.max_iter)
+    theta, r, J = _lm_iterate(pb, spec, theta, r, cfg.max_iter, cfg.workers)
     if spec.size > 1 and cfg.pattern_sweeps > 0:
         theta_p, r_p = _pattern_search(pb, spec, theta, r, cfg.pattern_sweeps)
         if r_p @ r_p < r @ r:
             # Polish from the better point; this also gives the Jacobian there (intervals, identifiability).
-            theta, r, J = _lm_iterate(pb, spec, theta_p, r_p, cfg.max_iter)
+            theta, r, J = _lm_iterate(pb, spec, theta_p, r_p, cfg.max_iter, cfg.workers)
     return theta, r, J
 
 
 def _lm_iterate(
-    pb: Problem, spec: EffectSpec, theta: np.ndarray, r: np.ndarray, max_iter: int
+    pb: Problem, spec: EffectSpec, theta: np.ndarray, r: np.ndarray, max_iter: int, workers: int = 1
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Bounded Levenberg-Marquardt iterations from ``theta`` (training residual ``r``); returns (theta, r, J)."""
     m = pb.train
@@ -207,11 +298,15 @@ def _lm_iterate(
     J = np.empty((r.size, spec.size))
     for _ in range(max_iter):
         J = np.empty((r.size, spec.size))
+        plist, hs = [], []
         for i in range(spec.size):
             th = theta.copy()
             h = steps[i] * 0.5 if theta[i] + steps[i] * 0.5 <= hi[i] else -steps[i] * 0.5
             th[i] += h
-            J[:, i] = (pb.resid(_sim_params(spec, th), m).ravel() - r) / h
+            plist.append(_sim_params(spec, th))
+            hs.append(h)
+        for i, y in enumerate(simulate_many(pb, plist, m, workers)):
+            J[:, i] = (((pb.y[m] - y) / pb.sigma * pb.weight).ravel() - r) / hs[i]
         g, A = J.T @ r, J.T @ J
         improved = False
         for _ in range(3):
@@ -371,8 +466,7 @@ def confirm(
     cand = candidates if candidates is not None else sorted([h for h in hyps if h.testable], key=lambda h: -h.dbic_lin)
     cand = cand[: cfg.top_k] if candidates is None else cand
     e0_seg = np.sum(r0[pb.held] ** 2, axis=(1, 2))
-    for hyp in cand:
-        theta, r, J = _lm(pb, hyp, cfg)
+    for hyp, (theta, r, J) in zip(cand, _fit_all(pb, cand, cfg), strict=True):
         n, k = r.size, hyp.spec.size
         rss0, rss1 = float(np.sum(r0[pb.train] ** 2)), float(r @ r)
         n_eff = effective_samples(r.reshape(r0[pb.train].shape))

@@ -42,6 +42,12 @@ def _parser() -> argparse.ArgumentParser:
         help="how the pelvis was held, overriding the run metadata's 'support': free (on its own feet) or gantry / "
         "fixed (pelvis welded in place, only the joints move)",
     )
+    p.add_argument(
+        "--workers",
+        type=int,
+        default=2,
+        help="processes for independent replays and fits (results do not depend on it; default 2)",
+    )
     p.add_argument("--no-plots", action="store_true", help="skip matplotlib plots")
     return p
 
@@ -91,8 +97,12 @@ def main(argv: list[str] | None = None) -> int:
     except ValueError as exc:  # a misspelt --ground or a --horizon below 1 sample
         console.print(f"[red]--{exc}")
         return 2
+    if args.workers < 1:
+        console.print(f"[red]error:[/] --workers {args.workers}: give at least 1 process. Nothing was analysed.")
+        return 2
     cfg = AnalysisCfg(replay=replay)
     cfg.attribution.effects = effects
+    cfg.attribution.workers = args.workers
     with Progress(console=console) as prog:
         task = prog.add_task("mismatch", total=1.0)
         res = analyze(rec, cfg, lambda msg, f: prog.update(task, completed=f, description=msg))

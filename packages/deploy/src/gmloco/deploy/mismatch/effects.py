@@ -19,9 +19,11 @@ import numpy as np
 from gmloco.deploy.logs.g1 import G1_JOINT_NAMES
 
 __all__ = [
+    "BACKLASH_GROUPS",
     "EFFECTS",
     "EFFECT_IDS",
     "LEG_JOINTS",
+    "LIMB_LINKS",
     "OUTCOME_IDS",
     "EffectSpec",
     "ParamSpec",
@@ -33,6 +35,12 @@ __all__ = [
 
 LEG_JOINTS: tuple[str, ...] = G1_JOINT_NAMES[:12]
 """Joints carrying per-joint effect parameters (encoder offsets): the two legs, hip to ankle."""
+
+LIMB_LINKS: tuple[str, ...] = ("left_hip_yaw_link", "right_hip_yaw_link", "left_knee_link", "right_knee_link")
+"""Bodies carrying limb-mass parameters: the thighs (hip-yaw links) and shanks (knee links)."""
+
+BACKLASH_GROUPS: tuple[str, ...] = ("hip", "knee", "ankle")
+"""Leg-joint groups sharing one backlash width (both legs)."""
 
 OUTCOME_IDS: tuple[str, ...] = ("none", "unexplained")
 """Report outcomes that are not effects: nothing missing, or something outside the library."""
@@ -84,6 +92,9 @@ class EffectSpec:
     """Effect ids with similar signatures."""
     excitation: str
     """What a recording needs for the effect to be testable."""
+    ground: bool = False
+    """Whether it acts only through ground contact: on a held pelvis (gantry, fixed), whose replay touches
+    nothing, its sensitivity is exactly zero and screening skips its replays."""
 
     @property
     def size(self) -> int:
@@ -250,6 +261,100 @@ EFFECTS: tuple[EffectSpec, ...] = (
         "Standing or stance phases.",
     ),
     EffectSpec(
+        "actuator.torque_limit",
+        "Static torque limit",
+        (
+            ParamSpec(
+                "limit_loss",
+                "1",
+                1,
+                0.0,
+                0.9,
+                0.3,
+                0.05,
+                "Fraction of the nominal effort limit the motor cannot deliver, at any speed.",
+            ),
+        ),
+        "|tau| <= (1 - s) tau_max (1 - droop |dq|): a lower peak torque (driver current limit, supply voltage), "
+        "beside the speed droop of actuator.torque_speed. A threshold effect: zero sensitivity where torques stay "
+        "below (1 - s) tau_max, so the finite-difference probe is large (30 %).",
+        "tau_est flat-topped at the same level at every speed; tracking error grows only while the PD torque is high.",
+        ("stance", "liftoff", "swing", "any"),
+        _A,
+        ("actuator.torque_speed", "actuator.gain_scale"),
+        "PD torques above ~70 % of the effort limit (push-off, deep squats, fast chirps).",
+    ),
+    EffectSpec(
+        "joint.coulomb_friction_leg",
+        "Per-joint Coulomb friction (legs)",
+        (ParamSpec("tau_c", "N*m", 12, 0.0, 6.0, 0.3, 0.3, "Dry friction of each leg joint, not scaled.", LEG_JOINTS),),
+        "Dry friction tau_c_j on each leg joint (MuJoCo frictionloss), added to joint.coulomb_friction's profile.",
+        "Steps in the motion residual of one joint at its velocity reversals.",
+        ("swing", "any"),
+        ("q", "dq", "gyro", "acc"),
+        ("joint.coulomb_friction", "joint.viscous_damping_leg", "actuator.backlash"),
+        "Velocity reversals of every leg joint (chirps, stepping).",
+    ),
+    EffectSpec(
+        "joint.viscous_damping_leg",
+        "Per-joint viscous damping (legs)",
+        (ParamSpec("b", "N*m*s/rad", 12, -0.5, 4.0, 0.15, 0.15, "Damping of each leg joint, not scaled.", LEG_JOINTS),),
+        "tau_f,j = -b_j dq_j on each leg joint (MuJoCo dof_damping), added to joint.viscous_damping's profile.",
+        "Motion residual ~ dq of one joint; tau_est unchanged.",
+        ("swing", "any"),
+        ("q", "dq", "gyro", "acc"),
+        ("joint.viscous_damping", "joint.coulomb_friction_leg"),
+        "Speeds of every leg joint well above the encoder noise (chirps, swing).",
+    ),
+    EffectSpec(
+        "actuator.backlash",
+        "Gear backlash / position dead zone",
+        (
+            ParamSpec(
+                "width",
+                "rad",
+                3,
+                0.0,
+                0.06,
+                0.006,
+                0.006,
+                "Dead-band width of the position loop, per leg-joint group (both legs).",
+                BACKLASH_GROUPS,
+            ),
+        ),
+        "The motor PD sees the position error through a dead band: e' = e - clip(e, -w/2, w/2) (lost motion of "
+        "the gear as the motor controller sees it).",
+        "Tracking error up to w/2 that the PD does not correct; softer joints at small amplitude, flat tau_est there.",
+        ("swing", "stance", "any"),
+        _A,
+        ("actuator.gain_scale", "joint.coulomb_friction_leg"),
+        "Small and large tracking errors on the leg joints (chirps, standing sway).",
+    ),
+    EffectSpec(
+        "body.limb_mass",
+        "Limb mass error",
+        (
+            ParamSpec(
+                "delta_mass",
+                "kg",
+                4,
+                -1.0,
+                3.0,
+                0.3,
+                0.3,
+                "Mass added at the centre of mass of each thigh and shank.",
+                ("left_thigh", "right_thigh", "left_shank", "right_shank"),
+            ),
+        ),
+        "m_link += dm at the link's centre of mass, inertia scaled with mass (thighs: hip-yaw links, shanks: knee "
+        "links).",
+        "Gravity and inertia torques of one leg: swing-leg tracking, stance hip/knee torques, chirp amplitude.",
+        ("swing", "stance", "any"),
+        _A,
+        ("body.mass_error", "joint.armature"),
+        "Leg swings or chirps (inertia), any loaded posture (gravity).",
+    ),
+    EffectSpec(
         "terrain.stiffness_scale",
         "Ground stiffness / packing scale (zeta)",
         (ParamSpec("zeta", "1", 1, -0.9, 8.0, 0.3, 0.3, "Added depth-linear stress zeta * alpha_ref * z."),),
@@ -259,6 +364,7 @@ EFFECTS: tuple[EffectSpec, ...] = (
         ("q", "dq", "tau_est", "acc"),
         ("body.mass_error", "terrain.depth_hardening"),
         "Stance phases; sinkage itself needs external sensing.",
+        ground=True,
     ),
     EffectSpec(
         "terrain.depth_hardening",
@@ -270,6 +376,7 @@ EFFECTS: tuple[EffectSpec, ...] = (
         ("q", "dq", "tau_est", "acc"),
         ("terrain.stiffness_scale",),
         "A range of sinkage depths (varying load).",
+        ground=True,
     ),
     EffectSpec(
         "terrain.rate_drag",
@@ -281,6 +388,7 @@ EFFECTS: tuple[EffectSpec, ...] = (
         ("q", "dq", "tau_est", "acc"),
         ("joint.armature",),
         "Touchdowns at varied speeds.",
+        ground=True,
     ),
     EffectSpec(
         "terrain.cohesion",
@@ -292,6 +400,7 @@ EFFECTS: tuple[EffectSpec, ...] = (
         ("q", "dq", "tau_est", "acc"),
         ("terrain.stiffness_scale", "body.mass_error"),
         "Lift-offs (stepping).",
+        ground=True,
     ),
 )
 """The library, in report order."""

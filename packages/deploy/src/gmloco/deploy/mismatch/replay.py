@@ -19,7 +19,7 @@ from typing import Any
 import numpy as np
 
 from gmloco.deploy.mismatch.baseest import BaseEstCfg, BaseTrajectory, estimate_base, odometry_base, welded_base
-from gmloco.deploy.mismatch.effects import EFFECTS, effect
+from gmloco.deploy.mismatch.effects import BACKLASH_GROUPS, EFFECTS, LIMB_LINKS, effect
 from gmloco.deploy.mismatch.frames import quat_conj, quat_from_roll_pitch, quat_mul, quat_to_mat
 from gmloco.deploy.mismatch.g1model import G1_ARMATURE, G1_EFFORT_LIMIT, SOLE_POINTS, G1SimCfg, build_model
 from gmloco.deploy.mismatch.recording import Recording
@@ -181,8 +181,13 @@ class _Hyp:
     delay: float
     gain: float
     droop: float
+    limit: float
     tau_c: float
     b: float
+    tau_c_leg: np.ndarray
+    b_leg: np.ndarray
+    backlash: np.ndarray
+    limb_mass: np.ndarray
     arm_scale: float
     offset: np.ndarray
     gyro_bias: np.ndarray
@@ -190,6 +195,20 @@ class _Hyp:
     dmass: float
     terrain: TerrainParams
     rmis_t: np.ndarray
+
+
+_BACKLASH_INDEX = np.array(
+    [next(i for i, g in enumerate(BACKLASH_GROUPS) if g in n) for n in ("hip_pitch", "hip_roll", "hip_yaw", "knee",
+     "ankle_pitch", "ankle_roll") * 2]
+)  # fmt: skip
+"""Backlash group of each leg joint (``G1_JOINT_NAMES[:12]`` order: six joints per leg)."""
+
+
+def _leg(x: np.ndarray) -> np.ndarray:
+    """Pad 12 leg-joint values to the 29 joints (zeros for waist and arms)."""
+    out = np.zeros(29)
+    out[:12] = x
+    return out
 
 
 def _unpack(params: dict[str, np.ndarray]) -> _Hyp:
@@ -201,8 +220,13 @@ def _unpack(params: dict[str, np.ndarray]) -> _Hyp:
         delay=float(p["actuator.delay"]["delay"][0]),
         gain=1.0 + float(p["actuator.gain_scale"]["kp_scale"][0]),
         droop=float(p["actuator.torque_speed"]["droop"][0]),
+        limit=1.0 - float(p["actuator.torque_limit"]["limit_loss"][0]),
         tau_c=float(p["joint.coulomb_friction"]["tau_c"][0]),
         b=float(p["joint.viscous_damping"]["b"][0]),
+        tau_c_leg=_leg(p["joint.coulomb_friction_leg"]["tau_c"]),
+        b_leg=_leg(p["joint.viscous_damping_leg"]["b"]),
+        backlash=_leg(p["actuator.backlash"]["width"][_BACKLASH_INDEX]),
+        limb_mass=p["body.limb_mass"]["delta_mass"],
         arm_scale=float(p["joint.armature"]["scale"][0]),
         offset=off,
         gyro_bias=p["imu.gyro_bias"]["bias"],
@@ -265,6 +289,9 @@ class Replayer:
         self._pelvis = m.body("pelvis").id
         self._mass0 = float(m.body_mass[self._torso])
         self._inertia0 = m.body_inertia[self._torso].copy()
+        self._limbs = np.array([m.body(n).id for n in LIMB_LINKS])
+        self._limb_mass0 = m.body_mass[self._limbs].copy()
+        self._limb_inertia0 = m.body_inertia[self._limbs].copy()
         self._feet = [m.body(f"{s}_ankle_roll_link").id for s in ("left", "right")]
         self._w = G1_EFFORT_LIMIT / _REF_EFFORT
         self.offsets = np.arange(self.cfg.stride, self.cfg.horizon + 1, self.cfg.stride)
@@ -379,9 +406,9 @@ class Replayer:
 
     @staticmethod
     def _load_key(h: _Hyp) -> tuple[float, ...]:
-        """Parameters that change the static sinkage (terrain laws, body mass)."""
+        """Parameters that change the static sinkage (terrain laws, body and limb masses)."""
         t = h.terrain
-        return tuple(round(float(v), 9) for v in (t.zeta, t.kappa, t.cohesion, h.dmass))
+        return tuple(round(float(v), 9) for v in (t.zeta, t.kappa, t.cohesion, h.dmass, *h.limb_mass))
 
     def _static_sinkage(self, h: _Hyp) -> float:
         """Sinkage of the lowest sole points of the G1 standing straight under hypothesis ``h`` [m] (cached).
@@ -425,9 +452,12 @@ class Replayer:
 
         m = self.model
         m.dof_armature[self._jv] = G1_ARMATURE * (1.0 + h.arm_scale)
-        m.dof_frictionloss[self._jv] = h.tau_c * self._w
+        m.dof_frictionloss[self._jv] = h.tau_c * self._w + h.tau_c_leg
         m.body_mass[self._torso] = self._mass0 + h.dmass
         m.body_inertia[self._torso] = self._inertia0 * (self._mass0 + h.dmass) / self._mass0
+        limb = self._limb_mass0 + h.limb_mass
+        m.body_mass[self._limbs] = limb
+        m.body_inertia[self._limbs] = self._limb_inertia0 * (limb / self._limb_mass0)[:, None]
         mujoco.mj_setConst(m, self.data)
 
     def _commands(self, k0: int, delay: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -501,7 +531,7 @@ class Replayer:
         k = seg.k0 + j
         kp, kd = r.kp[k], r.kd[k]
         # Damping enters qfrc_passive in mj_step1 and the implicit Euler update in mj_step2: set it first.
-        m.dof_damping[self._jv] = h.gain * kd + h.b * self._w
+        m.dof_damping[self._jv] = h.gain * kd + h.b * self._w + h.b_leg
         if seg.pelvis_quat is not None:  # segments share the model: put this segment's welded pelvis in place
             m.body_quat[self._pelvis] = seg.pelvis_quat
         mujoco.mj_step1(m, d)
@@ -509,8 +539,12 @@ class Replayer:
             seg.w_imu = d.qvel[3:6].copy()  # angular velocity the gyro sensor saw
         seg.qm = d.qpos[self._jq] + h.offset
         v = d.qvel[self._jv]
-        tau = h.gain * (kp * (seg.qc[j] - seg.qm) + kd * (seg.dqc[j] - v)) + seg.tff[j]
-        lim = G1_EFFORT_LIMIT if h.droop == 0.0 else G1_EFFORT_LIMIT * np.clip(1.0 - h.droop * np.abs(v), 0.0, None)
+        err = seg.qc[j] - seg.qm
+        if h.backlash.any():  # dead band of the position loop; at zero width the error passes unchanged
+            err = err - np.clip(err, -0.5 * h.backlash, 0.5 * h.backlash)
+        tau = h.gain * (kp * err + kd * (seg.dqc[j] - v)) + seg.tff[j]
+        lim = G1_EFFORT_LIMIT if h.limit == 1.0 else h.limit * G1_EFFORT_LIMIT
+        lim = lim if h.droop == 0.0 else lim * np.clip(1.0 - h.droop * np.abs(v), 0.0, None)
         seg.tau = np.clip(tau, -lim, lim)
         # The -kd*dq part is integrated implicitly through dof_damping (Euler integrator), so add it back.
         d.qfrc_applied[self._jv] = seg.tau + h.gain * kd * v
@@ -520,7 +554,7 @@ class Replayer:
         import mujoco
 
         m, d = self.model, seg.d
-        m.dof_damping[self._jv] = h.gain * self.rec.kd[seg.k0 + j] + h.b * self._w
+        m.dof_damping[self._jv] = h.gain * self.rec.kd[seg.k0 + j] + h.b * self._w + h.b_leg
         mujoco.mj_step2(m, d)
         if out is None:
             return

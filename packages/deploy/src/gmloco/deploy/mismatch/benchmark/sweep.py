@@ -34,8 +34,10 @@ def run_episode(
 ) -> dict:
     """Generate, analyse and score-prepare one episode; returns a JSON-ready row.
 
-    ``effects`` limits the tool's screening to a subset of the library (quick checks); None screens all.
+    ``effects`` limits the tool's screening to a subset of the library (quick checks); None screens all. An
+    episode with ``support`` gantry or fixed and ``chirp`` true is the in-air chirp stage (pelvis held).
     """
+    from gmloco.deploy.mismatch.benchmark.chirp import ChirpCfg
     from gmloco.deploy.mismatch.benchmark.generator import EpisodeCfg, generate
     from gmloco.deploy.mismatch.benchmark.policy_motion import motion_cfg
     from gmloco.deploy.mismatch.benchmark.truth import TruthEffect
@@ -57,6 +59,8 @@ def run_episode(
                 material=ep.get("material", "dry_sand"),
                 policy=motion_cfg(ep.get("motion", "walk")) if ep.get("policy") else None,
                 odometry=bool(ep.get("odometry", False)),
+                support=ep.get("support", "free"),
+                chirp=ChirpCfg() if ep.get("chirp") else None,
             )
         )
     except RuntimeError as exc:

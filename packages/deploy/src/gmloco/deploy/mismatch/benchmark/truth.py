@@ -63,6 +63,17 @@ def truth_spec_edit(e: TruthEffect, rng: np.random.Generator, nuisance: bool) ->
             pay.explicitinertial = True
             if dm < 0:
                 torso.mass = torso.mass + dm
+        if e.id == "body.limb_mass":
+            # a point mass at each link's centre of mass (thighs: hip-yaw links, shanks: knee links)
+            links = ("left_hip_yaw_link", "right_hip_yaw_link", "left_knee_link", "right_knee_link")
+            for name, dm in zip(links, e.params["delta_mass"], strict=True):
+                b = spec.body(name)
+                if dm > 0:
+                    extra = b.add_body(name=f"{name}_extra", pos=list(b.ipos))
+                    extra.mass, extra.inertia, extra.explicitinertial = float(dm), [1e-5] * 3, True
+                elif dm < 0:
+                    ratio = (b.mass + float(dm)) / b.mass
+                    b.mass, b.inertia = b.mass * ratio, [v * ratio for v in b.inertia]
         if e.id == "ool.shank_length":
             for side in ("left", "right"):
                 b = spec.body(f"{side}_ankle_pitch_link")
@@ -85,8 +96,14 @@ class TruthActuator:
         w = effort / 88.0
         self.tau_c = float(_p(e, "joint.coulomb_friction", "tau_c")[0]) * w
         self.b = float(_p(e, "joint.viscous_damping", "b")[0]) * w
+        self.tau_c[:12] += _p(e, "joint.coulomb_friction_leg", "tau_c", 12)
+        self.b[:12] += _p(e, "joint.viscous_damping_leg", "b", 12)
         self.droop = float(_p(e, "actuator.torque_speed", "droop")[0])
-        self.effort = effort
+        self.effort = effort * (1.0 - float(_p(e, "actuator.torque_limit", "limit_loss")[0]))
+        half = 0.5 * _p(e, "actuator.backlash", "width", 3)
+        # hip pitch/roll/yaw, knee, ankle pitch/roll per leg -> groups hip, knee, ankle
+        self.backlash_half = np.zeros(29)
+        self.backlash_half[:12] = np.tile(half[[0, 0, 0, 1, 2, 2]], 2)
         self.lag = float(e.params["tau_lag"][0]) if e.id == "ool.current_lag" else 0.0
         self.tau_prev = np.zeros(29)
 
@@ -94,7 +111,9 @@ class TruthActuator:
         """Torque the motor produces this physics step (what tau_est reports) [N*m], shape [29]."""
         self.fifo.append(cmd)
         q_t, dq_t, kp, kd, tff = self.fifo[0]
-        tau = self.gain * (kp * (q_t - q_enc) + kd * (dq_t - dq_enc)) + tff
+        e = q_t - q_enc
+        e = np.sign(e) * np.maximum(np.abs(e) - self.backlash_half, 0.0)  # dead band of the position loop
+        tau = self.gain * (kp * e + kd * (dq_t - dq_enc)) + tff
         if self.lag > 0:  # first-order current loop (out of library)
             tau = self.tau_prev + (tau - self.tau_prev) * min(1.0, self.dt / self.lag)
         env = self.effort * np.maximum(0.0, 1.0 - self.droop * np.abs(dq_enc))  # DC-motor envelope

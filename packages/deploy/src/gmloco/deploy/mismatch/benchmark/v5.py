@@ -1,0 +1,222 @@
+# SPDX-License-Identifier: Apache-2.0
+"""Benchmark v5: three suites (plane stepping, sand composite walking, fixed-base chirp), pre-registered.
+
+The protocol is ``results/mismatch_benchmark/v5/protocol.md``; this module is its runner. Usage::
+
+    python -m gmloco.deploy.mismatch.benchmark.v5 --out results/mismatch_benchmark/v5 --suite fixed
+        [--workers N] [--part I/N] [--resume] [--deadline-s S] [--list] [--score-only]
+
+Every suite has two seeds per library class at mid strength, two per out-of-library class and
+``NULLS_PER_SUITE`` nulls. The seeds are fixed here (``SEED_BASE``) and fresh: no earlier benchmark, floor
+calibration or tuning run used them. Rows go to ``OUT/<suite>/rows``; ``OUT/<suite>/summary.json`` scores one
+suite and ``OUT/summary_pooled.json`` pools every class of every suite scored so far.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import sys
+import time
+from multiprocessing import Pool
+from pathlib import Path
+
+import numpy as np
+
+from gmloco.deploy.mismatch.benchmark.episodes import MID, OOL, SAND_MID_V4, SAND_OOL
+
+__all__ = ["FIXED_MID_V5", "NEW_MID_V5", "NULLS_PER_SUITE", "SEED_BASE", "SUITES", "TARGETS", "suite_episodes"]
+
+_LEG = 12
+_KNEE_L, _HIP_PITCH_R, _ANKLE_PITCH_R = 3, 6, 10  # leg-joint indices (G1_JOINT_NAMES order)
+
+
+def _leg(values: dict[int, float]) -> list[float]:
+    """A 12-vector over the leg joints, zero except at the given indices."""
+    out = [0.0] * _LEG
+    for i, v in values.items():
+        out[i] = v
+    return out
+
+
+NEW_MID_V5: dict[str, dict[str, list[float]]] = {
+    "actuator.torque_limit": {"limit_loss": [0.4]},
+    "actuator.backlash": {"width": [0.0, 0.02, 0.0]},
+    "body.limb_mass": {"delta_mass": [0.0, 0.0, 1.0, 0.0]},
+    "joint.coulomb_friction_leg": {"tau_c": _leg({_KNEE_L: 2.0, _ANKLE_PITCH_R: 1.0})},
+    "joint.viscous_damping_leg": {"b": _leg({_KNEE_L: 1.0, _HIP_PITCH_R: 0.6})},
+}
+"""Mid strengths of the classes v5 adds (every component that is set is >= 1.5x its tolerance, v4's rule):
+a 40 % lower peak torque, 0.02 rad knee backlash, +1 kg on the left shank, left-knee / right-ankle-pitch dry
+friction 2 / 1 N*m, left-knee / right-hip-pitch damping 1 / 0.6 N*m*s/rad."""
+
+FIXED_MID_V5: dict[str, dict[str, list[float]]] = {
+    **{k: v for k, v in MID.items() if not k.startswith("terrain.")},
+    **NEW_MID_V5,
+}
+"""Fixed-base chirp suite: every library class that can act on a held robot (no terrain class)."""
+
+SUITES: dict[str, dict] = {
+    "plane": {
+        "mid": {**MID, **NEW_MID_V5},
+        "ool": OOL,
+        "episode": {"duration": 9.0},
+    },
+    "sand": {
+        "mid": {**SAND_MID_V4, **NEW_MID_V5},
+        "ool": SAND_OOL,
+        "episode": {
+            "duration": 18.0,
+            "ground": "sand",
+            "material": "dry_sand",
+            "policy": True,
+            "odometry": True,
+            "motion": "composite",
+        },
+    },
+    "fixed": {
+        "mid": FIXED_MID_V5,
+        "ool": OOL,
+        "episode": {"duration": 9.0, "support": "gantry", "chirp": True},
+    },
+}
+"""Per suite: mid-strength table, out-of-library classes, and the episode fields every episode carries."""
+
+SEED_BASE: dict[str, int] = {"plane": 51000, "sand": 52000, "fixed": 53000}
+"""First seed of each suite; classes take ``base + 10 i + s``, out-of-library ``base + 500 + 10 j + s``, nulls
+``base + 900 + n``. Fresh: every earlier benchmark and calibration seed is below 30000."""
+
+SEEDS_PER_CLASS = 2
+"""Seeds per library and out-of-library class."""
+NULLS_PER_SUITE = 20
+"""Null episodes per suite (the false-positive rate's denominator)."""
+
+TARGETS: dict[str, float] = {
+    "top1_pooled": 0.8,
+    "false_positive_max": 0.05,
+    "ool_unexplained": 0.8,
+}
+"""Pre-registered targets; interval coverage is reported without a target."""
+
+
+def suite_episodes(suite: str) -> list[dict]:
+    """Episode dicts of one suite, in a fixed order (``sweep.run_episode`` input)."""
+    if suite not in SUITES:
+        raise ValueError(f"unknown suite {suite!r}; suites: {sorted(SUITES)}")
+    cfg, base = SUITES[suite], SEED_BASE[suite]
+    eps = []
+    for i, (eid, p) in enumerate(cfg["mid"].items()):
+        for s in range(SEEDS_PER_CLASS):
+            eps.append({"name": f"{suite}-{eid}-{s}", "effect": eid, "params": p, "strength": "mid",
+                        "seed": base + 10 * i + s})  # fmt: skip
+    for j, (eid, p) in enumerate(cfg["ool"].items()):
+        for s in range(SEEDS_PER_CLASS):
+            eps.append({"name": f"{suite}-{eid}-{s}", "effect": eid, "params": p, "strength": "mid",
+                        "seed": base + 500 + 10 * j + s})  # fmt: skip
+    for n in range(NULLS_PER_SUITE):
+        eps.append({"name": f"{suite}-none-{n}", "effect": "none", "params": {}, "strength": "none",
+                    "seed": base + 900 + n})  # fmt: skip
+    return [{**e, **cfg["episode"], "suite": suite} for e in eps]
+
+
+def pooled(rows_by_suite: dict[str, list[dict]]) -> dict:
+    """Pooled scores over every (suite, class): top-1 macro, null false positives, out-of-library, coverage."""
+    from gmloco.deploy.mismatch.benchmark.scorer import score
+
+    top1, cover, fp, ool, per_suite = [], [], [], [], {}
+    for suite, rows in rows_by_suite.items():
+        sc = score(rows)
+        per_suite[suite] = sc["overall"]
+        for k, v in sc["per_effect"].items():
+            if k.endswith("@mid") and not k.startswith("ool.") and v.get("top1") is not None:
+                top1.append(v["top1"])
+            if v.get("coverage") is not None:
+                cover.append(v["coverage"])
+        fp += [r["verdict"] != "no_mismatch" for r in rows if r.get("effect") == "none" and "verdict" in r]
+        ool += [
+            r["verdict"] == "unexplained" for r in rows if r.get("effect", "").startswith("ool.") and "verdict" in r
+        ]
+    out = {
+        "classes": len(top1),
+        "top1_pooled": float(np.mean(top1)) if top1 else None,
+        "null_episodes": len(fp),
+        "false_positive_rate": float(np.mean(fp)) if fp else None,
+        "ool_episodes": len(ool),
+        "ool_unexplained": float(np.mean(ool)) if ool else None,
+        "ci_coverage": float(np.mean(cover)) if cover else None,
+        "targets": TARGETS,
+    }
+    out["met"] = {
+        "top1_pooled": out["top1_pooled"] is not None and out["top1_pooled"] >= TARGETS["top1_pooled"],
+        "false_positive": out["false_positive_rate"] is not None
+        and out["false_positive_rate"] <= TARGETS["false_positive_max"],
+        "ool_unexplained": out["ool_unexplained"] is not None and out["ool_unexplained"] >= TARGETS["ool_unexplained"],
+    }
+    return {"pooled": out, "per_suite": per_suite}
+
+
+def _rows(d: Path) -> list[dict]:
+    """Rows already written under ``d/rows``."""
+    return [json.loads(f.read_text()) for f in sorted((d / "rows").glob("*.json"))]
+
+
+def _write_json(path: Path, obj: dict) -> None:
+    """Write JSON atomically (temporary file, then rename)."""
+    tmp = path.with_name(f".{path.name}.tmp")
+    tmp.write_text(json.dumps(obj, indent=2, default=float))
+    tmp.replace(path)
+
+
+def main(argv: list[str] | None = None) -> int:
+    """Run (part of) one suite, then score it and the pool; exit 2 on bad arguments."""
+    from gmloco.deploy.mismatch.benchmark.sweep import _git_commit, _part, _star
+
+    p = argparse.ArgumentParser(prog="mismatch-benchmark-v5", description=__doc__)
+    p.add_argument("--out", type=Path, required=True, help="v5 results directory (suites go to OUT/<suite>)")
+    p.add_argument("--suite", choices=sorted(SUITES), required=True)
+    p.add_argument("--workers", type=int, default=2)
+    p.add_argument("--part", default=None, help="I/N: episodes at positions I, I+N, ... of the suite's list")
+    p.add_argument("--only", default=None, help="comma-separated episode-name prefixes")
+    p.add_argument("--resume", action="store_true", help="skip episodes whose row exists")
+    p.add_argument("--deadline-s", type=float, default=None, help="start no episode after this many seconds")
+    p.add_argument("--list", action="store_true", help="print the suite's episodes and exit")
+    p.add_argument("--score-only", action="store_true", help="score the rows already written and exit")
+    a = p.parse_args(argv)
+    eps = suite_episodes(a.suite)
+    if a.list:
+        for e in eps:
+            print(e["name"], e["seed"])
+        return 0
+    try:
+        eps = _part(eps, a.part)
+    except ValueError as exc:
+        print(f"error: {exc}. Nothing was run.", file=sys.stderr)
+        return 2
+    if a.only:
+        eps = [e for e in eps if any(e["name"].startswith(s) for s in a.only.split(","))]
+    out = a.out / a.suite
+    if not a.score_only:
+        out.mkdir(parents=True, exist_ok=True)
+        todo = [e for e in eps if not (a.resume and (out / "rows" / f"{e['name']}.json").exists())]
+        t0 = time.time()
+        deadline = None if a.deadline_s is None else t0 + a.deadline_s
+        args = [(e, str(out), e["duration"], None, None, deadline) for e in todo]
+        with Pool(a.workers) as pool:
+            done = pool.map(_star, args, chunksize=1)
+        run = {"suite": a.suite, "argv": argv if argv is not None else sys.argv[1:], "ran": [r["name"] for r in done
+               if "skipped" not in r], "wall_s": time.time() - t0, "cpus": os.cpu_count(), "git": _git_commit()}  # fmt: skip
+        (out / "runs").mkdir(exist_ok=True)
+        _write_json(out / "runs" / f"{time.strftime('%Y%m%dT%H%M%S')}.json", run)
+        print(json.dumps({k: v for k, v in run.items() if k != "ran"} | {"ran": len(run["ran"])}))
+    from gmloco.deploy.mismatch.benchmark.scorer import score
+
+    rows = _rows(out)
+    _write_json(out / "summary.json", {**score(rows), "episodes_scored": len(rows)})
+    by_suite = {s: _rows(a.out / s) for s in SUITES if (a.out / s / "rows").is_dir()}
+    _write_json(a.out / "summary_pooled.json", pooled(by_suite))
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())
