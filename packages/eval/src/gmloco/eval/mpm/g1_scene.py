@@ -26,7 +26,8 @@
   q* = q_0 + action_scale a. One frame (rigid substeps + window + MPM) is one CUDA graph when the grid has a
   fixed capacity (``max_active_cell_count > 0``).
 * Observation: the mjlab velocity-task terms: base angular velocity (pelvis, body frame), projected gravity,
-  command (v_x, v_y, w_z), joint_pos - q_0, joint_vel, last action.
+  command (v_x, v_y, w_z), joint_pos - q_0, joint_vel, last action. The policy gets the pelvis heading too, so
+  a ``yaw_target`` policy observes w_z with the heading correction it was trained with (``g1_eval_policy``).
 """
 
 from __future__ import annotations
@@ -598,7 +599,8 @@ class G1MpmScene:
             st = self._read_state()
             target = self.targets.numpy().astype(np.float64)
             if self.policy is not None:
-                self.last_action = self.policy.act(self.observation_terms(st)).astype(np.float64)
+                heading = quat_wxyz_to_roll_pitch_yaw(st["base_q"][:, [6, 3, 4, 5]])[:, 2]
+                self.last_action = self.policy.act(self.observation_terms(st), heading).astype(np.float64)
                 target = self.spec.default_joint_pos + self.spec.action_scale * self.last_action
                 self.targets.assign(target.astype(np.float32))
             self._log(st, target)
