@@ -54,6 +54,7 @@ def test_perfect_straight_walk_succeeds() -> None:
     assert row["success"] and row["reason"] == "success"
     assert row["finished_at_s"] is not None and row["finished_at_s"] <= 2.0 * (1 - cfg.course_slack) + 1e-9
     assert math.isclose(row["vel_error"], 0.0, abs_tol=1e-12) and math.isclose(row["yaw_error"], 0.0)
+    assert math.isclose(row["heading_error_deg"], 0.0)
     assert row["path_error"] < 0.011  # half a sample spacing at most
     assert math.isclose(row["support_ratio"], 1.0) and math.isclose(row["max_sinkage"], 0.02)
     assert math.isclose(row["mean_sinkage"], 0.02)
@@ -177,7 +178,8 @@ def test_episode_specs_batches_summary_and_tables() -> None:
     # batches of 2: [ds0, ds1], [ds2], [ps0, ps1], [ps2] (a batch never mixes terrains)
     assert [[s.index for s in b] for b in episode_batches(specs, 2)] == [[0, 1], [2], [0, 1], [2]]
     rows = [{"terrain": s.terrain, "scenario": s.scenario, "speed": s.speed, "success": s.index == 0,
-             "vel_error": 0.1 * s.index, "yaw_error": 0.0, "path_error": 0.0, "support_ratio": 1.0,
+             "vel_error": 0.1 * s.index, "heading_error_deg": 3.0, "yaw_error": 0.0, "path_error": 0.0,
+             "support_ratio": 1.0,
              "max_sinkage": 0.01, "mean_sinkage": 0.005, "swing_apex": 0.02 * s.index,
              "swing_lift": float("nan") if s.index else 0.06, "window_exit_early": s.index == 2,
              "window_exit_turn": False}
@@ -186,12 +188,13 @@ def test_episode_specs_batches_summary_and_tables() -> None:
     assert math.isclose(m["all/success_rate"], 1 / 3) and m["all/num_episodes"] == 6
     assert m["all/success_lo95"] < 1 / 3 < m["all/success_hi95"]  # 2 of 6: the Wilson interval holds the rate
     assert math.isclose(m["dry_sand/straight/v1/vel_error"], 0.1) and m["poppy_seed/straight/v2/num_episodes"] == 1
-    # table: dry sand success 1/3 = 33.3 %, velocity error mean(0, 0.1, 0.2) = 0.1 m/s, sinkage 0.5 cm, swing apex
+    # table: dry sand success 1/3 = 33.3 %, velocity error mean(0, 0.1, 0.2) = 0.1 m/s, heading error 3 degrees,
+    # sinkage 0.5 cm, swing apex
     # mean(0, 2, 4) = 2 cm, lift 6 cm (episodes without a finished swing, NaN, are left out of the mean); one of
     # the three episodes had a sole outside its sand window early: 33.3 %, not by a turn: 0 %, not with a fall: 0 %
     t = table_terrains(rows, "p")
     assert t[0][:4] == ["p", "dry_sand", "straight", 3]
-    np.testing.assert_allclose(t[0][4:5] + t[0][7:], [100 / 3, 0.1, 0.0, 0.0, 0.5, 2.0, 6.0, 100 / 3, 0.0, 0.0])
+    np.testing.assert_allclose(t[0][4:5] + t[0][7:], [100 / 3, 0.1, 3.0, 0.0, 0.0, 0.5, 2.0, 6.0, 100 / 3, 0.0, 0.0])
     assert math.isclose(m["all/window_exit_early"], 1 / 3)
     assert t[0][5] < 100 / 3 < t[0][6]  # the 95 % interval of 1 success in 3 episodes holds the rate
     header, body = table_speeds(rows)

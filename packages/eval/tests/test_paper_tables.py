@@ -114,6 +114,9 @@ def test_summary_file_holds_the_rows_as_records(tmp_path: Path) -> None:
     assert summary["rows"][0]["success_rate_pct"] == pytest.approx(75.0)
     assert summary["speed_rows"][0]["v=1 m/s"] == pytest.approx(100.0)
     assert summary["speed_rows"][0]["v=2 m/s"] == pytest.approx(50.0)
+    cell = summary["paper_metrics"]["td"]["dry_sand"]["straight"]  # the paper's keys per (policy, terrain, scenario)
+    assert set(cell) == {"success_pct", "vel_error_mps", "heading_error_deg", "path_error_m", "episodes"}
+    assert cell["success_pct"] == pytest.approx(75.0) and cell["episodes"] == summary["rows"][0]["episodes"]
     assert json.loads((out / "tables.json").read_text())["rows"] == summary["rows"]
 
 

@@ -12,8 +12,10 @@ with :mod:`gmloco.eval.metrics.locomotion`:
   in ``episode_s``. The course is the commanded path (``circular_path``); it counts as finished once the nearest
   commanded sample to the base (searched forwards only) is past ``1 - course_slack`` of the path (a project
   choice: the paper gives no tolerance, and an exact v T lets no lag through).
-* velocity tracking error: mean |v_xy - v_cmd| in the yaw frame over alive steps; yaw tracking error: mean
-  |w_z - w_cmd| over alive steps; path error: DTW between executed and commanded xy paths (alive part).
+* velocity tracking error: mean |v_xy - v_cmd| in the yaw frame over alive steps; heading error (the paper's yaw
+  tracking error, ``heading_error_deg``): mean |wrap(psi - psi_cmd)| in degrees over alive steps, psi_cmd the start
+  heading plus the commanded w_z integrated; yaw-rate error (``yaw_error``, an extra column): mean |w_z - w_cmd|
+  [rad/s]; path error: DTW between executed and commanded xy paths (alive part).
 * swing clearance: mean apex of the completed swings above the local surface and their lift above the stance
   before (``swing_clearance``: a foot is in swing while its sand force is below 40 N).
 * window size needed: ``sole_behind_m`` / ``sole_ahead_m`` / ``sole_side_m``, the soles' largest reach from the
@@ -52,6 +54,7 @@ from gmloco.eval.metrics.locomotion import (
     circular_path,
     course_finished_at,
     episode_outcome,
+    metric_heading_error_deg,
     metric_path_error,
     metric_velocity_tracking_error,
     metric_yaw_tracking_error,
@@ -502,6 +505,7 @@ def score_episode(spec: EpisodeSpec, cfg: G1EvalCfg, log: dict[str, Any]) -> dic
         "success": out.success, "reason": out.reason, "alive_s": out.alive_steps * dt,
         "finished_at_s": finished_at,
         "vel_error": metric_velocity_tracking_error(np.tile([v, 0.0], (len(q), 1)), v_yaw, alive),
+        "heading_error_deg": metric_heading_error_deg(yaw, wz, dt, alive),
         "yaw_error": metric_yaw_tracking_error(np.full(len(q), wz), qd[:, 5], alive),
         "path_error": metric_path_error(q[:alive, :2], cmd_xy),
         "support_ratio": float(fz[len(fz) // 2 :].mean() / (log["robot_mass"] * 9.81)),
@@ -660,7 +664,7 @@ def _runs(mask: np.ndarray) -> list[tuple[int, int]]:
 
 
 METRIC_KEYS = (
-    "success", "vel_error", "yaw_error", "path_error", "support_ratio", "max_sinkage", "mean_sinkage", "floor_reached",
+    "success", "vel_error", "heading_error_deg", "yaw_error", "path_error", "support_ratio", "max_sinkage", "mean_sinkage", "floor_reached",
     "swing_apex", "swing_lift", "eta_mean", "window_exit_early", "window_exit_turn", "heading_turn_deg",
     "sole_behind_m", "sole_ahead_m", "sole_side_m",
 )  # fmt: skip
@@ -982,7 +986,10 @@ def write_outputs(
         figures, note = (write_figures(rows, out, policy, cfg.episode_s, run_dirs) if rows else []), ""
     except ImportError as exc:
         figures, note = [], f"figures skipped: {exc}"
+    from gmloco.eval.tables_mpm import paper_metrics, table_terrains
+
     doc = {"complete": complete, "policy": cfg.policy_path, "cfg": _jsonable(asdict(cfg)), "metrics": summary,
+           "paper_metrics": paper_metrics(table_terrains(rows, policy)),
            "tables": [str(p.name) for p in tables], "figures": [str(p.name) for p in figures],
            "note": note}  # fmt: skip
     tmp = out / "summary.json.tmp"

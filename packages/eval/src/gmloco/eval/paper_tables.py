@@ -20,7 +20,9 @@ tool labels each run's episodes with the policy's name and writes the combined t
   sinkage; straight walks);
 * ``fig_speeds_<terrain>_<scenario>.png``: per cell, the policies' success rate (95 % interval) and median time alive
   against the commanded speed;
-* ``tables.json``: the runs, their common MPM setting, which rows are partial, and the rows as records
+* ``tables.json``: the runs, their common MPM setting, which rows are partial, the paper's metrics per (policy,
+  terrain, scenario) (``paper_metrics``: ``success_pct``, ``vel_error_mps``, ``heading_error_deg``,
+  ``path_error_m``, ``episodes``; ``tables_mpm.paper_metrics``), and the rows as records
   (``--summary FILE`` writes the same to FILE, e.g. ``results/mpm_eval/summary.json``).
 
 A table mixes like with like only: runs whose MPM setting (voxel, iterations, frame, bed, window, episode length,
@@ -91,6 +93,7 @@ def combine(
         ABLATION_COLUMNS,
         TERRAIN_COLUMNS,
         TRANSITION_COLUMNS,
+        paper_metrics,
         table_ablation,
         table_per_terrain,
         table_speeds,
@@ -156,6 +159,7 @@ def combine(
         "window_exit_rows": exits,
         "window_exit_turn_rows": turns,
         "figures": [p.name for p in figures],
+        "paper_metrics": paper_metrics(terrains),
         "rows": [dict(zip((*TERRAIN_COLUMNS, "complete"), row, strict=True)) for row in terrains],
         "speed_rows": [dict(zip(["policy", *table_speeds([], all_speeds)[0]], row, strict=True)) for row in speeds],
     }
