@@ -139,16 +139,34 @@ def test_a_covering_window_grows_only_where_the_soles_reached_past_it() -> None:
     w = covering_window((0.73, 0.13, 0.31), tables, turned=False)
     assert (w.length, w.width, w.lead) == pytest.approx((1.7, 0.8, 0.05))  # rear 0.8, front 0.9 kept, 0.4 beside
     assert 0.5 * w.length - w.lead >= 0.73 and 0.5 * w.length + w.lead == pytest.approx(0.9)
-    w = covering_window((0.45, 0.13, 0.2), tables, turned=True)
+    fixed = replace(tables, turn_with_robot=False)
+    w = covering_window((0.45, 0.13, 0.2), fixed, turned=True)
     assert (w.length, w.width, w.lead) == pytest.approx((1.4, 1.4, 0.2))  # the square of the tables' window
+    assert covering_window((0.45, 0.13, 0.2), tables, turned=True) == tables  # a turning window keeps its shape
     assert covering_window((0.45, 0.13, 0.2), tables, turned=False) == tables
 
 
-def test_a_circle_gets_a_square_moving_window() -> None:
-    """The window does not turn with the robot: on a circle it is max(length, width) square; straight it is as set."""
+def test_one_turning_window_serves_straight_and_circle() -> None:
+    """The default window turns: the circle keeps it, lanes spaced by its diagonal plus twice its lead (any heading).
+
+    1.4 x 0.6 m, lead 0.2 m: hypot = 1.5232 m, + 0.4 = 1.9232 m; the circle adds its 4 m diameter.
+    """
     from gmloco.eval.g1_eval import _window_and_lanes
 
     cfg = G1EvalCfg()
+    straight, lane_s = _window_and_lanes([EpisodeSpec("dry_sand", "straight", 1.0, 0)], cfg)
+    circle, lane_c = _window_and_lanes([EpisodeSpec("dry_sand", "circle", 1.0, 0)], cfg)
+    assert straight == circle == cfg.window and cfg.window.turn_with_robot
+    span = math.hypot(1.4, 0.6) + 0.4
+    assert lane_s == pytest.approx(span + cfg.lane_gap)
+    assert lane_c == pytest.approx(span + 2.0 * cfg.circle_radius + cfg.lane_gap)
+
+
+def test_a_window_on_the_grid_axes_becomes_a_square_on_a_circle() -> None:
+    """A window that does not turn: on a circle it is max(length, width) square; straight it is as set."""
+    from gmloco.eval.g1_eval import _window_and_lanes
+
+    cfg = replace(G1EvalCfg(), window=replace(G1EvalCfg().window, turn_with_robot=False))
     straight, lane_s = _window_and_lanes([EpisodeSpec("dry_sand", "straight", 1.0, 0)], cfg)
     circle, lane_c = _window_and_lanes([EpisodeSpec("dry_sand", "circle", 1.0, 0)], cfg)
     assert (straight.length, straight.width) == (cfg.window.length, cfg.window.width)
@@ -461,7 +479,7 @@ def test_a_share_whose_walk_cannot_end_is_not_built(monkeypatch: pytest.MonkeyPa
 
 
 def test_the_prior_prices_the_cell_build_cell_scene_builds() -> None:
-    """The prior counts the batch's window as the scene sizes it: the circle's square, the terrain's depth."""
+    """The prior counts the batch's window as the scene solves it: the terrain's depth, one window for every walk."""
     from gmloco.eval.g1_eval import _prior_cost
     from gmloco.eval.g1_eval_fit import PRIOR_FRAME_S_AT_ZERO, PRIOR_FRAME_S_PER_MILLION
 
@@ -473,7 +491,9 @@ def test_the_prior_prices_the_cell_build_cell_scene_builds() -> None:
     cost = _prior_cost(straight, cfg)
     assert cost.lanes == 25
     assert cost.frame_s == pytest.approx(PRIOR_FRAME_S_AT_ZERO + PRIOR_FRAME_S_PER_MILLION * 25 * per_lane / 1e6)
-    assert _prior_cost(circle, cfg).frame_s > cost.frame_s  # the square window holds 94 x 94 columns
+    assert _prior_cost(circle, cfg).frame_s == cost.frame_s  # the turning window serves the circle as it is
+    fixed = replace(cfg, window=replace(cfg.window, turn_with_robot=False))
+    assert _prior_cost(circle, fixed).frame_s > cost.frame_s  # a window on the grid's axes: 94 x 94 on a circle
 
 
 def _run_in(cfg: G1EvalCfg, monkeypatch: pytest.MonkeyPatch) -> tuple[dict, bool]:

@@ -24,8 +24,10 @@ with :mod:`gmloco.eval.metrics.locomotion`:
   sand window (no particles there), and ``window_exit_early`` when that was more than ``WINDOW_EXIT_GRACE_S`` before
   the episode ended; its rate is in the summary and the terrain table, and a run warns about it.
   ``window_exit_cause`` says why: ``"turn"`` when the soles were within the window's extent along the robot's
-  heading (the window, a box of the grid's axes, did not turn with it; ``window_exit_turn`` flags such early exits),
-  ``"reach"`` when they stepped beyond it; ``heading_turn_deg`` is the heading's largest turn from its start.
+  heading (a window that does not turn, ``turn_with_robot=False``, was left behind by the robot's turn;
+  ``window_exit_turn`` flags such early exits), ``"reach"`` when they stepped beyond it; ``heading_turn_deg`` is the
+  heading's largest turn from its start. The default window turns with the robot (``SandWindowCfg.turn_with_robot``),
+  so one window serves straight walks, circles and drifting headings alike.
 * decoded stiffness: the student's mean decoded eta over the alive steps; on the layered ``transition`` course
   also per medium, with the swings there (``layer_stats``; ``table_transition``, ``fig_mpm_transition.png``).
 
@@ -62,7 +64,7 @@ from gmloco.eval.metrics.locomotion import (
     swing_clearance,
 )
 from gmloco.eval.mpm.box_scene import MpmSolverCfg
-from gmloco.eval.mpm.window import SandWindowCfg
+from gmloco.eval.mpm.window import SandWindowCfg, reach_within_window
 
 __all__ = [
     "REACH_QUANTILE",
@@ -129,7 +131,8 @@ class G1EvalCfg:
     window: SandWindowCfg = field(default_factory=lambda: SandWindowCfg(length=1.4, width=0.6))
     """Sand window of each robot (``moving=False``: a static bed covering the course, the naive baseline). 1.4 m
     walks as 1.8 m does, 0.6 m wide as 1.0 m does (``docs/mpm_eval.md``); a 1.0 x 0.5 m window was rejected. The
-    window does not turn with the robot: for walks whose heading drifts use a square (length = width)."""
+    window turns with the robot's heading (within ``turn_step``), so straight walks, circles and drifting headings
+    share one setting; ``turn_with_robot=False`` gives the box of the grid's axes the earlier tables used."""
     bed_margin: float = 0.6
     """Static beds: margin around the commanded path [m]."""
     robots_per_batch: int = 32
@@ -235,18 +238,23 @@ def command(spec: EpisodeSpec, cfg: G1EvalCfg) -> tuple[float, float, float]:
 def _window_and_lanes(batch: list[EpisodeSpec], cfg: G1EvalCfg) -> tuple[SandWindowCfg, float]:
     """The batch's sand window and its lane spacing [m].
 
-    A moving window is a box of the sand grid's axes that follows the pelvis (centred ``lead`` along its heading);
-    it does not turn with the robot. On a circle the heading sweeps all directions, so the window becomes a square
-    of side ``max(length, width)``: along any heading it then reaches at least as far as the straight window does
-    along x, at ``(side / width)`` times its cost. A static window covers the fastest course.
+    A moving window follows the pelvis (centred ``lead`` along its heading) and, by default, turns with it: every
+    scenario uses the same window, and the lanes are spaced for any heading (the window's diagonal plus twice its
+    lead). A window that does not turn (``turn_with_robot=False``) becomes a square of side ``max(length, width)``
+    on a circle, whose heading sweeps all directions: along any heading it then reaches at least as far as the
+    straight window does along x, at ``(side / width)`` times its cost. A static window covers the fastest course.
     """
     circle = batch[0].scenario == "circle"
     if cfg.window.moving:
         window = cfg.window
-        if circle:
-            side = max(window.length, window.width)
-            window = replace(window, length=side, width=side)
-        span = window.width + (2.0 * cfg.circle_radius if circle else 0.0)
+        if window.turn_with_robot:
+            span = math.hypot(window.length, window.width) + 2.0 * abs(window.lead)
+        else:
+            if circle:
+                side = max(window.length, window.width)
+                window = replace(window, length=side, width=side)
+            span = window.width
+        span += 2.0 * cfg.circle_radius if circle else 0.0
         return window, span + cfg.lane_gap
     v = max(s.speed for s in batch)
     vx, _, wz = command(replace(batch[0], speed=v), cfg)
@@ -473,9 +481,14 @@ def _cell_sand(specs: list[EpisodeSpec], cfg: G1EvalCfg) -> tuple[Any, SandWindo
 
 
 def _window_particles(window: SandWindowCfg, depth: float, voxel: float) -> int:
-    """Particles of one robot's window (as :class:`SandWindow` sizes it)."""
+    """Particles of one robot's window in the MPM solve: nx ny columns of nz (as :class:`SandWindow` sizes it).
+
+    A turning window holds nx ny columns to within its perimeter's cells (``window_slots`` reserves up to
+    ``sqrt(2) (nx + ny) + 2`` more slots for its worst heading); its free slots are parked, out of the solve.
+    """
     h = voxel / window.particles_per_voxel
-    return math.ceil(window.length / h) * math.ceil(window.width / h) * max(1, round(depth / h))
+    nx, ny = max(1, math.ceil(window.length / h)), max(1, math.ceil(window.width / h))
+    return nx * ny * max(1, round(depth / h))
 
 
 def score_episode(spec: EpisodeSpec, cfg: G1EvalCfg, log: dict[str, Any]) -> dict[str, Any]:
@@ -575,9 +588,9 @@ def window_exit_cause(reach: Any, exit_s: float | None, dt: float, window: SandW
     """Why the soles first left the sand window, from their reach at that sample (``sole_reach``, pelvis yaw frame).
 
     ``"turn"``: they lay within the window's extent measured along the robot's heading (behind, ahead, beside the
-    pelvis, less ``WINDOW_EXIT_MARGIN_M``), so the exit came from the robot turning: the window is a box of the
-    grid's axes and does not turn with it. ``"reach"``: they reached beyond that extent (the window is too short or
-    narrow, or a static bed). None without an exit or without a reach log (older runs).
+    pelvis, less ``WINDOW_EXIT_MARGIN_M``; for a turning window under its worst heading lag), so the exit came from
+    the robot turning away from a window that does not turn with it. ``"reach"``: they reached beyond that extent
+    (the window is too short or narrow, or a static bed). None without an exit or without a reach log (older runs).
     """
     if reach is None or exit_s is None:
         return None
@@ -593,11 +606,10 @@ def window_exit_cause(reach: Any, exit_s: float | None, dt: float, window: SandW
 def reach_fits(reach: tuple[float, float, float], window: SandWindowCfg) -> bool:
     """Whether the soles' reach (behind, ahead, beside the pelvis) [m] lies within the window's extent.
 
-    Measured along the robot's heading, less ``WINDOW_EXIT_MARGIN_M``.
+    Measured along the robot's heading, less ``WINDOW_EXIT_MARGIN_M`` on every side; a turning window may lag the
+    heading by its ``turn_step`` (``window.reach_within_window``).
     """
-    b, a, s = (float(v) + WINDOW_EXIT_MARGIN_M for v in reach)
-    half = 0.5 * window.length
-    return b <= half - window.lead and a <= half + window.lead and s <= 0.5 * window.width
+    return reach_within_window(window, (float(reach[0]), float(reach[1]), float(reach[2])), WINDOW_EXIT_MARGIN_M)
 
 
 def heading_turn_deg(yaw: np.ndarray, alive: int) -> float:
@@ -918,7 +930,8 @@ def covering_window(reach: tuple[float, float, float], window: SandWindowCfg, tu
 
     Each side grows to the reach plus ``WINDOW_SUGGEST_MARGIN_M`` where the reach passed it, rounded up to 5 cm;
     no side shrinks (the convergence check accepted the window's front and rear clearances, not less). With
-    ``turned`` (walks that turned out of it) the window becomes a square of the larger side.
+    ``turned`` (walks that turned out of it) a window that does not turn becomes a square of the larger side; a
+    turning window keeps its shape.
     """
 
     def up(x: float) -> float:
@@ -929,7 +942,7 @@ def covering_window(reach: tuple[float, float, float], window: SandWindowCfg, tu
     front = max(0.5 * window.length + window.lead, up(ahead + WINDOW_SUGGEST_MARGIN_M))
     width = max(window.width, 2.0 * up(side + WINDOW_SUGGEST_MARGIN_M))
     length = rear + front
-    if turned:
+    if turned and not window.turn_with_robot:
         length = width = max(length, width)
     return replace(window, length=round(length, 3), width=round(width, 3), lead=round(0.5 * (front - rear), 3))
 
@@ -946,15 +959,17 @@ def report_window(rows: list[dict[str, Any]], window: SandWindowCfg) -> None:
         print(f"sand window: the soles reached {reach[0]:.2f} m behind the pelvis, {reach[1]:.2f} m ahead and "
               f"{reach[2]:.2f} m sideways (largest over {len(rows)} episodes); the window spans "
               f"{0.5 * window.length - window.lead:.2f} m behind, {0.5 * window.length + window.lead:.2f} m ahead and "
-              f"{0.5 * window.width:.2f} m sideways (along the grid's axes; on circles a square of the larger side)",
+              f"{0.5 * window.width:.2f} m sideways ("
+              + ("turning with the robot)" if window.turn_with_robot else
+                 "along the grid's axes; on circles a square of the larger side)"),
               file=sys.stderr, flush=True)  # fmt: skip
     early = [r for r in rows if r.get("window_exit_early")]
     if early:
         worst = min(early, key=lambda r: r["window_exit_s"])
         turned = sum(bool(r.get("window_exit_turn")) for r in early)
         why = (f"; in {turned} of them the robot had turned and the soles were within the window's reach along its "
-               "heading: the window is a box of the grid's axes and does not turn, so a walk whose heading drifts "
-               "needs a square window (--window-width equal to --window-length)") if turned else ""  # fmt: skip
+               "heading: a window that does not turn (--window-fixed-axes) leaves a drifting walk behind; let it "
+               "turn with the robot (the default)") if turned else ""  # fmt: skip
         q = reach_quantile(rows)
         cover = covering_window(q, window, turned >= WINDOW_TURN_SHARE * len(early))
         print(f"warning: in {len(early)} of {len(rows)} episodes a sole that needed sand stood outside its sand window "
