@@ -125,7 +125,8 @@ def test_a_figure_per_cell_puts_the_policies_side_by_side(tmp_path: Path) -> Non
     a = _run(tmp_path, "a", 3, 8, speeds=(1.0, 2.0))
     b = _run(tmp_path, "b", 0, 8, speeds=(1.0, 2.0))
     summary = combine([("x", a), ("y", b)], tmp_path / "out")
-    assert summary["figures"] == ["fig_speeds_dry_sand_straight.png", "fig_per_terrain.png"]
+    tables = ["fig_table_terrains.png", "fig_table_speeds.png", "fig_table_ablation.png", "fig_table_per_terrain.png"]
+    assert summary["figures"] == ["fig_speeds_dry_sand_straight.png", *tables, "fig_per_terrain.png"]
     assert (tmp_path / "out" / "fig_speeds_dry_sand_straight.png").stat().st_size > 10_000
     assert (tmp_path / "out" / "fig_per_terrain.png").stat().st_size > 10_000
 
