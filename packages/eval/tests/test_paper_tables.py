@@ -148,7 +148,7 @@ def test_rows_whose_soles_left_the_window_are_named(tmp_path: Path) -> None:
 
 
 def test_exits_by_a_turn_are_named_with_their_share(tmp_path: Path) -> None:
-    """4 of 10 early exits, 3 of them by the robot's turn: the note gives 30 % by turn and asks for a square window."""
+    """4 of 10 early exits, 3 of them by the robot's turn: the note gives 30 % by turn and asks for a turning window."""
     a = _run(tmp_path, "a", 5, 10)
     rows = [json.loads(line) for line in (a / "episodes.jsonl").read_text().splitlines()]
     for k, r in enumerate(rows):
@@ -158,7 +158,7 @@ def test_exits_by_a_turn_are_named_with_their_share(tmp_path: Path) -> None:
     assert summary["window_exit_rows"] == {"td/dry_sand/straight": 40.0}
     assert summary["window_exit_turn_rows"] == {"td/dry_sand/straight": 30.0}
     md = (tmp_path / "out" / "table_terrains.md").read_text()
-    assert "40 % of episodes (30 % by the robot's turn: give it a square window)" in md
+    assert "40 % of episodes (30 % by the robot's turn: give it a turning window)" in md
 
 
 def test_runs_older_than_the_window_check_are_not_named(tmp_path: Path) -> None:

@@ -64,16 +64,17 @@ def _save(fig: Any, path: str | Path) -> Path:
     return path
 
 
-def _grouped_bars(
-    ax: Any, groups: list[str], series: dict[str, list[float]], err: dict[str, Any] | None = None
-) -> None:
-    """Bars of each series side by side per group (NaN: no bar)."""
+def _grouped_bars(ax: Any, groups: list[str], series: dict[str, list[float]], fmt: str = "{:.2g}") -> None:
+    """Bars of each series side by side per group, each labelled with its value (a 0 shows; NaN: no bar)."""
     width = 0.8 / max(len(series), 1)
     x = np.arange(len(groups))
     for k, (label, values) in enumerate(series.items()):
         xk = x + (k - 0.5 * (len(series) - 1)) * width
-        yerr = None if err is None or label not in err else err[label]
-        ax.bar(xk, np.asarray(values, dtype=float), width, yerr=yerr, capsize=2, label=label)
+        v = np.asarray(values, dtype=float)
+        ax.bar(xk, v, width, label=label, color=f"C{k}")
+        for xi, vi in zip(xk, v, strict=True):
+            if math.isfinite(vi):
+                ax.text(xi, vi, fmt.format(vi), ha="center", va="bottom", fontsize=6, color=f"C{k}")
     ax.set_xticks(x, [g.replace("_", " ") for g in groups], fontsize=7, rotation=20)
 
 
@@ -132,8 +133,10 @@ def fig_table_ablation(body: list[list[Any]], path: str | Path) -> Path:
     for ax, key, label in zip(axes, ("straight_success_pct", "circle_success_pct", "circle_path_error_m"),
                               ("straight success [%]", "circle success [%]", "circle DTW path error [m]"), strict=True):  # fmt: skip
         series = {p: [float(at[(t, p)][col[key]]) if (t, p) in at else math.nan for t in terrains] for p in policies}
-        _grouped_bars(ax, terrains, series)
+        _grouped_bars(ax, terrains, series, "{:.0f}" if key.endswith("pct") else "{:.2g}")
         ax.set(ylabel=label)
+        if key.endswith("pct"):
+            ax.set_ylim(0, 105)
     axes[0].legend(fontsize=7)
     fig.suptitle("contact-model ablation (table_ablation)", fontsize=9)
     return _save(fig, path)
@@ -148,8 +151,10 @@ def fig_table_per_terrain(header: list[str], body: list[list[Any]], path: str | 
     fig, axes = plt.subplots(1, len(metrics), figsize=(3.4 * len(metrics), 3.4), constrained_layout=True)
     for ax, metric in zip(np.atleast_1d(axes), metrics, strict=True):
         series = {p: [float(r[header.index(f"{p}: {metric}")]) for r in body] for p in policies}
-        _grouped_bars(ax, terrains, series)
+        _grouped_bars(ax, terrains, series, "{:.0f}" if "%" in metric else "{:.2g}")
         ax.set(ylabel=metric)
+        if "%" in metric:
+            ax.set_ylim(0, 105)
     np.atleast_1d(axes)[0].legend(fontsize=7)
     fig.suptitle("per terrain, straight walks (table_per_terrain)", fontsize=9)
     return _save(fig, path)

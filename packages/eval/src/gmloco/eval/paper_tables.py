@@ -336,7 +336,7 @@ def _window_exit_note(
     def why(key: str) -> str:
         if key not in turns:
             return ""
-        return f" ({turns[key]:.0f} % by the robot's turn: give it a square window)" if turns[key] > 0 else " (reach)"
+        return f" ({turns[key]:.0f} % by the robot's turn: give it a turning window)" if turns[key] > 0 else " (reach)"
 
     def fall(key: str) -> str:
         if key not in falls:
@@ -348,7 +348,7 @@ def _window_exit_note(
         "\nSoles left the sand window more than 0.25 s before the episode ended (the robot stepped where no sand "
         "was simulated), so these rows' times alive and falls may depend on the window; rerun them with a window "
         "that covers the reach printed by the run (`--window-length`, `--window-width`, `--window-lead`), or, where "
-        "the robot turned out of it (the window does not turn), with a square one (length = width). Exits within "
+        "the robot turned out of a window on the grid's axes, with a window that turns with it (the default). Exits within "
         f"{FALL_EXIT_S:g} s before a fall came with it (a stumble's trailing sole): rerun at a window no sole left, "
         "the reach-window runs' poppy-seed and deep-sand rows did not change (`results/mpm_eval/table_rows/poppy_seed_deep_sand_reach/README.md`):\n\n"
         + "\n".join(lines)
