@@ -312,3 +312,34 @@ def test_reach_within_window_accounts_for_the_turn_lag() -> None:
     assert reach_within_window(SandWindowCfg(length=1.4, width=0.6, lead=0.2, turn_with_robot=False),
                                (0.45, 0.85, 0.26))  # fmt: skip
     assert not reach_within_window(cfg, (0.45, 0.95, 0.1))  # 0.95 - 0.2 > 0.7 m ahead of the centre
+
+
+def test_turned_walls_clamp_in_the_window_frame_and_turn_their_body() -> None:
+    """Window turned 90 deg: a grain pushed 0.1 m past its far side wall comes back onto it, outward speed dropped.
+
+    At psi_w = 90 deg the window's u axis is world +y: the 0.5 m side spans y in lane +-0.25 m about its centre,
+    the 0.3 m side x +-0.15 m. A grain at u = 0.35 m (0.1 m past the u = 0.25 m wall) moving outward at 0.5 m/s and
+    sideways at 0.2 m/s ends at u = 0.25 m with the sideways speed kept. The wall body turns by 90 deg about z.
+    """
+    import warp as wp
+
+    lane_y = np.array([0.0, 2.0])
+    win, _, state, _ = _window(terrain_cfg("dry_sand"), lane_y, turn=True, heading=np.pi / 2)
+    centre, heading, half = win.frames()
+    np.testing.assert_allclose(half, [0.25, 0.15])
+    q, v = state.particle_q.numpy(), state.particle_qd.numpy()
+    q[0, :2] = centre[0] + [0.05, 0.35]  # u = +0.35 m (world +y), v = -0.05 m
+    v[0, :2] = [0.2, 0.5]  # world (x, y): sideways -0.2 m/s in v, outward +0.5 m/s in u
+    state.particle_q.assign(q)
+    state.particle_qd.assign(v)
+    win.apply_walls()
+    q, v = state.particle_q.numpy(), state.particle_qd.numpy()
+    np.testing.assert_allclose(q[0, :2], centre[0] + [0.05, 0.25], atol=1e-6)
+    np.testing.assert_allclose(v[0, :2], [0.2, 0.0], atol=1e-6)
+    body_q = wp.zeros(3, dtype=wp.transform, device="cpu")
+    body_qd = wp.zeros(3, dtype=wp.spatial_vector, device="cpu")
+    win.place_walls(1, body_q, body_qd)
+    pose = body_q.numpy()
+    np.testing.assert_allclose(pose[1, :2], centre[0], atol=1e-6)
+    np.testing.assert_allclose(pose[1, 3:], [0.0, 0.0, np.sin(np.pi / 4), np.cos(np.pi / 4)], atol=1e-6)  # x y z w
+    np.testing.assert_allclose(heading, np.pi / 2, atol=1e-6)
