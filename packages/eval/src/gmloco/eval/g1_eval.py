@@ -84,6 +84,7 @@ __all__ = [
     "reach_fits",
     "read_episodes",
     "report_window",
+    "resume_problem",
     "run",
     "run_cell",
     "score_episode",
@@ -776,13 +777,43 @@ def read_episodes(path: Path, repair: bool = False) -> list[dict[str, Any]]:
     return rows
 
 
+def resume_problem(cfg: G1EvalCfg) -> str | None:
+    """Why resuming ``cfg.out_dir`` would mix sand windows (one sentence), or None.
+
+    The folder's ``summary.json`` records the window its episodes walked on (without ``turn_with_robot``: a run
+    before the window turned, on the grid's axes); a resume at another window would pool two settings in one row.
+    """
+    out = Path(cfg.out_dir)
+    if not cfg.resume or not (out / "episodes.jsonl").is_file() or not (out / "summary.json").is_file():
+        return None
+    try:
+        recorded = json.loads((out / "summary.json").read_text())["cfg"]["window"]
+    except (OSError, ValueError, KeyError, TypeError):
+        return None
+    recorded = {"turn_with_robot": False} | dict(recorded)
+    now = _jsonable(asdict(cfg.window))
+    diff = [f"{k} {recorded.get(k)!r} -> {v!r}" for k, v in now.items() if k in recorded and recorded[k] != v]
+    if not diff:
+        return None
+    flag = " (--window-fixed-axes for a run on the grid's axes)" if any("turn_with_robot" in d for d in diff) else ""
+    return (
+        f"{out} holds episodes walked on another sand window ({', '.join(diff)}); resume it with its own window"
+        f"{flag}, or pass another --out"
+    )
+
+
 def run(cfg: G1EvalCfg) -> tuple[dict[str, float], bool]:
     """Run (or resume) the evaluation; return (summary metrics, complete).
 
     Appends each episode to ``episodes.jsonl`` as it finishes, and writes ``summary.json``, tables and figures at
     the end of the call. Stops early when ``max_minutes`` is reached (complete = False) with every finished episode
     kept; the episodes still running then are dropped, since they are unfinished.
+
+    Raises:
+        ValueError: The folder's episodes walked on another sand window (``resume_problem``).
     """
+    if (problem := resume_problem(cfg)) is not None:
+        raise ValueError(problem)
     out = Path(cfg.out_dir)
     out.mkdir(parents=True, exist_ok=True)
     log_path = out / "episodes.jsonl"

@@ -14,7 +14,7 @@ import json
 import sys
 from dataclasses import replace
 
-from gmloco.eval.g1_eval import G1EvalCfg, run
+from gmloco.eval.g1_eval import G1EvalCfg, resume_problem, run
 from gmloco.eval.g1_eval_policy import policy_problem
 from gmloco.eval.mpm.box_scene import frame_dt_problem
 from gmloco.eval.mpm.window import SandWindowCfg
@@ -236,7 +236,11 @@ def main(argv: list[str] | None = None) -> None:
     if (problem := policy_problem(a.policy)) is not None:  # checked before Warp and Newton start
         print(f"error: --policy {problem}. Nothing was run.", file=sys.stderr)
         raise SystemExit(2)
-    metrics, complete = run(cfg_from_args(a))
+    cfg = cfg_from_args(a)
+    if (problem := resume_problem(cfg)) is not None:
+        print(f"error: {problem}. Nothing was run.", file=sys.stderr)
+        raise SystemExit(2)
+    metrics, complete = run(cfg)
     print(json.dumps({"complete": complete, **{k: v for k, v in metrics.items() if "/v" not in k}}, indent=1))
 
 
