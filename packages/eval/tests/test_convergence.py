@@ -167,3 +167,19 @@ def test_sinkage_interval_skips_episodes_without_a_sinkage() -> None:
     cand[0]["mean_sinkage"] = float("nan")
     lo, hi = compare_runs(_rows(alive, 0.08, 0.5), cand).sinkage_rel_ci95
     assert np.isfinite(lo) and np.isfinite(hi) and lo <= 0.0 <= hi
+
+
+def test_a_drifting_heading_alone_is_rejected_and_older_runs_skip_it() -> None:
+    """Same walks but 12 instead of 2 degrees of heading error (the paper's yaw metric): rejected on it alone.
+
+    Runs older than the metric (no ``heading_error_deg``) leave the test out: p = 1, medians NaN.
+    """
+    alive = np.full(8, 5.0)
+    ref, cand = _rows(alive, 0.045, 1.0), _rows(alive, 0.045, 1.0)
+    for k, (r, c) in enumerate(zip(ref, cand, strict=True)):
+        r["heading_error_deg"], c["heading_error_deg"] = 2.0 + 0.1 * k, 12.0 + 0.1 * k
+    v = compare_runs(ref, cand)
+    assert v.decision == "rejected" and len(v.reasons) == 1 and "heading error" in v.reasons[0]
+    assert v.heading_error_median == pytest.approx((12.35, 2.35))
+    old = compare_runs(_rows(alive, 0.045, 1.0), _rows(alive, 0.045, 1.0))
+    assert old.decision == "accepted" and old.heading_error_p == 1.0 and np.isnan(old.heading_error_median).all()

@@ -54,6 +54,7 @@ def test_perfect_straight_walk_succeeds() -> None:
     assert row["success"] and row["reason"] == "success"
     assert row["finished_at_s"] is not None and row["finished_at_s"] <= 2.0 * (1 - cfg.course_slack) + 1e-9
     assert math.isclose(row["vel_error"], 0.0, abs_tol=1e-12) and math.isclose(row["yaw_error"], 0.0)
+    assert math.isclose(row["heading_error_deg"], 0.0)
     assert row["path_error"] < 0.011  # half a sample spacing at most
     assert math.isclose(row["support_ratio"], 1.0) and math.isclose(row["max_sinkage"], 0.02)
     assert math.isclose(row["mean_sinkage"], 0.02)
@@ -138,16 +139,34 @@ def test_a_covering_window_grows_only_where_the_soles_reached_past_it() -> None:
     w = covering_window((0.73, 0.13, 0.31), tables, turned=False)
     assert (w.length, w.width, w.lead) == pytest.approx((1.7, 0.8, 0.05))  # rear 0.8, front 0.9 kept, 0.4 beside
     assert 0.5 * w.length - w.lead >= 0.73 and 0.5 * w.length + w.lead == pytest.approx(0.9)
-    w = covering_window((0.45, 0.13, 0.2), tables, turned=True)
+    fixed = replace(tables, turn_with_robot=False)
+    w = covering_window((0.45, 0.13, 0.2), fixed, turned=True)
     assert (w.length, w.width, w.lead) == pytest.approx((1.4, 1.4, 0.2))  # the square of the tables' window
+    assert covering_window((0.45, 0.13, 0.2), tables, turned=True) == tables  # a turning window keeps its shape
     assert covering_window((0.45, 0.13, 0.2), tables, turned=False) == tables
 
 
-def test_a_circle_gets_a_square_moving_window() -> None:
-    """The window does not turn with the robot: on a circle it is max(length, width) square; straight it is as set."""
+def test_one_turning_window_serves_straight_and_circle() -> None:
+    """The default window turns: the circle keeps it, lanes spaced by its diagonal plus twice its lead (any heading).
+
+    1.4 x 0.6 m, lead 0.2 m: hypot = 1.5232 m, + 0.4 = 1.9232 m; the circle adds its 4 m diameter.
+    """
     from gmloco.eval.g1_eval import _window_and_lanes
 
     cfg = G1EvalCfg()
+    straight, lane_s = _window_and_lanes([EpisodeSpec("dry_sand", "straight", 1.0, 0)], cfg)
+    circle, lane_c = _window_and_lanes([EpisodeSpec("dry_sand", "circle", 1.0, 0)], cfg)
+    assert straight == circle == cfg.window and cfg.window.turn_with_robot
+    span = math.hypot(1.4, 0.6) + 0.4
+    assert lane_s == pytest.approx(span + cfg.lane_gap)
+    assert lane_c == pytest.approx(span + 2.0 * cfg.circle_radius + cfg.lane_gap)
+
+
+def test_a_window_on_the_grid_axes_becomes_a_square_on_a_circle() -> None:
+    """A window that does not turn: on a circle it is max(length, width) square; straight it is as set."""
+    from gmloco.eval.g1_eval import _window_and_lanes
+
+    cfg = replace(G1EvalCfg(), window=replace(G1EvalCfg().window, turn_with_robot=False))
     straight, lane_s = _window_and_lanes([EpisodeSpec("dry_sand", "straight", 1.0, 0)], cfg)
     circle, lane_c = _window_and_lanes([EpisodeSpec("dry_sand", "circle", 1.0, 0)], cfg)
     assert (straight.length, straight.width) == (cfg.window.length, cfg.window.width)
@@ -177,7 +196,8 @@ def test_episode_specs_batches_summary_and_tables() -> None:
     # batches of 2: [ds0, ds1], [ds2], [ps0, ps1], [ps2] (a batch never mixes terrains)
     assert [[s.index for s in b] for b in episode_batches(specs, 2)] == [[0, 1], [2], [0, 1], [2]]
     rows = [{"terrain": s.terrain, "scenario": s.scenario, "speed": s.speed, "success": s.index == 0,
-             "vel_error": 0.1 * s.index, "yaw_error": 0.0, "path_error": 0.0, "support_ratio": 1.0,
+             "vel_error": 0.1 * s.index, "heading_error_deg": 3.0, "yaw_error": 0.0, "path_error": 0.0,
+             "support_ratio": 1.0,
              "max_sinkage": 0.01, "mean_sinkage": 0.005, "swing_apex": 0.02 * s.index,
              "swing_lift": float("nan") if s.index else 0.06, "window_exit_early": s.index == 2,
              "window_exit_turn": False}
@@ -186,12 +206,13 @@ def test_episode_specs_batches_summary_and_tables() -> None:
     assert math.isclose(m["all/success_rate"], 1 / 3) and m["all/num_episodes"] == 6
     assert m["all/success_lo95"] < 1 / 3 < m["all/success_hi95"]  # 2 of 6: the Wilson interval holds the rate
     assert math.isclose(m["dry_sand/straight/v1/vel_error"], 0.1) and m["poppy_seed/straight/v2/num_episodes"] == 1
-    # table: dry sand success 1/3 = 33.3 %, velocity error mean(0, 0.1, 0.2) = 0.1 m/s, sinkage 0.5 cm, swing apex
+    # table: dry sand success 1/3 = 33.3 %, velocity error mean(0, 0.1, 0.2) = 0.1 m/s, heading error 3 degrees,
+    # sinkage 0.5 cm, swing apex
     # mean(0, 2, 4) = 2 cm, lift 6 cm (episodes without a finished swing, NaN, are left out of the mean); one of
     # the three episodes had a sole outside its sand window early: 33.3 %, not by a turn: 0 %, not with a fall: 0 %
     t = table_terrains(rows, "p")
     assert t[0][:4] == ["p", "dry_sand", "straight", 3]
-    np.testing.assert_allclose(t[0][4:5] + t[0][7:], [100 / 3, 0.1, 0.0, 0.0, 0.5, 2.0, 6.0, 100 / 3, 0.0, 0.0])
+    np.testing.assert_allclose(t[0][4:5] + t[0][7:], [100 / 3, 0.1, 3.0, 0.0, 0.0, 0.5, 2.0, 6.0, 100 / 3, 0.0, 0.0])
     assert math.isclose(m["all/window_exit_early"], 1 / 3)
     assert t[0][5] < 100 / 3 < t[0][6]  # the 95 % interval of 1 success in 3 episodes holds the rate
     header, body = table_speeds(rows)
@@ -458,7 +479,7 @@ def test_a_share_whose_walk_cannot_end_is_not_built(monkeypatch: pytest.MonkeyPa
 
 
 def test_the_prior_prices_the_cell_build_cell_scene_builds() -> None:
-    """The prior counts the batch's window as the scene sizes it: the circle's square, the terrain's depth."""
+    """The prior counts the batch's window as the scene solves it: the terrain's depth, one window for every walk."""
     from gmloco.eval.g1_eval import _prior_cost
     from gmloco.eval.g1_eval_fit import PRIOR_FRAME_S_AT_ZERO, PRIOR_FRAME_S_PER_MILLION
 
@@ -470,7 +491,9 @@ def test_the_prior_prices_the_cell_build_cell_scene_builds() -> None:
     cost = _prior_cost(straight, cfg)
     assert cost.lanes == 25
     assert cost.frame_s == pytest.approx(PRIOR_FRAME_S_AT_ZERO + PRIOR_FRAME_S_PER_MILLION * 25 * per_lane / 1e6)
-    assert _prior_cost(circle, cfg).frame_s > cost.frame_s  # the square window holds 94 x 94 columns
+    assert _prior_cost(circle, cfg).frame_s == cost.frame_s  # the turning window serves the circle as it is
+    fixed = replace(cfg, window=replace(cfg.window, turn_with_robot=False))
+    assert _prior_cost(circle, fixed).frame_s > cost.frame_s  # a window on the grid's axes: 94 x 94 on a circle
 
 
 def _run_in(cfg: G1EvalCfg, monkeypatch: pytest.MonkeyPatch) -> tuple[dict, bool]:

@@ -161,3 +161,28 @@ def test_non_positive_counts_and_durations_are_refused(argv: list[str], capsys: 
     with pytest.raises(SystemExit) as info:
         _parse(["--out", "x", *argv])
     assert info.value.code == 2 and argv[-1] in capsys.readouterr().err
+
+
+def test_resuming_a_folder_at_another_window_exits_2(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    """A folder walked on the grid's axes (no ``turn_with_robot`` recorded) is not resumed at a turning window."""
+    import json
+
+    import gmloco.eval.g1_eval_cli as cli
+    from gmloco.eval.g1_eval import resume_problem
+    from gmloco.eval.g1_eval_cli import cfg_from_args
+
+    policy = Path(__file__).resolve().parents[3] / "artifacts" / "ppo_rft3d" / "policy.onnx"
+    if not policy.exists():
+        pytest.skip(f"no exported policy at {policy}")
+    out = tmp_path / "run"
+    out.mkdir()
+    (out / "episodes.jsonl").write_text("")
+    window = {"moving": True, "length": 1.4, "width": 0.6, "lead": 0.2, "offset_y": 0.0, "particles_per_voxel": 2,
+              "jitter": 0.5}  # fmt: skip
+    (out / "summary.json").write_text(json.dumps({"cfg": {"window": window}}))
+    with pytest.raises(SystemExit) as info:
+        cli.main(["--out", str(out), "--policy", str(policy)])
+    err = capsys.readouterr().err
+    assert info.value.code == 2 and "turn_with_robot False -> True" in err and "--window-fixed-axes" in err
+    assert resume_problem(cfg_from_args(_parse(["--out", str(out), "--window-fixed-axes"]))) is None
+    assert resume_problem(cfg_from_args(_parse(["--out", str(out), "--fresh"]))) is None  # a fresh start mixes nothing

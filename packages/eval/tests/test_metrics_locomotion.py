@@ -14,6 +14,7 @@ from gmloco.eval.metrics.locomotion import (
     dtw_distance,
     episode_outcome,
     failure_step,
+    metric_heading_error_deg,
     metric_path_error,
     metric_velocity_tracking_error,
     metric_yaw_tracking_error,
@@ -160,3 +161,27 @@ def test_course_progress_counts_along_the_course() -> None:
     assert course_finished_at(walk, cmd, dt, 0.2) == pytest.approx(8.0, abs=dt)
     assert course_finished_at(walk + np.array([0.0, 3.0]), cmd, dt, 0.2) == pytest.approx(8.0, abs=dt)
     assert course_finished_at(np.zeros((500, 2)), cmd, dt, 0.2) is None
+
+
+def test_heading_error_straight_drift_hand_computed() -> None:
+    """w_cmd = 0, yaw 0, 0.1, 0.2, 0.3 rad: mean error 0.15 rad = 8.5944 deg; the first 2 steps alive: 2.8648 deg."""
+    yaw = np.array([0.0, 0.1, 0.2, 0.3])
+    np.testing.assert_allclose(metric_heading_error_deg(yaw, 0.0, 0.02), math.degrees(0.15), rtol=1e-12)
+    np.testing.assert_allclose(metric_heading_error_deg(yaw, 0.0, 0.02, alive_steps=2), math.degrees(0.05))
+
+
+def test_heading_error_circle_follows_the_integrated_command() -> None:
+    """A turn at exactly w_cmd from any start heading, across the +-pi seam: 0; turning half as fast: w t / 2."""
+    dt, w, n = 0.02, 0.5, 500
+    t = np.arange(n) * dt
+    exact = np.angle(np.exp(1j * (3.0 + w * t)))  # starts at 3 rad, wraps through pi
+    assert metric_heading_error_deg(exact, w, dt) < 1e-9
+    lagging = 3.0 + 0.5 * w * t  # error 0.5 w t_i, mean 0.5 w mean(t) = 0.25 * 4.99 rad
+    np.testing.assert_allclose(metric_heading_error_deg(lagging, w, dt), math.degrees(0.25 * t.mean()), rtol=1e-9)
+
+
+def test_heading_error_is_a_wrapped_angle() -> None:
+    """An error of 350 degrees counts as 10 degrees (the shortest way round); an empty log is NaN."""
+    yaw = np.radians([0.0, 350.0])
+    np.testing.assert_allclose(metric_heading_error_deg(yaw, 0.0, 0.02), 5.0, rtol=1e-9)
+    assert math.isnan(metric_heading_error_deg(np.array([]), 0.0, 0.02))

@@ -35,16 +35,19 @@ def standing_g1() -> G1MpmScene:
 
 def test_soles_outside_counts_low_corners_beyond_the_window() -> None:
     """Window x in [0, 1], y in [-0.5, 0.5]: corners behind it count if within 2 cm of the sand, not if higher."""
-    bounds = np.array([[[0.0, -0.5], [1.0, 0.5]]])
+    bounds = (np.array([[0.5, 0.0]]), np.zeros(1), np.array([0.5, 0.5]))  # centre, heading, half extents
     corners = np.zeros((1, 2, 8, 3))
     corners[0, 0, :, 0] = 0.5  # left sole inside
-    corners[0, 1, :, 0] = np.linspace(-0.2, 0.15, 8)  # right sole straddles the rear edge: 5 corners behind it
+    corners[0, 1, :, 0] = np.linspace(-0.21, 0.14, 8)  # right sole straddles the rear edge: 5 corners behind it
     surface = np.zeros((1, 2, 8))
     assert soles_outside(corners, needs_sand(corners, surface), bounds).tolist() == [5]
     corners[0, 1, :, 2] = 0.05  # the right sole 5 cm up in its swing: no sand needed
     assert soles_outside(corners, needs_sand(corners, surface), bounds).tolist() == [0]
     corners[0, 1, :, 2], corners[0, 1, :, 0], corners[0, 1, :, 1] = -0.03, 0.5, 0.6  # sunk, beside the window
     assert soles_outside(corners, needs_sand(corners, surface), bounds).tolist() == [8]
+    # the window turned by 45 degrees about its centre reaches y = 0.707 at x = 0.5: the sunk sole is inside it
+    turned = (bounds[0], np.array([np.pi / 4]), bounds[2])
+    assert soles_outside(corners, needs_sand(corners, surface), turned).tolist() == [0]
 
 
 def test_sole_reach_is_measured_in_the_pelvis_yaw_frame() -> None:

@@ -16,31 +16,39 @@ from gmloco.eval.mpm.window_terrain import TerrainCfg, terrain_cfg, terrain_laye
 VOXEL = 0.1  # columns h = 5 cm at 2 particles per voxel edge
 
 
-def _pelvis(x: np.ndarray, lane_y: np.ndarray, bodies: int) -> np.ndarray:
-    """Body poses [R bodies, 7] with each robot's pelvis at (x_r, lane_y_r, 0.7), heading +x."""
+def _pelvis(x: np.ndarray, lane_y: np.ndarray, bodies: int, heading: float | np.ndarray = 0.0) -> np.ndarray:
+    """Body poses [R bodies, 7] with each robot's pelvis at (x_r, lane_y_r, 0.7), yawed by ``heading`` [rad]."""
     q = np.zeros((len(x) * bodies, 7), dtype=np.float32)
-    q[:, 6] = 1.0
+    yaw = np.repeat(np.broadcast_to(heading, len(x)), bodies)
+    q[:, 5], q[:, 6] = np.sin(0.5 * yaw), np.cos(0.5 * yaw)  # x y z w
     q[::bodies, 0], q[::bodies, 1], q[::bodies, 2] = x, lane_y, 0.7
     return q
 
 
 def _window(
-    terrain: TerrainCfg, lane_y: np.ndarray, bodies: int = 2, capacity: int = -1
+    terrain: TerrainCfg,
+    lane_y: np.ndarray,
+    bodies: int = 2,
+    capacity: int = -1,
+    turn: bool = False,
+    heading: float = 0.0,
 ) -> tuple[SandWindow, Any, Any, Any]:
     """A 2-robot window (0.5 x 0.3 m, 5 cm columns), seeded at x = 0, with its sand model, state and solver.
 
-    ``capacity`` > 0: the evaluation's rebuildable sparse grid of that many cells (else one allocated per step).
+    ``capacity`` > 0: the evaluation's rebuildable sparse grid of that many cells (else one allocated per step);
+    ``turn``: the window turns with the robots (else it keeps the grid's axes), seeded at ``heading`` [rad].
     """
     import newton
     import warp as wp
 
-    win = SandWindow(SandWindowCfg(moving=True, length=0.5, width=0.3, lead=0.0), terrain, VOXEL, lane_y, bodies)
+    cfg = SandWindowCfg(moving=True, length=0.5, width=0.3, lead=0.0, turn_with_robot=turn)
+    win = SandWindow(cfg, terrain, VOXEL, lane_y, bodies)
     builder = newton.ModelBuilder()
     newton.solvers.SolverImplicitMPM.register_custom_attributes(builder)
     win.add_particles(builder)
     model = builder.finalize(device="cpu")
     win.allocate(wp, model.device)
-    body_q = wp.array(_pelvis(np.zeros(len(lane_y)), lane_y, bodies), dtype=wp.transform, device="cpu")
+    body_q = wp.array(_pelvis(np.zeros(len(lane_y)), lane_y, bodies, heading), dtype=wp.transform, device="cpu")
     win.seed_model(wp, model, body_q)
     solver = make_mpm_solver(newton, model, MpmSolverCfg(voxel_size=VOXEL, max_active_cell_count=capacity),
                              win.materials[0])  # fmt: skip
@@ -189,3 +197,149 @@ def test_a_retired_lane_leaves_the_solve_and_the_others_do_not_notice() -> None:
     np.testing.assert_allclose(cached, mm.material_particle_volume.numpy(), rtol=1e-5)
     with pytest.raises(ValueError, match="outside"):
         win.set_lanes_active([2], False)
+
+
+def _columns_inside(win: SandWindow, robot: int) -> set[tuple[int, int]]:
+    """Brute force: every world column whose centre lies inside robot ``robot``'s (turned) window rectangle."""
+    centre, heading, half = win.frames()
+    cx, cy = centre[robot, 0], centre[robot, 1] - win.lane_y[robot]
+    c, s = np.cos(heading[robot]), np.sin(heading[robot])
+    r = int(np.ceil(np.hypot(*half) / win.h)) + 2
+    i0, j0 = int(np.floor(cx / win.h)), int(np.floor(cy / win.h))
+    out = set()
+    for i in range(i0 - r, i0 + r + 1):
+        for j in range(j0 - r, j0 + r + 1):
+            dx, dy = (i + 0.5) * win.h - cx, (j + 0.5) * win.h - cy
+            if abs(c * dx + s * dy) < half[0] and abs(-s * dx + c * dy) < half[1]:
+                out.add((i, j))
+    return out
+
+
+def _check_window(win: SandWindow, model: Any, state: Any, solver: Any, robot: int) -> None:
+    """Robot ``robot``'s sand is exactly its window's columns, nz particles each, in the rectangle; the rest parked.
+
+    A column kept through a turn keeps its grains, which lie within its cell: up to the cell's half diagonal h / sqrt(2)
+    outside the turned rectangle, until the walls' clamp after the next MPM step.
+    """
+    import newton
+
+    held = [tuple(c) for c in win.held_columns(robot).tolist()]
+    assert set(held) == _columns_inside(win, robot) and len(held) == win.nz * len(set(held))
+    assert len(set(held)) <= win.slots
+    per, active = win.particles_per_robot, int(newton.ParticleFlags.ACTIVE)
+    rows = slice(robot * per, (robot + 1) * per)
+    live = win.column.numpy()[rows, 0] > -(2**30) + 1
+    mm = solver._mpm_model
+    for arr in (model.particle_flags, mm.particle_flags, mm.material_particle_flags):
+        np.testing.assert_array_equal((arr.numpy()[rows] & active) != 0, live)
+    assert not mm.material_particle_volume.numpy()[rows][~live].any()
+    centre, heading, half = win.frames()
+    q = state.particle_q.numpy()[rows][live]
+    c, s = np.cos(heading[robot]), np.sin(heading[robot])
+    dx, dy = q[:, 0] - centre[robot, 0], q[:, 1] - centre[robot, 1]
+    tol = win.h / np.sqrt(2.0)
+    assert np.all(np.abs(c * dx + s * dy) <= half[0] + tol) and np.all(np.abs(-s * dx + c * dy) <= half[1] + tol)
+    cached = mm.material_particle_volume.numpy().copy()  # the solver's volume cache = a fresh notify's
+    mm.notify_particle_material_changed()
+    np.testing.assert_allclose(cached, mm.material_particle_volume.numpy(), rtol=1e-5)
+
+
+def test_turned_window_holds_exactly_the_columns_inside_it() -> None:
+    """Seeded at a 30 degree heading: the window is turned 30 degrees and holds every column centre inside it."""
+    lane_y = np.array([0.0, 2.0])
+    win, model, state, solver = _window(terrain_cfg("dry_sand"), lane_y, turn=True, heading=np.radians(30.0))
+    # slots: 10 x 6 columns + ceil(sqrt(2) (10 + 6) + pi / 2) = 60 + 25 (window_slots' bound)
+    assert win.slots == 85 and win.particles_per_robot == 85 * win.nz
+    np.testing.assert_allclose(win.frames()[1], np.radians(30.0), atol=1e-6)
+    for robot in (0, 1):
+        _check_window(win, model, state, solver, robot)
+
+
+def test_window_turns_with_the_robot_and_keeps_the_sand_it_still_covers() -> None:
+    """A 2 degree yaw keeps the window (3 degree step); 20 degrees turn it: kept columns untouched, new ones seeded."""
+    import warp as wp
+
+    lane_y = np.array([0.0, 2.0])
+    win, model, state, solver = _window(terrain_cfg("dry_sand"), lane_y, turn=True)
+    before = {tuple(c) for c in win.held_columns(0).tolist()}
+    q0, col0 = state.particle_q.numpy().copy(), win.column.numpy().copy()
+    win.advance(wp.array(_pelvis(np.zeros(2), lane_y, 2, np.radians(2.0)), dtype=wp.transform, device="cpu"))
+    np.testing.assert_array_equal(state.particle_q.numpy(), q0)  # within the step: nothing moves
+    win.advance(wp.array(_pelvis(np.zeros(2), lane_y, 2, np.radians(20.0)), dtype=wp.transform, device="cpu"))
+    np.testing.assert_allclose(win.frames()[1], np.radians(20.0), atol=1e-6)
+    _check_window(win, model, state, solver, 0)
+    after = {tuple(c) for c in win.held_columns(0).tolist()}
+    assert before - after and after - before  # corners left, others entered
+    per = win.particles_per_robot
+    col = win.column.numpy()[:per]
+    kept = np.array([tuple(c) in before & after for c in col.tolist()])
+    same_slot = np.all(col == col0[:per], axis=1)
+    np.testing.assert_array_equal(state.particle_q.numpy()[:per][kept & same_slot], q0[:per][kept & same_slot])
+    assert (kept & same_slot).sum() == win.nz * len(before & after)  # a kept column keeps its slot
+    # the new columns' particles carry the medium: mass rho_c h^2 hz (flat dry sand: hz = depth / nz)
+    fresh = ~same_slot & (col[:, 0] > -(2**30) + 1)
+    assert fresh.sum() == win.nz * len(after - before)
+    np.testing.assert_allclose(model.particle_mass.numpy()[:per][fresh], 1500.0 * 0.05**3, rtol=1e-5)
+
+
+def test_reseed_turns_a_lane_to_its_robot_at_once() -> None:
+    """A refilled lane's window snaps to its robot's heading (90 degrees), the other lane keeps its window."""
+    import warp as wp
+
+    lane_y = np.array([0.0, 2.0])
+    win, model, state, solver = _window(terrain_cfg("poppy_seed"), lane_y, turn=True)
+    q0 = state.particle_q.numpy().copy()
+    win.set_lanes_active([0], False)
+    pose = _pelvis(np.zeros(2), lane_y, 2, np.array([np.pi / 2, 0.0]))
+    win.reseed_lanes([0], [3], wp.array(pose, dtype=wp.transform, device="cpu"))
+    np.testing.assert_allclose(win.frames()[1], [np.pi / 2, 0.0], atol=1e-6)
+    assert win.retired == set()
+    _check_window(win, model, state, solver, 0)
+    per = win.particles_per_robot
+    np.testing.assert_array_equal(state.particle_q.numpy()[per:], q0[per:])
+
+
+def test_reach_within_window_accounts_for_the_turn_lag() -> None:
+    """1.4 x 0.6 m, lead 0.2 m: a (0.45, 0.85, 0.26) m reach fits a window on the heading, not one lagging 3 deg.
+
+    Front corner (0.85, 0.26) turned by 3 deg: v = 0.85 sin 3 + 0.26 cos 3 = 0.0445 + 0.2596 = 0.3041 > 0.3 m.
+    """
+    from gmloco.eval.mpm.window import reach_within_window
+
+    cfg = SandWindowCfg(length=1.4, width=0.6, lead=0.2, turn_step=np.radians(3.0))
+    assert reach_within_window(cfg, (0.45, 0.85, 0.25))  # v = 0.0445 + 0.2497 = 0.2942 m
+    assert not reach_within_window(cfg, (0.45, 0.85, 0.26))
+    assert reach_within_window(SandWindowCfg(length=1.4, width=0.6, lead=0.2, turn_with_robot=False),
+                               (0.45, 0.85, 0.26))  # fmt: skip
+    assert not reach_within_window(cfg, (0.45, 0.95, 0.1))  # 0.95 - 0.2 > 0.7 m ahead of the centre
+
+
+def test_turned_walls_clamp_in_the_window_frame_and_turn_their_body() -> None:
+    """Window turned 90 deg: a grain pushed 0.1 m past its far side wall comes back onto it, outward speed dropped.
+
+    At psi_w = 90 deg the window's u axis is world +y: the 0.5 m side spans y in lane +-0.25 m about its centre,
+    the 0.3 m side x +-0.15 m. A grain at u = 0.35 m (0.1 m past the u = 0.25 m wall) moving outward at 0.5 m/s and
+    sideways at 0.2 m/s ends at u = 0.25 m with the sideways speed kept. The wall body turns by 90 deg about z.
+    """
+    import warp as wp
+
+    lane_y = np.array([0.0, 2.0])
+    win, _, state, _ = _window(terrain_cfg("dry_sand"), lane_y, turn=True, heading=np.pi / 2)
+    centre, heading, half = win.frames()
+    np.testing.assert_allclose(half, [0.25, 0.15])
+    q, v = state.particle_q.numpy(), state.particle_qd.numpy()
+    q[0, :2] = centre[0] + [0.05, 0.35]  # u = +0.35 m (world +y), v = -0.05 m
+    v[0, :2] = [0.2, 0.5]  # world (x, y): sideways -0.2 m/s in v, outward +0.5 m/s in u
+    state.particle_q.assign(q)
+    state.particle_qd.assign(v)
+    win.apply_walls()
+    q, v = state.particle_q.numpy(), state.particle_qd.numpy()
+    np.testing.assert_allclose(q[0, :2], centre[0] + [0.05, 0.25], atol=1e-6)
+    np.testing.assert_allclose(v[0, :2], [0.2, 0.0], atol=1e-6)
+    body_q = wp.zeros(3, dtype=wp.transform, device="cpu")
+    body_qd = wp.zeros(3, dtype=wp.spatial_vector, device="cpu")
+    win.place_walls(1, body_q, body_qd)
+    pose = body_q.numpy()
+    np.testing.assert_allclose(pose[1, :2], centre[0], atol=1e-6)
+    np.testing.assert_allclose(pose[1, 3:], [0.0, 0.0, np.sin(np.pi / 4), np.cos(np.pi / 4)], atol=1e-6)  # x y z w
+    np.testing.assert_allclose(heading, np.pi / 2, atol=1e-6)

@@ -114,6 +114,9 @@ def test_summary_file_holds_the_rows_as_records(tmp_path: Path) -> None:
     assert summary["rows"][0]["success_rate_pct"] == pytest.approx(75.0)
     assert summary["speed_rows"][0]["v=1 m/s"] == pytest.approx(100.0)
     assert summary["speed_rows"][0]["v=2 m/s"] == pytest.approx(50.0)
+    cell = summary["paper_metrics"]["td"]["dry_sand"]["straight"]  # the paper's keys per (policy, terrain, scenario)
+    assert set(cell) == {"success_pct", "vel_error_mps", "heading_error_deg", "path_error_m", "episodes"}
+    assert cell["success_pct"] == pytest.approx(75.0) and cell["episodes"] == summary["rows"][0]["episodes"]
     assert json.loads((out / "tables.json").read_text())["rows"] == summary["rows"]
 
 
@@ -122,7 +125,8 @@ def test_a_figure_per_cell_puts_the_policies_side_by_side(tmp_path: Path) -> Non
     a = _run(tmp_path, "a", 3, 8, speeds=(1.0, 2.0))
     b = _run(tmp_path, "b", 0, 8, speeds=(1.0, 2.0))
     summary = combine([("x", a), ("y", b)], tmp_path / "out")
-    assert summary["figures"] == ["fig_speeds_dry_sand_straight.png", "fig_per_terrain.png"]
+    tables = ["fig_table_terrains.png", "fig_table_speeds.png", "fig_table_ablation.png", "fig_table_per_terrain.png"]
+    assert summary["figures"] == ["fig_speeds_dry_sand_straight.png", *tables, "fig_per_terrain.png"]
     assert (tmp_path / "out" / "fig_speeds_dry_sand_straight.png").stat().st_size > 10_000
     assert (tmp_path / "out" / "fig_per_terrain.png").stat().st_size > 10_000
 
@@ -144,7 +148,7 @@ def test_rows_whose_soles_left_the_window_are_named(tmp_path: Path) -> None:
 
 
 def test_exits_by_a_turn_are_named_with_their_share(tmp_path: Path) -> None:
-    """4 of 10 early exits, 3 of them by the robot's turn: the note gives 30 % by turn and asks for a square window."""
+    """4 of 10 early exits, 3 of them by the robot's turn: the note gives 30 % by turn and asks for a turning window."""
     a = _run(tmp_path, "a", 5, 10)
     rows = [json.loads(line) for line in (a / "episodes.jsonl").read_text().splitlines()]
     for k, r in enumerate(rows):
@@ -154,7 +158,7 @@ def test_exits_by_a_turn_are_named_with_their_share(tmp_path: Path) -> None:
     assert summary["window_exit_rows"] == {"td/dry_sand/straight": 40.0}
     assert summary["window_exit_turn_rows"] == {"td/dry_sand/straight": 30.0}
     md = (tmp_path / "out" / "table_terrains.md").read_text()
-    assert "40 % of episodes (30 % by the robot's turn: give it a square window)" in md
+    assert "40 % of episodes (30 % by the robot's turn: give it a turning window)" in md
 
 
 def test_runs_older_than_the_window_check_are_not_named(tmp_path: Path) -> None:

@@ -8,12 +8,13 @@ from typing import Any
 
 import pytest
 
-from gmloco.eval.tables_mpm import ABLATION_COLUMNS, table_ablation, table_per_terrain, table_terrains
+from gmloco.eval.tables_mpm import ABLATION_COLUMNS, paper_metrics, table_ablation, table_per_terrain, table_terrains
 
 
 def _episodes(terrain: str, scenario: str, wins: int, n: int, path: float = 0.3, vel: float = 0.2) -> list[dict]:
     return [{"terrain": terrain, "scenario": scenario, "speed": 1.0, "success": k < wins, "alive_s": 10.0,
-             "vel_error": vel, "yaw_error": 0.1, "path_error": path, "mean_sinkage": 0.05}
+             "vel_error": vel, "heading_error_deg": 2.0, "yaw_error": 0.1, "path_error": path,
+             "mean_sinkage": 0.05}
             for k in range(n)]  # fmt: skip
 
 
@@ -39,11 +40,24 @@ def test_ablation_puts_straight_and_circle_side_by_side() -> None:
 def test_per_terrain_gives_each_policy_its_columns() -> None:
     """Rows are terrains (straight walks), columns each policy's success and tracking errors; NaN where not run."""
     header, body = table_per_terrain(_rows())
-    assert header[:4] == ["terrain", "td: success %", "td: vel error [m/s]", "td: yaw error [rad/s]"]
-    assert header[4] == "rigid: success %"
+    assert header[:5] == ["terrain", "td: success %", "td: vel error [m/s]", "td: heading error [deg]",
+                          "td: yaw-rate error [rad/s]"]  # fmt: skip
+    assert header[5] == "rigid: success %"
     by = {r[0]: dict(zip(header, r, strict=True)) for r in body}
     assert set(by) == {"dry_sand", "basalt"}
     assert by["dry_sand"]["td: success %"] == pytest.approx(80.0)
     assert by["dry_sand"]["rigid: vel error [m/s]"] == pytest.approx(0.9)
     assert by["basalt"]["td: vel error [m/s]"] == pytest.approx(0.1)
     assert math.isnan(by["basalt"]["rigid: success %"])
+
+
+def test_paper_metrics_keys_per_policy_terrain_scenario() -> None:
+    """Summary keys of the paper per (policy, terrain, scenario): td dry sand circle 5/10, DTW 0.4 m, 2 degrees."""
+    got = paper_metrics(_rows())
+    assert set(got) == {"td", "rigid"} and set(got["td"]) == {"dry_sand", "basalt"}
+    assert got["td"]["dry_sand"]["circle"] == {"success_pct": pytest.approx(50.0), "vel_error_mps": pytest.approx(0.2),
+                                              "heading_error_deg": pytest.approx(2.0),
+                                              "path_error_m": pytest.approx(0.4), "episodes": 10}  # fmt: skip
+    assert got["rigid"]["dry_sand"]["straight"]["success_pct"] == 0.0
+    older = [{k: v for k, v in e.items() if k != "heading_error_deg"} for e in _episodes("basalt", "straight", 1, 2)]
+    assert paper_metrics(table_terrains(older, "old"))["old"]["basalt"]["straight"]["heading_error_deg"] is None

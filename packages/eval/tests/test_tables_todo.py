@@ -40,7 +40,8 @@ def test_cut_shares_are_resumed_and_window_exits_rerun(tmp_path: Path) -> None:
     Row A: share 1 of 4 cut at 20 of 25 -> one resume with --shard 1/4. Row B: 40 % turn exits at the tables'
     window -> four shares at a square window. Every line parses as g1_eval_cli will.
     """
-    base = replace(G1EvalCfg(), policy_path="p.onnx", shards=4)
+    fixed_axes = replace(G1EvalCfg().window, turn_with_robot=False)  # a turning window keeps its shape instead
+    base = replace(G1EvalCfg(), policy_path="p.onnx", shards=4, window=fixed_axes)
     a = [_run(tmp_path / f"a_share{i}of4", replace(base, shard=i), 25 if i != 1 else 20) for i in range(4)]
     b = _run(tmp_path / "b", replace(base, terrains=("basalt",), shards=1), 100)
     rows = [json.loads(x) for x in (b / "episodes.jsonl").read_text().splitlines()]
@@ -92,3 +93,13 @@ def test_rows_whose_exits_came_with_the_fall_are_not_rerun(tmp_path: Path) -> No
     assert len(notes) == 1 and "40 of its 45 early window exits came within 0.75 s before the fall" in notes[0]
     reruns = todo([("td", d)], fall_exits=True)
     assert len(reruns) == 4 and "45 % early window exits (reach)" in reruns[0].why
+
+
+def test_a_window_recorded_before_it_turned_reads_as_fixed_axes() -> None:
+    """A summary's window without ``turn_with_robot`` (older runs) kept the grid's axes; a recorded one is kept."""
+    from gmloco.eval.tables_todo import cfg_from_summary
+
+    old = cfg_from_summary({"window": {"moving": True, "length": 1.4, "width": 1.4, "lead": 0.2}})
+    assert not old.window.turn_with_robot and old.window.length == 1.4
+    new = cfg_from_summary({"window": {"moving": True, "turn_with_robot": True, "turn_step": 0.05}})
+    assert new.window.turn_with_robot and new.window.turn_step == 0.05

@@ -4,6 +4,7 @@
 from __future__ import annotations
 
 from collections.abc import Callable
+from dataclasses import replace
 from pathlib import Path
 from types import SimpleNamespace
 
@@ -25,6 +26,14 @@ from gmloco.deploy.export import (
 )
 
 STEPS, ENVS = 8, 3
+
+
+def _heading_envs(meta: PolicyMetadata) -> PolicyMetadata:
+    """Return the metadata with the ``heading_envs`` rule: the command is observed as given.
+
+    ``test_yaw_target.py`` covers the ``yaw_target`` correction.
+    """
+    return replace(meta, command=replace(meta.command, yaw_command="heading_envs", heading_stiffness=0.5))
 
 
 def _raw_terms(meta: PolicyMetadata, rng: np.random.Generator) -> dict[str, np.ndarray]:
@@ -78,7 +87,7 @@ def student(
 ) -> tuple[Path, Callable[[np.ndarray, np.ndarray], np.ndarray]]:
     """The tiny student exported with full metadata; returns (path, torch actions of (o_t, history))."""
     model = students.good()
-    path = export_policy_onnx(model, tmp_path / "student.onnx", make_metadata())
+    path = export_policy_onnx(model, tmp_path / "student.onnx", _heading_envs(make_metadata()))
     wrapper = model.as_onnx(verbose=False).eval()
 
     def act(obs: np.ndarray, history: np.ndarray) -> np.ndarray:
@@ -93,7 +102,7 @@ def stacked(
     tmp_path: Path, make_metadata: Callable[..., PolicyMetadata], dims: SimpleNamespace
 ) -> tuple[Path, Callable[[np.ndarray], np.ndarray]]:
     """A stacked-input actor exported as mjlab does (batch fixed to 1) plus our metadata; (path, torch actions)."""
-    meta = make_metadata(layout="term_stacked", history_length=4, policy_class="MLPModel", latent_dim=0)
+    meta = _heading_envs(make_metadata(layout="term_stacked", history_length=4, policy_class="MLPModel", latent_dim=0))
     model = _StackedMlp(4 * meta.obs_dim, dims.actions).eval()
     path = tmp_path / "actor.onnx"
     torch.onnx.export(

@@ -6,7 +6,8 @@ candidate (another voxel size, iteration count, window or bed), are compared epi
 
 * time alive (until the fall, or the episode length): two-sided Mann-Whitney U test (``scipy.stats``);
 * success: two-sided Fisher exact test on the 2 x 2 table of successes;
-* velocity and yaw tracking errors (the tables' metrics, per episode): two-sided Mann-Whitney U tests;
+* velocity, heading and yaw-rate tracking errors (the tables' metrics, per episode): two-sided Mann-Whitney U
+  tests (runs older than the heading error leave that test out);
 * mean sinkage of the lowest sole point: relative difference of the run means (its 95 % bootstrap interval over
   episodes is reported beside it: a difference within the tolerance whose interval reaches past it is a weak pass);
 * a sole reaching the bed's rigid floor: two-sided Fisher exact test on the episodes where it did (runs older
@@ -84,6 +85,10 @@ class Verdict:
     """Episodes in which a sole reached the bed's rigid floor, candidate and reference."""
     floor_p: float = 1.0
     """Two-sided Fisher p-value of the floor counts (1.0 when a run does not record them)."""
+    heading_error_median: tuple[float, float] = (math.nan, math.nan)
+    """Median heading error (the paper's yaw tracking error), candidate and reference [deg]."""
+    heading_error_p: float = 1.0
+    """Two-sided Mann-Whitney p-value of the heading errors (1.0 when a run does not record them)."""
 
 
 def load_episodes(path: str | Path) -> list[dict[str, Any]]:
@@ -199,7 +204,7 @@ def compare_runs(
     k_ref = float(np.nanmean([r["mean_sinkage"] for r in ref]))
     k_cand = float(np.nanmean([r["mean_sinkage"] for r in cand]))
     alive_p = _mw_p(a_cand, a_ref)
-    tracking = {k: (_metric(cand, k), _metric(ref, k)) for k in ("vel_error", "yaw_error")}
+    tracking = {k: (_metric(cand, k), _metric(ref, k)) for k in ("vel_error", "heading_error_deg", "yaw_error")}
     track_p = {k: _mw_p(c, r) for k, (c, r) in tracking.items()}
     track_med = {k: (float(np.median(c)) if len(c) else math.nan, float(np.median(r)) if len(r) else math.nan)
                  for k, (c, r) in tracking.items()}  # fmt: skip
@@ -211,7 +216,8 @@ def compare_runs(
         reasons.append(f"time alive differs (Mann-Whitney p = {alive_p:.3g} < {cfg.alpha})")
     if success_p < cfg.alpha:
         reasons.append(f"success differs ({s_cand}/{len(cand)} vs {s_ref}/{len(ref)}, Fisher p = {success_p:.3g})")
-    for key, name in (("vel_error", "velocity tracking error"), ("yaw_error", "yaw tracking error")):
+    for key, name in (("vel_error", "velocity tracking error"), ("heading_error_deg", "heading error"),
+                      ("yaw_error", "yaw-rate tracking error")):  # fmt: skip
         if track_p[key] < cfg.alpha:
             c, r = track_med[key]
             reasons.append(f"{name} differs (median {c:.3g} vs {r:.3g}, Mann-Whitney p = {track_p[key]:.3g})")
@@ -231,7 +237,7 @@ def compare_runs(
     return Verdict(decision, tuple(reasons), (len(cand), len(ref)), (float(np.median(a_cand)), float(np.median(a_ref))),
                    alive_p, (s_cand, s_ref), success_p, track_med["vel_error"], track_p["vel_error"],
                    track_med["yaw_error"], track_p["yaw_error"], (k_cand, k_ref), rel, sink_ci, floor,
-                   floor_p)  # fmt: skip
+                   floor_p, track_med["heading_error_deg"], track_p["heading_error_deg"])  # fmt: skip
 
 
 def main(argv: list[str] | None = None) -> Verdict:
@@ -256,7 +262,8 @@ def main(argv: list[str] | None = None) -> Verdict:
     print(f"  success {v.success[0]}/{v.episodes[0]} vs {v.success[1]}/{v.episodes[1]} (p = {v.success_p:.3g})")
     print(f"  velocity error median {v.vel_error_median[0]:.3f} vs {v.vel_error_median[1]:.3f} m/s "
           f"(p = {v.vel_error_p:.3g}); yaw error {v.yaw_error_median[0]:.3f} vs {v.yaw_error_median[1]:.3f} "
-          f"(p = {v.yaw_error_p:.3g})")  # fmt: skip
+          f"(p = {v.yaw_error_p:.3g}); heading error {v.heading_error_median[0]:.2f} vs "
+          f"{v.heading_error_median[1]:.2f} deg (p = {v.heading_error_p:.3g})")  # fmt: skip
     lo, hi = v.sinkage_rel_ci95
     print(f"  mean sinkage {100 * v.sinkage_mean_m[0]:.1f} vs {100 * v.sinkage_mean_m[1]:.1f} cm "
           f"({v.sinkage_rel_diff:.0%}; candidate - reference: 95 % interval {lo:+.0%} to {hi:+.0%})")  # fmt: skip

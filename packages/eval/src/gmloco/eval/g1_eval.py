@@ -12,8 +12,10 @@ with :mod:`gmloco.eval.metrics.locomotion`:
   in ``episode_s``. The course is the commanded path (``circular_path``); it counts as finished once the nearest
   commanded sample to the base (searched forwards only) is past ``1 - course_slack`` of the path (a project
   choice: the paper gives no tolerance, and an exact v T lets no lag through).
-* velocity tracking error: mean |v_xy - v_cmd| in the yaw frame over alive steps; yaw tracking error: mean
-  |w_z - w_cmd| over alive steps; path error: DTW between executed and commanded xy paths (alive part).
+* velocity tracking error: mean |v_xy - v_cmd| in the yaw frame over alive steps; heading error (the paper's yaw
+  tracking error, ``heading_error_deg``): mean |wrap(psi - psi_cmd)| in degrees over alive steps, psi_cmd the start
+  heading plus the commanded w_z integrated; yaw-rate error (``yaw_error``, an extra column): mean |w_z - w_cmd|
+  [rad/s]; path error: DTW between executed and commanded xy paths (alive part).
 * swing clearance: mean apex of the completed swings above the local surface and their lift above the stance
   before (``swing_clearance``: a foot is in swing while its sand force is below 40 N).
 * window size needed: ``sole_behind_m`` / ``sole_ahead_m`` / ``sole_side_m``, the soles' largest reach from the
@@ -22,8 +24,10 @@ with :mod:`gmloco.eval.metrics.locomotion`:
   sand window (no particles there), and ``window_exit_early`` when that was more than ``WINDOW_EXIT_GRACE_S`` before
   the episode ended; its rate is in the summary and the terrain table, and a run warns about it.
   ``window_exit_cause`` says why: ``"turn"`` when the soles were within the window's extent along the robot's
-  heading (the window, a box of the grid's axes, did not turn with it; ``window_exit_turn`` flags such early exits),
-  ``"reach"`` when they stepped beyond it; ``heading_turn_deg`` is the heading's largest turn from its start.
+  heading (a window that does not turn, ``turn_with_robot=False``, was left behind by the robot's turn;
+  ``window_exit_turn`` flags such early exits), ``"reach"`` when they stepped beyond it; ``heading_turn_deg`` is the
+  heading's largest turn from its start. The default window turns with the robot (``SandWindowCfg.turn_with_robot``),
+  so one window serves straight walks, circles and drifting headings alike.
 * decoded stiffness: the student's mean decoded eta over the alive steps; on the layered ``transition`` course
   also per medium, with the swings there (``layer_stats``; ``table_transition``, ``fig_mpm_transition.png``).
 
@@ -52,6 +56,7 @@ from gmloco.eval.metrics.locomotion import (
     circular_path,
     course_finished_at,
     episode_outcome,
+    metric_heading_error_deg,
     metric_path_error,
     metric_velocity_tracking_error,
     metric_yaw_tracking_error,
@@ -59,7 +64,7 @@ from gmloco.eval.metrics.locomotion import (
     swing_clearance,
 )
 from gmloco.eval.mpm.box_scene import MpmSolverCfg
-from gmloco.eval.mpm.window import SandWindowCfg
+from gmloco.eval.mpm.window import SandWindowCfg, reach_within_window
 
 __all__ = [
     "REACH_QUANTILE",
@@ -79,6 +84,7 @@ __all__ = [
     "reach_fits",
     "read_episodes",
     "report_window",
+    "resume_problem",
     "run",
     "run_cell",
     "score_episode",
@@ -128,7 +134,8 @@ class G1EvalCfg:
     window: SandWindowCfg = field(default_factory=lambda: SandWindowCfg(length=1.4, width=0.6))
     """Sand window of each robot (``moving=False``: a static bed covering the course, the naive baseline). 1.4 m
     walks as 1.8 m does, 0.6 m wide as 1.0 m does (``docs/mpm_eval.md``); a 1.0 x 0.5 m window was rejected. The
-    window does not turn with the robot: for walks whose heading drifts use a square (length = width)."""
+    window turns with the robot's heading (within ``turn_step``), so straight walks, circles and drifting headings
+    share one setting; ``turn_with_robot=False`` gives the box of the grid's axes the earlier tables used."""
     bed_margin: float = 0.6
     """Static beds: margin around the commanded path [m]."""
     robots_per_batch: int = 32
@@ -234,18 +241,23 @@ def command(spec: EpisodeSpec, cfg: G1EvalCfg) -> tuple[float, float, float]:
 def _window_and_lanes(batch: list[EpisodeSpec], cfg: G1EvalCfg) -> tuple[SandWindowCfg, float]:
     """The batch's sand window and its lane spacing [m].
 
-    A moving window is a box of the sand grid's axes that follows the pelvis (centred ``lead`` along its heading);
-    it does not turn with the robot. On a circle the heading sweeps all directions, so the window becomes a square
-    of side ``max(length, width)``: along any heading it then reaches at least as far as the straight window does
-    along x, at ``(side / width)`` times its cost. A static window covers the fastest course.
+    A moving window follows the pelvis (centred ``lead`` along its heading) and, by default, turns with it: every
+    scenario uses the same window, and the lanes are spaced for any heading (the window's diagonal plus twice its
+    lead). A window that does not turn (``turn_with_robot=False``) becomes a square of side ``max(length, width)``
+    on a circle, whose heading sweeps all directions: along any heading it then reaches at least as far as the
+    straight window does along x, at ``(side / width)`` times its cost. A static window covers the fastest course.
     """
     circle = batch[0].scenario == "circle"
     if cfg.window.moving:
         window = cfg.window
-        if circle:
-            side = max(window.length, window.width)
-            window = replace(window, length=side, width=side)
-        span = window.width + (2.0 * cfg.circle_radius if circle else 0.0)
+        if window.turn_with_robot:
+            span = math.hypot(window.length, window.width) + 2.0 * abs(window.lead)
+        else:
+            if circle:
+                side = max(window.length, window.width)
+                window = replace(window, length=side, width=side)
+            span = window.width
+        span += 2.0 * cfg.circle_radius if circle else 0.0
         return window, span + cfg.lane_gap
     v = max(s.speed for s in batch)
     vx, _, wz = command(replace(batch[0], speed=v), cfg)
@@ -472,9 +484,14 @@ def _cell_sand(specs: list[EpisodeSpec], cfg: G1EvalCfg) -> tuple[Any, SandWindo
 
 
 def _window_particles(window: SandWindowCfg, depth: float, voxel: float) -> int:
-    """Particles of one robot's window (as :class:`SandWindow` sizes it)."""
+    """Particles of one robot's window in the MPM solve: nx ny columns of nz (as :class:`SandWindow` sizes it).
+
+    A turning window holds nx ny columns to within its perimeter's cells (``window_slots`` reserves up to
+    ``sqrt(2) (nx + ny) + 2`` more slots for its worst heading); its free slots are parked, out of the solve.
+    """
     h = voxel / window.particles_per_voxel
-    return math.ceil(window.length / h) * math.ceil(window.width / h) * max(1, round(depth / h))
+    nx, ny = max(1, math.ceil(window.length / h)), max(1, math.ceil(window.width / h))
+    return nx * ny * max(1, round(depth / h))
 
 
 def score_episode(spec: EpisodeSpec, cfg: G1EvalCfg, log: dict[str, Any]) -> dict[str, Any]:
@@ -504,6 +521,7 @@ def score_episode(spec: EpisodeSpec, cfg: G1EvalCfg, log: dict[str, Any]) -> dic
         "success": out.success, "reason": out.reason, "alive_s": out.alive_steps * dt,
         "finished_at_s": finished_at,
         "vel_error": metric_velocity_tracking_error(np.tile([v, 0.0], (len(q), 1)), v_yaw, alive),
+        "heading_error_deg": metric_heading_error_deg(yaw, wz, dt, alive),
         "yaw_error": metric_yaw_tracking_error(np.full(len(q), wz), qd[:, 5], alive),
         "path_error": metric_path_error(q[:alive, :2], cmd_xy),
         "support_ratio": float(fz[len(fz) // 2 :].mean() / (log["robot_mass"] * 9.81)),
@@ -573,9 +591,9 @@ def window_exit_cause(reach: Any, exit_s: float | None, dt: float, window: SandW
     """Why the soles first left the sand window, from their reach at that sample (``sole_reach``, pelvis yaw frame).
 
     ``"turn"``: they lay within the window's extent measured along the robot's heading (behind, ahead, beside the
-    pelvis, less ``WINDOW_EXIT_MARGIN_M``), so the exit came from the robot turning: the window is a box of the
-    grid's axes and does not turn with it. ``"reach"``: they reached beyond that extent (the window is too short or
-    narrow, or a static bed). None without an exit or without a reach log (older runs).
+    pelvis, less ``WINDOW_EXIT_MARGIN_M``; for a turning window under its worst heading lag), so the exit came from
+    the robot turning away from a window that does not turn with it. ``"reach"``: they reached beyond that extent
+    (the window is too short or narrow, or a static bed). None without an exit or without a reach log (older runs).
     """
     if reach is None or exit_s is None:
         return None
@@ -591,11 +609,10 @@ def window_exit_cause(reach: Any, exit_s: float | None, dt: float, window: SandW
 def reach_fits(reach: tuple[float, float, float], window: SandWindowCfg) -> bool:
     """Whether the soles' reach (behind, ahead, beside the pelvis) [m] lies within the window's extent.
 
-    Measured along the robot's heading, less ``WINDOW_EXIT_MARGIN_M``.
+    Measured along the robot's heading, less ``WINDOW_EXIT_MARGIN_M`` on every side; a turning window may lag the
+    heading by its ``turn_step`` (``window.reach_within_window``).
     """
-    b, a, s = (float(v) + WINDOW_EXIT_MARGIN_M for v in reach)
-    half = 0.5 * window.length
-    return b <= half - window.lead and a <= half + window.lead and s <= 0.5 * window.width
+    return reach_within_window(window, (float(reach[0]), float(reach[1]), float(reach[2])), WINDOW_EXIT_MARGIN_M)
 
 
 def heading_turn_deg(yaw: np.ndarray, alive: int) -> float:
@@ -662,7 +679,7 @@ def _runs(mask: np.ndarray) -> list[tuple[int, int]]:
 
 
 METRIC_KEYS = (
-    "success", "vel_error", "yaw_error", "path_error", "support_ratio", "max_sinkage", "mean_sinkage", "floor_reached",
+    "success", "vel_error", "heading_error_deg", "yaw_error", "path_error", "support_ratio", "max_sinkage", "mean_sinkage", "floor_reached",
     "swing_apex", "swing_lift", "eta_mean", "window_exit_early", "window_exit_turn", "heading_turn_deg",
     "sole_behind_m", "sole_ahead_m", "sole_side_m",
 )  # fmt: skip
@@ -762,13 +779,43 @@ def read_episodes(path: Path, repair: bool = False) -> list[dict[str, Any]]:
     return rows
 
 
+def resume_problem(cfg: G1EvalCfg) -> str | None:
+    """Why resuming ``cfg.out_dir`` would mix sand windows (one sentence), or None.
+
+    The folder's ``summary.json`` records the window its episodes walked on (without ``turn_with_robot``: a run
+    before the window turned, on the grid's axes); a resume at another window would pool two settings in one row.
+    """
+    out = Path(cfg.out_dir)
+    if not cfg.resume or not (out / "episodes.jsonl").is_file() or not (out / "summary.json").is_file():
+        return None
+    try:
+        recorded = json.loads((out / "summary.json").read_text())["cfg"]["window"]
+    except (OSError, ValueError, KeyError, TypeError):
+        return None
+    recorded = {"turn_with_robot": False} | dict(recorded)
+    now = _jsonable(asdict(cfg.window))
+    diff = [f"{k} {recorded.get(k)!r} -> {v!r}" for k, v in now.items() if k in recorded and recorded[k] != v]
+    if not diff:
+        return None
+    flag = " (--window-fixed-axes for a run on the grid's axes)" if any("turn_with_robot" in d for d in diff) else ""
+    return (
+        f"{out} holds episodes walked on another sand window ({', '.join(diff)}); resume it with its own window"
+        f"{flag}, or pass another --out"
+    )
+
+
 def run(cfg: G1EvalCfg) -> tuple[dict[str, float], bool]:
     """Run (or resume) the evaluation; return (summary metrics, complete).
 
     Appends each episode to ``episodes.jsonl`` as it finishes, and writes ``summary.json``, tables and figures at
     the end of the call. Stops early when ``max_minutes`` is reached (complete = False) with every finished episode
     kept; the episodes still running then are dropped, since they are unfinished.
+
+    Raises:
+        ValueError: The folder's episodes walked on another sand window (``resume_problem``).
     """
+    if (problem := resume_problem(cfg)) is not None:
+        raise ValueError(problem)
     out = Path(cfg.out_dir)
     out.mkdir(parents=True, exist_ok=True)
     log_path = out / "episodes.jsonl"
@@ -916,7 +963,8 @@ def covering_window(reach: tuple[float, float, float], window: SandWindowCfg, tu
 
     Each side grows to the reach plus ``WINDOW_SUGGEST_MARGIN_M`` where the reach passed it, rounded up to 5 cm;
     no side shrinks (the convergence check accepted the window's front and rear clearances, not less). With
-    ``turned`` (walks that turned out of it) the window becomes a square of the larger side.
+    ``turned`` (walks that turned out of it) a window that does not turn becomes a square of the larger side; a
+    turning window keeps its shape.
     """
 
     def up(x: float) -> float:
@@ -927,7 +975,7 @@ def covering_window(reach: tuple[float, float, float], window: SandWindowCfg, tu
     front = max(0.5 * window.length + window.lead, up(ahead + WINDOW_SUGGEST_MARGIN_M))
     width = max(window.width, 2.0 * up(side + WINDOW_SUGGEST_MARGIN_M))
     length = rear + front
-    if turned:
+    if turned and not window.turn_with_robot:
         length = width = max(length, width)
     return replace(window, length=round(length, 3), width=round(width, 3), lead=round(0.5 * (front - rear), 3))
 
@@ -944,15 +992,17 @@ def report_window(rows: list[dict[str, Any]], window: SandWindowCfg) -> None:
         print(f"sand window: the soles reached {reach[0]:.2f} m behind the pelvis, {reach[1]:.2f} m ahead and "
               f"{reach[2]:.2f} m sideways (largest over {len(rows)} episodes); the window spans "
               f"{0.5 * window.length - window.lead:.2f} m behind, {0.5 * window.length + window.lead:.2f} m ahead and "
-              f"{0.5 * window.width:.2f} m sideways (along the grid's axes; on circles a square of the larger side)",
+              f"{0.5 * window.width:.2f} m sideways ("
+              + ("turning with the robot)" if window.turn_with_robot else
+                 "along the grid's axes; on circles a square of the larger side)"),
               file=sys.stderr, flush=True)  # fmt: skip
     early = [r for r in rows if r.get("window_exit_early")]
     if early:
         worst = min(early, key=lambda r: r["window_exit_s"])
         turned = sum(bool(r.get("window_exit_turn")) for r in early)
         why = (f"; in {turned} of them the robot had turned and the soles were within the window's reach along its "
-               "heading: the window is a box of the grid's axes and does not turn, so a walk whose heading drifts "
-               "needs a square window (--window-width equal to --window-length)") if turned else ""  # fmt: skip
+               "heading: a window that does not turn (--window-fixed-axes) leaves a drifting walk behind; let it "
+               "turn with the robot (the default)") if turned else ""  # fmt: skip
         q = reach_quantile(rows)
         cover = covering_window(q, window, turned >= WINDOW_TURN_SHARE * len(early))
         print(f"warning: in {len(early)} of {len(rows)} episodes a sole that needed sand stood outside its sand window "
@@ -984,7 +1034,10 @@ def write_outputs(
         figures, note = (write_figures(rows, out, policy, cfg.episode_s, run_dirs) if rows else []), ""
     except ImportError as exc:
         figures, note = [], f"figures skipped: {exc}"
+    from gmloco.eval.tables_mpm import paper_metrics, table_terrains
+
     doc = {"complete": complete, "policy": cfg.policy_path, "cfg": _jsonable(asdict(cfg)), "metrics": summary,
+           "paper_metrics": paper_metrics(table_terrains(rows, policy)),
            "tables": [str(p.name) for p in tables], "figures": [str(p.name) for p in figures],
            "note": note}  # fmt: skip
     tmp = out / "summary.json.tmp"

@@ -14,7 +14,7 @@ import json
 import sys
 from dataclasses import replace
 
-from gmloco.eval.g1_eval import G1EvalCfg, run
+from gmloco.eval.g1_eval import G1EvalCfg, resume_problem, run
 from gmloco.eval.g1_eval_policy import policy_problem
 from gmloco.eval.mpm.box_scene import frame_dt_problem
 from gmloco.eval.mpm.window import SandWindowCfg
@@ -80,6 +80,17 @@ def _parse(argv: list[str] | None) -> argparse.Namespace:
     p.add_argument("--window-length", type=float, default=_WINDOW.length)
     p.add_argument("--window-width", type=float, default=_WINDOW.width)
     p.add_argument("--window-lead", type=float, default=_WINDOW.lead, help="window centre ahead of the pelvis [m]")
+    p.add_argument(
+        "--window-fixed-axes",
+        action="store_true",
+        help="keep the moving window's sides on the grid's axes (default: it turns with the robot's heading)",
+    )
+    p.add_argument(
+        "--window-turn-step",
+        type=float,
+        default=_WINDOW.turn_step,
+        help="heading change of the robot that turns the window to it [rad] (0.0524 = 3 degrees)",
+    )
     p.add_argument(
         "--particles-per-voxel", type=int, default=SandWindowCfg.particles_per_voxel, help="particles per voxel edge"
     )
@@ -147,6 +158,8 @@ def cfg_from_args(a: argparse.Namespace) -> G1EvalCfg:
             length=a.window_length,
             width=a.window_width,
             lead=a.window_lead,
+            turn_with_robot=not a.window_fixed_axes,
+            turn_step=a.window_turn_step,
             particles_per_voxel=a.particles_per_voxel,
         ),
         robots_per_batch=a.robots_per_batch,
@@ -194,9 +207,10 @@ def cli_args(cfg: G1EvalCfg, cells: bool = True) -> list[str]:
         raise ValueError("the MPM solver config sets fields the command line cannot pass (only voxel, iterations, "
                          "tolerance, frame, rigid substeps and rheology solver)")  # fmt: skip
     if replace(w, moving=_WINDOW.moving, length=_WINDOW.length, width=_WINDOW.width, lead=_WINDOW.lead,
+               turn_with_robot=_WINDOW.turn_with_robot, turn_step=_WINDOW.turn_step,
                particles_per_voxel=_WINDOW.particles_per_voxel) != _WINDOW:  # fmt: skip
         raise ValueError("the sand window sets fields the command line cannot pass (only moving, size, lead, "
-                         "particles per voxel)")  # fmt: skip
+                         "turning, turn step, particles per voxel)")  # fmt: skip
     out = ["--policy", cfg.policy_path]
     if cells:
         out += ["--terrains", *cfg.terrains, "--scenarios", *cfg.scenarios]
@@ -207,10 +221,11 @@ def cli_args(cfg: G1EvalCfg, cells: bool = True) -> list[str]:
             "--substeps", str(s.rigid_substeps), "--bed-depth", repr(cfg.bed_depth),
             "--robots-per-batch", str(cfg.robots_per_batch), "--window-length", repr(w.length),
             "--window-width", repr(w.width), "--window-lead", repr(w.lead),
+            "--window-turn-step", repr(w.turn_step),
             "--particles-per-voxel", str(w.particles_per_voxel),
             "--cell-capacity-factor", repr(cfg.cell_capacity_factor), "--seed", str(cfg.seed)]  # fmt: skip
     flags = {"--no-refill": not cfg.refill, "--keep-idle-lanes": not cfg.retire_idle_lanes,
-             "--static-bed": not w.moving, "--no-mcap": not cfg.record_mcap, "--fresh": not cfg.resume,
+             "--static-bed": not w.moving, "--window-fixed-axes": not w.turn_with_robot, "--no-mcap": not cfg.record_mcap, "--fresh": not cfg.resume,
              "--no-fit-time-box": not cfg.fit_time_box}  # fmt: skip
     return out + [f for f, on in flags.items() if on]
 
@@ -221,7 +236,11 @@ def main(argv: list[str] | None = None) -> None:
     if (problem := policy_problem(a.policy)) is not None:  # checked before Warp and Newton start
         print(f"error: --policy {problem}. Nothing was run.", file=sys.stderr)
         raise SystemExit(2)
-    metrics, complete = run(cfg_from_args(a))
+    cfg = cfg_from_args(a)
+    if (problem := resume_problem(cfg)) is not None:
+        print(f"error: {problem}. Nothing was run.", file=sys.stderr)
+        raise SystemExit(2)
+    metrics, complete = run(cfg)
     print(json.dumps({"complete": complete, **{k: v for k, v in metrics.items() if "/v" not in k}}, indent=1))
 
 

@@ -4,7 +4,10 @@
 Two kinds: a file with gmloco's metadata document (student ``obs`` + ``history``, or an actor whose one input
 stacks each term's history oldest first), run by ``gmloco.deploy.export.OnnxPolicyRunner``; and a plain mjlab
 actor export, read from mjlab's comma-joined keys. Both take one
-frame of observation terms per robot, ``{name: [num_robots, dim]}``, and return actions ``[num_robots, A]``.
+frame of observation terms per robot, ``{name: [num_robots, dim]}``, and the robots' heading, and return actions
+``[num_robots, A]``. A policy whose metadata says ``yaw_command="yaw_target"`` observes the heading-corrected yaw
+rate of its training (the runner applies :mod:`gmloco.deploy.export.yaw_target` from the metadata); mjlab exports
+and ``heading_envs`` policies see the command as given.
 """
 
 from __future__ import annotations
@@ -93,8 +96,11 @@ class MjlabOnnxPolicy:
         else:
             self._fresh = sorted(set(self._fresh) | {int(r) for r in robots})
 
-    def act(self, terms: dict[str, np.ndarray]) -> np.ndarray:
-        """Push one frame of observation terms ``{name: [R, dim]}`` and return the actions [R, A]."""
+    def act(self, terms: dict[str, np.ndarray], heading: np.ndarray | None = None) -> np.ndarray:
+        """Push one frame of observation terms ``{name: [R, dim]}`` and return the actions [R, A].
+
+        ``heading`` [rad] is not used: mjlab's velocity task observes the commanded w_z as given.
+        """
         frames = [
             np.asarray(terms[n], dtype=np.float32).reshape(self.num_robots, -1) * s
             for n, s in zip(self.term_names, self.term_scale, strict=True)
@@ -140,9 +146,17 @@ class StudentOnnxPolicy:
         """Forget the histories of ``robots`` (all if None)."""
         self.runner.reset(None if robots is None else list(robots))
 
-    def act(self, terms: dict[str, np.ndarray]) -> np.ndarray:
-        """Build o_t from the terms ``{name: [R, dim]}`` by the metadata (clip, scale, order); return actions [R, A]."""
-        return np.asarray(self.runner.step(terms)).reshape(self.num_robots, -1)
+    def act(self, terms: dict[str, np.ndarray], heading: np.ndarray | None = None) -> np.ndarray:
+        """Build o_t from the terms ``{name: [R, dim]}`` by the metadata (heading rule, clip, scale, order).
+
+        Args:
+            terms: Raw observation terms, ``command`` = (v_x, v_y, w_z) as commanded.
+            heading: Base yaw of each robot [rad], [R]; a ``yaw_target`` policy needs it.
+
+        Returns:
+            Actions [R, A].
+        """
+        return np.asarray(self.runner.step(terms, heading=heading)).reshape(self.num_robots, -1)
 
 
 def policy_problem(path: str | Path) -> str | None:

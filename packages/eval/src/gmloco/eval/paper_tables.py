@@ -20,7 +20,12 @@ tool labels each run's episodes with the policy's name and writes the combined t
   sinkage; straight walks);
 * ``fig_speeds_<terrain>_<scenario>.png``: per cell, the policies' success rate (95 % interval) and median time alive
   against the commanded speed;
-* ``tables.json``: the runs, their common MPM setting, which rows are partial, and the rows as records
+* ``fig_table_<table>.png`` for every table above (``gmloco.eval.figures_tables``) and, where a run walked the
+  transition course, ``fig_adaptation_<label>.png``: GM-Loco's adaptation figure (decoded eta and swing clearance
+  over the course, per-medium means of every walk and the recorded walks);
+* ``tables.json``: the runs, their common MPM setting, which rows are partial, the paper's metrics per (policy,
+  terrain, scenario) (``paper_metrics``: ``success_pct``, ``vel_error_mps``, ``heading_error_deg``,
+  ``path_error_m``, ``episodes``; ``tables_mpm.paper_metrics``), and the rows as records
   (``--summary FILE`` writes the same to FILE, e.g. ``results/mpm_eval/summary.json``).
 
 A table mixes like with like only: runs whose MPM setting (voxel, iterations, frame, bed, window, episode length,
@@ -91,6 +96,7 @@ def combine(
         ABLATION_COLUMNS,
         TERRAIN_COLUMNS,
         TRANSITION_COLUMNS,
+        paper_metrics,
         table_ablation,
         table_per_terrain,
         table_speeds,
@@ -140,6 +146,8 @@ def combine(
     write_table(out_dir / "table_per_terrain", *table_per_terrain(terrains), note)
     figures = _figures_by_cell(loaded, out_dir) + _path_figures(grouped, summaries, out_dir)
     figures += _transition_figures(loaded, out_dir)
+    figures += _table_figures(out_dir, terrains, speeds, transition, all_speeds)
+    figures += _adaptation_figures(loaded, grouped, out_dir)
     if any(r["scenario"] == "straight" for _, rows in loaded for r in rows):
         from gmloco.eval.figures_mpm import fig_per_terrain
 
@@ -156,6 +164,7 @@ def combine(
         "window_exit_rows": exits,
         "window_exit_turn_rows": turns,
         "figures": [p.name for p in figures],
+        "paper_metrics": paper_metrics(terrains),
         "rows": [dict(zip((*TERRAIN_COLUMNS, "complete"), row, strict=True)) for row in terrains],
         "speed_rows": [dict(zip(["policy", *table_speeds([], all_speeds)[0]], row, strict=True)) for row in speeds],
     }
@@ -186,6 +195,48 @@ def _transition_figures(loaded: list[tuple[str, list[dict[str, Any]]]], out_dir:
 
     return [fig_mpm_transition(rows, out_dir / f"fig_transition_{label}.png", label)
             for label, rows in loaded if any(r.get("layers") for r in rows)]  # fmt: skip
+
+
+def _table_figures(
+    out_dir: Path,
+    terrains: list[list[Any]],
+    speeds: list[list[Any]],
+    transition: list[list[Any]],
+    all_speeds: list[float],
+) -> list[Path]:
+    """``fig_table_<table>.png``: one figure per table, drawn from the table's own rows."""
+    from gmloco.eval import figures_tables as ft
+    from gmloco.eval.tables_mpm import TERRAIN_COLUMNS, table_ablation, table_per_terrain, table_speeds
+
+    columns: list[str] = [*TERRAIN_COLUMNS, "complete"]
+    records: list[dict[str, Any]] = [{c: v for c, v in zip(columns, row, strict=True)} for row in terrains]
+    out = [ft.fig_table_terrains(records, out_dir / "fig_table_terrains.png"),
+           ft.fig_table_speeds(["policy", *table_speeds([], all_speeds)[0]], speeds, out_dir / "fig_table_speeds.png"),
+           ft.fig_table_ablation(table_ablation(terrains), out_dir / "fig_table_ablation.png"),
+           ft.fig_table_per_terrain(*table_per_terrain(terrains), out_dir / "fig_table_per_terrain.png")]  # fmt: skip
+    if transition:
+        out.append(ft.fig_table_transition(transition, out_dir / "fig_table_transition.png"))
+    return out
+
+
+def _adaptation_figures(
+    loaded: list[tuple[str, list[dict[str, Any]]]], grouped: dict[str, list[Path]], out_dir: Path
+) -> list[Path]:
+    """``fig_adaptation_<label>.png`` for each policy that walked the transition course (with its recordings)."""
+    from gmloco.eval.figures_tables import fig_adaptation
+
+    out = []
+    for label, rows in loaded:
+        layered = [r for r in rows if r.get("layers")]
+        if not layered:
+            continue
+        recs = sorted(p for d in grouped[label] for p in (d / "recordings").glob("transition__*.mcap"))
+        try:
+            out.append(fig_adaptation(layered, recs, out_dir / f"fig_adaptation_{label}.png", label))
+        except (KeyError, ValueError, OSError) as exc:
+            print(f"fig_adaptation_{label}.png skipped: a recording could not be read ({type(exc).__name__}: {exc})",
+                  file=sys.stderr)  # fmt: skip
+    return out
 
 
 def _path_figures(
@@ -285,7 +336,7 @@ def _window_exit_note(
     def why(key: str) -> str:
         if key not in turns:
             return ""
-        return f" ({turns[key]:.0f} % by the robot's turn: give it a square window)" if turns[key] > 0 else " (reach)"
+        return f" ({turns[key]:.0f} % by the robot's turn: give it a turning window)" if turns[key] > 0 else " (reach)"
 
     def fall(key: str) -> str:
         if key not in falls:
@@ -297,7 +348,7 @@ def _window_exit_note(
         "\nSoles left the sand window more than 0.25 s before the episode ended (the robot stepped where no sand "
         "was simulated), so these rows' times alive and falls may depend on the window; rerun them with a window "
         "that covers the reach printed by the run (`--window-length`, `--window-width`, `--window-lead`), or, where "
-        "the robot turned out of it (the window does not turn), with a square one (length = width). Exits within "
+        "the robot turned out of a window on the grid's axes, with a window that turns with it (the default). Exits within "
         f"{FALL_EXIT_S:g} s before a fall came with it (a stumble's trailing sole): rerun at a window no sole left, "
         "the reach-window runs' poppy-seed and deep-sand rows did not change (`results/mpm_eval/table_rows/poppy_seed_deep_sand_reach/README.md`):\n\n"
         + "\n".join(lines)

@@ -2,7 +2,8 @@
 """The MPM evaluation's paper-shaped tables (markdown + CSV) from the per-episode rows of ``episodes.jsonl``.
 
 * ``table_terrains``: one row per (policy, terrain, scenario): episodes, success rate with its 95 % Wilson
-  interval, velocity and yaw tracking error, DTW path error, mean sinkage, swing apex and lift (GM-Loco's
+  interval, velocity tracking error, heading error in degrees (GM-Loco's yaw tracking error), yaw-rate error
+  [rad/s] (an extra column), DTW path error, mean sinkage, swing apex and lift (GM-Loco's
   per-terrain and contact-model tables;
   ``window_exit_pct``: episodes whose soles left the sand window early, a validity check, NaN for older runs;
   ``window_exit_turn_pct``: those of them that left it because the robot turned (the window does not turn), NaN for
@@ -16,6 +17,8 @@
 * ``table_transition``: on the layered ``transition`` course, per (scenario, medium): episodes that reached the
   medium, the student's mean decoded stiffness eta and the swing apex / lift there (GM-Loco's terrain-transition
   analysis); written only when the rows hold transition episodes.
+* ``paper_metrics``: the ``table_terrains`` rows as ``{policy: {terrain: {scenario: {success_pct, vel_error_mps,
+  heading_error_deg, path_error_m, episodes}}}}``, the keys of the paper's tables (``summary.json``).
 """
 
 from __future__ import annotations
@@ -29,9 +32,11 @@ import numpy as np
 
 __all__ = [
     "ABLATION_COLUMNS",
+    "PAPER_METRIC_KEYS",
     "PER_TERRAIN_METRICS",
     "TERRAIN_COLUMNS",
     "TRANSITION_COLUMNS",
+    "paper_metrics",
     "table_ablation",
     "table_per_terrain",
     "table_speeds",
@@ -43,7 +48,7 @@ __all__ = [
 ]
 
 TERRAIN_COLUMNS = ("policy", "terrain", "scenario", "episodes", "success_rate_pct", "success_lo95_pct",
-                   "success_hi95_pct", "vel_error_mps",
+                   "success_hi95_pct", "vel_error_mps", "heading_error_deg",
                    "yaw_error_radps", "path_error_m", "mean_sinkage_cm", "swing_apex_cm", "swing_lift_cm",
                    "window_exit_pct", "window_exit_turn_pct", "window_exit_fall_pct")  # fmt: skip
 """Columns of ``table_terrains``."""
@@ -93,7 +98,7 @@ def table_terrains(rows: list[dict[str, Any]], policy: str) -> list[list[Any]]:
     for (terrain, scenario), rs in _cells(rows).items():
         lo, hi = wilson_interval(sum(bool(r["success"]) for r in rs), len(rs))
         out.append([policy, terrain, scenario, len(rs), 100.0 * _mean(rs, "success"), 100.0 * lo, 100.0 * hi,
-                    _mean(rs, "vel_error"),
+                    _mean(rs, "vel_error"), _mean(rs, "heading_error_deg"),
                     _mean(rs, "yaw_error"), _mean(rs, "path_error"), 100.0 * _mean(rs, "mean_sinkage"),
                     100.0 * _mean(rs, "swing_apex"), 100.0 * _mean(rs, "swing_lift"),
                     100.0 * _mean(rs, "window_exit_early"), 100.0 * _mean(rs, "window_exit_turn"),
@@ -147,7 +152,8 @@ def table_ablation(terrain_rows: list[list[Any]]) -> list[list[Any]]:
 
 
 PER_TERRAIN_METRICS = (("success_rate_pct", "success %"), ("vel_error_mps", "vel error [m/s]"),
-                       ("yaw_error_radps", "yaw error [rad/s]"))  # fmt: skip
+                       ("heading_error_deg", "heading error [deg]"),
+                       ("yaw_error_radps", "yaw-rate error [rad/s]"))  # fmt: skip
 """The per-terrain table's metrics (``table_terrains`` column, header label)."""
 
 
@@ -164,6 +170,24 @@ def table_per_terrain(terrain_rows: list[list[Any]], scenario: str = "straight")
     body = [[t, *[at[(t, p)][_COL[key]] if (t, p) in at else float("nan") for p in policies
                   for key, _ in PER_TERRAIN_METRICS]] for t in terrains]  # fmt: skip
     return header, body
+
+
+PAPER_METRIC_KEYS = {"success_pct": "success_rate_pct", "vel_error_mps": "vel_error_mps",
+                     "heading_error_deg": "heading_error_deg", "path_error_m": "path_error_m",
+                     "episodes": "episodes"}  # fmt: skip
+"""Summary key of the paper's metrics -> its ``table_terrains`` column."""
+
+
+def paper_metrics(terrain_rows: list[list[Any]]) -> dict[str, dict[str, dict[str, dict[str, float | int | None]]]]:
+    """The paper's metrics per (policy, terrain, scenario) from ``table_terrains`` rows (NaN written as None)."""
+    out: dict[str, dict[str, dict[str, dict[str, float | int | None]]]] = {}
+    for r in terrain_rows:
+        cell: dict[str, float | int | None] = {}
+        for key, column in PAPER_METRIC_KEYS.items():
+            v = r[_COL[column]]
+            cell[key] = int(v) if key == "episodes" else (float(v) if math.isfinite(float(v)) else None)
+        out.setdefault(r[_COL["policy"]], {}).setdefault(r[_COL["terrain"]], {})[r[_COL["scenario"]]] = cell
+    return out
 
 
 TRANSITION_COLUMNS = ("scenario", "medium", "episodes_reached", "eta_decoded", "swing_apex_cm", "swing_lift_cm")

@@ -66,7 +66,11 @@ class Todo:
 
 
 def cfg_from_summary(cfg: dict[str, Any]) -> G1EvalCfg:
-    """A run's ``G1EvalCfg`` from its ``summary.json`` ``cfg`` (unknown keys of older runs ignored)."""
+    """A run's ``G1EvalCfg`` from its ``summary.json`` ``cfg`` (unknown keys of older runs ignored).
+
+    A window recorded without ``turn_with_robot`` (runs before the window turned with the robot) kept the grid's
+    axes, and reads so.
+    """
 
     def build(cls: type, d: dict[str, Any]) -> Any:
         names = {f.name for f in fields(cls)}
@@ -79,7 +83,7 @@ def cfg_from_summary(cfg: dict[str, Any]) -> G1EvalCfg:
         terrains=tuple(out.terrains),
         scenarios=tuple(out.scenarios),
         speeds=tuple(float(v) for v in out.speeds),
-        window=build(SandWindowCfg, cfg.get("window", {})),
+        window=build(SandWindowCfg, {"turn_with_robot": False} | cfg.get("window", {})),
         solver=build(MpmSolverCfg, cfg.get("solver", {})),
         failure=build(FailureCfg, cfg.get("failure", {})),
     )

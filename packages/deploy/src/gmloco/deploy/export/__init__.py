@@ -11,6 +11,8 @@
   version) is refused with :class:`PolicyMetadataError`.
 * :class:`OnnxPolicyRunner`: builds o_t from raw terms by the metadata, keeps the history buffer and steps the
   policy with onnxruntime (``export`` extra).
+* :class:`YawTargetCommand` (:mod:`gmloco.deploy.export.yaw_target`): the heading rule of ``yaw_target`` policies
+  (observed w_z = clip(w_z + k * wrap(psi_target - psi))), applied by the runner and by the MPM evaluation.
 * ``gmloco-policy-info <policy.onnx>`` (:mod:`gmloco.deploy.export.info`): prints the metadata.
 
 Importing this package needs neither torch nor onnxruntime.
@@ -40,6 +42,7 @@ from gmloco.deploy.export.onnx_export import (
     verify_parity,
 )
 from gmloco.deploy.export.runner import OnnxPolicyRunner
+from gmloco.deploy.export.yaw_target import YawTargetCfg, YawTargetCommand
 
 __all__ = [
     "METADATA_KEY",
@@ -57,6 +60,8 @@ __all__ = [
     "PolicyMetadata",
     "PolicyMetadataError",
     "TimingSpec",
+    "YawTargetCfg",
+    "YawTargetCommand",
     "check_export_keeps_encoder",
     "export_policy_onnx",
     "read_policy_metadata",

@@ -7,6 +7,11 @@ metadata's order), keeps the last N frames oldest first, and feeds them in the f
 ``history`` ``[batch, N, obs_dim]`` for a student, or one ``[batch, N * obs_dim]`` input stacked term by term for
 an mjlab actor export. On the first step after construction or :meth:`OnnxPolicyRunner.reset` the older frames are
 padded as the metadata's ``history_padding`` says (``"repeat_first"``: mjlab back-fills with that first frame).
+
+A policy trained with ``yaw_command="yaw_target"`` observes a heading-corrected yaw rate: given raw terms, the
+runner replaces the last entry of the ``command`` term (w_z) by the rule of :mod:`gmloco.deploy.export.yaw_target`,
+which needs the robots' heading at every step (``step(terms, heading=...)``); ``heading_envs`` policies see the
+command as given.
 """
 
 from __future__ import annotations
@@ -19,6 +24,7 @@ from typing import Any
 import numpy as np
 
 from gmloco.deploy.export.metadata import PolicyMetadata, PolicyMetadataError
+from gmloco.deploy.export.yaw_target import YawTargetCfg, YawTargetCommand
 
 __all__ = ["OnnxPolicyRunner"]
 
@@ -67,6 +73,9 @@ class OnnxPolicyRunner:
         """z_hat of the last step, ``[num_envs, latent_dim]`` (None if the model has no ``latent`` output)."""
         self.eta: np.ndarray | None = None
         """Decoded stiffness psi(z_hat) of the last step, ``[num_envs, 1]`` (None if no ``eta`` output)."""
+        rule = YawTargetCfg.from_metadata(self.metadata)
+        self.yaw_target = None if rule is None else YawTargetCommand(rule, num_envs)
+        """Heading rule of a ``yaw_target`` policy (None: the command is observed as given)."""
 
     @staticmethod
     def _read(path: str | Path) -> PolicyMetadata:
@@ -123,6 +132,29 @@ class OnnxPolicyRunner:
             self._needs_fill[:] = True
         else:
             self._needs_fill[np.asarray(env_ids, dtype=int)] = True
+        if self.yaw_target is not None:
+            self.yaw_target.reset(env_ids)
+
+    def observed_terms(self, terms: Mapping[str, Any], heading: np.ndarray | None) -> Mapping[str, Any]:
+        """Return ``terms`` with the command's w_z (its last entry) as the policy was trained to observe it.
+
+        Args:
+            terms: Raw observation terms ``{name: [num_envs, dim]}``; ``command`` holds (..., w_z [rad/s]).
+            heading: Base yaw of each robot [rad], ``[num_envs]``; needed by ``yaw_target`` policies.
+
+        Raises:
+            ValueError: A ``yaw_target`` policy is stepped without ``heading``.
+        """
+        if self.yaw_target is None or "command" not in terms:
+            return terms
+        if heading is None:
+            raise ValueError(
+                "this policy was trained with yaw_command='yaw_target' (see gmloco-policy-info): it observes "
+                "w_z + k * wrap(yaw_target - yaw), so pass the robots' heading: runner.step(terms, heading=yaw)."
+            )
+        cmd = np.array(terms["command"], dtype=np.float64).reshape(self.num_envs, -1)
+        cmd[:, -1] = self.yaw_target.step(cmd[:, -1], heading)
+        return {**terms, "command": cmd}
 
     def push(self, obs: np.ndarray) -> None:
         """Append o_t ``[num_envs, obs_dim]`` as the newest history frame, padding envs after a reset."""
@@ -141,15 +173,17 @@ class OnnxPolicyRunner:
         stacked = [self.history[:, :, s].reshape(self.num_envs, -1) for s in self._slices]  # term-major, oldest first
         return {self.input_names[0]: np.concatenate(stacked, axis=1)}
 
-    def step(self, obs: np.ndarray | Mapping[str, Any]) -> np.ndarray:
+    def step(self, obs: np.ndarray | Mapping[str, Any], heading: np.ndarray | None = None) -> np.ndarray:
         """Push o_t and return the action ``[num_envs, num_actions]`` (``[num_actions]`` for a 1-D ``obs``).
 
         Args:
-            obs: Raw observation terms ``{name: [num_envs, dim]}`` (built into o_t by :meth:`frame`), or o_t
-                itself, ``[num_envs, obs_dim]`` or ``[obs_dim]`` when ``num_envs == 1``, already clipped and scaled.
+            obs: Raw observation terms ``{name: [num_envs, dim]}`` (heading rule applied by
+                :meth:`observed_terms`, then built into o_t by :meth:`frame`), or o_t itself, ``[num_envs, obs_dim]``
+                or ``[obs_dim]`` when ``num_envs == 1``, already corrected, clipped and scaled.
+            heading: Base yaw of each robot [rad], ``[num_envs]``, with raw terms of a ``yaw_target`` policy.
         """
         if isinstance(obs, Mapping):
-            single, frame = False, self.frame(obs)
+            single, frame = False, self.frame(self.observed_terms(obs, heading))
         else:
             single = np.ndim(obs) == 1
             frame = np.asarray(obs, dtype=np.float32).reshape(self.num_envs, self.metadata.obs_dim)

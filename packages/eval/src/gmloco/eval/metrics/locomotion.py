@@ -28,6 +28,7 @@ __all__ = [
     "dtw_distance",
     "episode_outcome",
     "failure_step",
+    "metric_heading_error_deg",
     "metric_path_error",
     "metric_velocity_tracking_error",
     "metric_yaw_tracking_error",
@@ -141,6 +142,29 @@ def metric_velocity_tracking_error(v_cmd: np.ndarray, v_meas: np.ndarray, alive_
 def metric_yaw_tracking_error(wz_cmd: np.ndarray, wz_meas: np.ndarray, alive_steps: int | None = None) -> float:
     """Mean |w_z - w_z_cmd| [rad/s] over the (alive) steps."""
     return metric_velocity_tracking_error(np.ravel(wz_cmd), np.ravel(wz_meas), alive_steps)
+
+
+def metric_heading_error_deg(
+    yaw: np.ndarray, wz_cmd: float | np.ndarray, dt: float, alive_steps: int | None = None
+) -> float:
+    """Mean heading error |wrap(psi - psi_cmd)| [deg] over the (alive) steps: GM-Loco's yaw tracking error.
+
+    The commanded heading integrates the commanded yaw rate from the start heading,
+    psi_cmd(t_i) = psi(0) + sum_{j < i} w_cmd(t_j) dt (for a constant command, psi(0) + w_cmd i dt).
+
+    Args:
+        yaw: Measured base yaw psi [rad], [T] (any branch: differences are wrapped).
+        wz_cmd: Commanded yaw rate [rad/s], scalar or [T].
+        dt: Sample period [s].
+        alive_steps: Count only the first ``alive_steps`` steps (None: all).
+    """
+    psi = np.ravel(np.asarray(yaw, dtype=np.float64))
+    if not len(psi):
+        return float("nan")
+    w = np.broadcast_to(np.asarray(wz_cmd, dtype=np.float64), psi.shape)
+    psi_cmd = psi[0] + np.concatenate([[0.0], np.cumsum(w[:-1]) * dt])
+    err = np.abs(np.angle(np.exp(1j * (psi - psi_cmd))))[_alive(len(psi), alive_steps)]
+    return float(np.degrees(err.mean())) if err.size else float("nan")
 
 
 def dtw_distance(a: np.ndarray, b: np.ndarray) -> tuple[float, int]:

@@ -26,7 +26,8 @@
   q* = q_0 + action_scale a. One frame (rigid substeps + window + MPM) is one CUDA graph when the grid has a
   fixed capacity (``max_active_cell_count > 0``).
 * Observation: the mjlab velocity-task terms: base angular velocity (pelvis, body frame), projected gravity,
-  command (v_x, v_y, w_z), joint_pos - q_0, joint_vel, last action.
+  command (v_x, v_y, w_z), joint_pos - q_0, joint_vel, last action. The policy gets the pelvis heading too, so
+  a ``yaw_target`` policy observes w_z with the heading correction it was trained with (``g1_eval_policy``).
 """
 
 from __future__ import annotations
@@ -76,20 +77,24 @@ def needs_sand(corners: np.ndarray, surface: np.ndarray, near: float = SOLE_NEAR
     return corners[..., 2] - surface <= near
 
 
-def soles_outside(corners: np.ndarray, low: np.ndarray, bounds: np.ndarray) -> np.ndarray:
+def soles_outside(
+    corners: np.ndarray, low: np.ndarray, frames: tuple[np.ndarray, np.ndarray, np.ndarray]
+) -> np.ndarray:
     """Sole corners that need sand under them but lie outside their robot's sand window, per robot.
 
     Args:
         corners: World sole corners [m], [R, 2, 8, 3].
         low: The corners that need sand (``needs_sand``), [R, 2, 8].
-        bounds: Window boxes [m], [R, 2, 2]: (lower, upper) xy corners (``SandWindow.bounds``).
+        frames: The windows (``SandWindow.frames``): centres [R, 2] [m], headings [R] [rad], half extents [2] [m].
 
     Returns:
         Number of such corners per robot, [R] (0 when the soles are over sand or in the air).
     """
-    x, y = corners[..., 0], corners[..., 1]
-    lo, hi = bounds[:, None, None, 0, :], bounds[:, None, None, 1, :]
-    out = (x < lo[..., 0]) | (x > hi[..., 0]) | (y < lo[..., 1]) | (y > hi[..., 1])
+    centre, heading, half = frames
+    c, s = np.cos(heading)[:, None, None], np.sin(heading)[:, None, None]
+    dx, dy = corners[..., 0] - centre[:, None, None, 0], corners[..., 1] - centre[:, None, None, 1]
+    u, v = c * dx + s * dy, -s * dx + c * dy
+    out = (np.abs(u) > half[0]) | (np.abs(v) > half[1])
     return (out & low).reshape(len(corners), -1).sum(axis=1)
 
 
@@ -311,7 +316,10 @@ class G1MpmScene:
         return model
 
     def _assemble(self, newton: Any, wp: Any, walls: list[np.ndarray] | None = None) -> Any:
-        """Builder of R robots (worlds or one world) and the floor; ``walls``: one wall body per robot after them."""
+        """Builder of R robots (worlds or one world) and the floor; ``walls``: one wall body per robot after them.
+
+        ``walls`` holds each wall body's first position (the window centre); ``place_walls`` turns it.
+        """
         builder = newton.ModelBuilder()
         if self.as_worlds:
             for _ in range(self.cfg.num_robots):
@@ -374,8 +382,8 @@ class G1MpmScene:
         # wall_colliders, one kinematic (zero effective mass) wall body per robot after the robots' bodies
         self.wall_body_offset = self.model.body_count
         if self.cfg.wall_colliders:
-            corners = self.window.bounds()[:, 0]
-            walls = [np.array([x, y, 0.0]) for x, y in corners]
+            centres = self.window.frames()[0]
+            walls = [np.array([x, y, 0.0]) for x, y in centres]
             self.collider_model = self._assemble(newton, wp, walls).finalize()
         else:
             self.collider_model = self.model
@@ -465,7 +473,7 @@ class G1MpmScene:
         self.action.append(self.last_action.copy())
         self.eta.append(self._decoded_eta())
         low = needs_sand(corners, surf)
-        self.sole_out.append(soles_outside(corners, low, self.window.bounds()))
+        self.sole_out.append(soles_outside(corners, low, self.window.frames()))
         self.sole_reach.append(sole_reach(corners, low, st["base_q"]))
 
     def _decoded_eta(self) -> np.ndarray:
@@ -598,7 +606,8 @@ class G1MpmScene:
             st = self._read_state()
             target = self.targets.numpy().astype(np.float64)
             if self.policy is not None:
-                self.last_action = self.policy.act(self.observation_terms(st)).astype(np.float64)
+                heading = quat_wxyz_to_roll_pitch_yaw(st["base_q"][:, [6, 3, 4, 5]])[:, 2]
+                self.last_action = self.policy.act(self.observation_terms(st), heading).astype(np.float64)
                 target = self.spec.default_joint_pos + self.spec.action_scale * self.last_action
                 self.targets.assign(target.astype(np.float32))
             self._log(st, target)
