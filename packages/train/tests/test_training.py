@@ -113,7 +113,9 @@ def test_policy_onnx_runs_from_its_gmloco_metadata(run_dir: Path) -> None:
     assert meta.joints.effort_limit[meta.joints.names.index("left_knee_joint")] == pytest.approx(139.0)
     assert json.loads((run_dir / "policy.json").read_text()) == meta.to_dict()
     runner = OnnxPolicyRunner(run_dir / "policy.onnx", num_envs=2)
-    actions = runner.step({t.name: np.zeros((2, t.dim), dtype=np.float32) for t in obs.terms})
+    zeros = {t.name: np.zeros((2, t.dim), dtype=np.float32) for t in obs.terms}
+    heading = np.zeros(2) if meta.command.yaw_command == "yaw_target" else None
+    actions = runner.step(zeros, heading=heading)
     assert actions.shape == (2, 29) and np.isfinite(actions).all()
 
 
