@@ -45,8 +45,13 @@ CURVE_TAGS = {
     "Train/mean_episode_length": "mean_episode_length",
     "Perf/total_fps": "env_steps_per_s",
     "Policy/mean_std": "action_std",
+    "Metrics/twist/error_vel_yaw": "yaw_rate_error",
+    "Metrics/twist/error_heading": "heading_error",
+    "Episode_Reward/track_yaw_target_exp": "reward_track_yaw_target",
+    "Episode_Reward/track_ang_vel_z_exp": "reward_track_ang_vel_z",
 }
-"""TensorBoard scalars of the curve besides the ``Loss/*`` terms (which are all taken)."""
+"""TensorBoard scalars of the curve besides the ``Loss/*`` terms (which are all taken); the yaw-tracking ones feed
+the yaw panel of ``gmloco.train.learning_curves``."""
 
 
 def _parse(argv: list[str] | None) -> argparse.Namespace:
