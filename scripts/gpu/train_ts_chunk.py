@@ -87,10 +87,11 @@ def _parse(argv: list[str] | None) -> argparse.Namespace:
     )
     p.add_argument(
         "--foot-clearance",
-        choices=["penalty", "reward", "touchdown"],
+        choices=["penalty", "reward", "touchdown", "sinkage"],
         default=None,
         help="GranularTaskCfg.foot_clearance (default: the task's, the L2 penalty); 'touchdown' pays each swing's "
-        "lift out of the footprint at touchdown; pass the same value to every chunk of a run",
+        "lift out of the footprint at touchdown; 'sinkage' as touchdown with a swing target of 9 cm above the surface "
+        "plus the footprint's depth; pass the same value to every chunk of a run",
     )
     p.add_argument(
         "--foot-faces",
