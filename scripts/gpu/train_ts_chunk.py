@@ -100,6 +100,14 @@ def _parse(argv: list[str] | None) -> argparse.Namespace:
         help="GranularTaskCfg.foot_faces (default: the task's, the sole only); 'box' samples all six faces of the "
         "foot box, so a buried swinging foot meets sand; pass the same value to every chunk of a run",
     )
+    p.add_argument(
+        "--allow-changed",
+        action="append",
+        default=[],
+        metavar="KEY",
+        help="config key (dotted, or a prefix such as task.reward_weights) a resumed chunk may change on purpose "
+        "(repeatable); without it a chunk whose config differs from the run's train_cfg.json is refused",
+    )
     p.add_argument("--teacher-checkpoint", type=Path, default=None)
     p.add_argument(
         "--warm-start-ppo",
@@ -414,8 +422,15 @@ def main(argv: list[str] | None = None) -> dict[str, Any]:
         warm_start_student_encoder=None
         if init is None or args.warm_start_encoder is None
         else str(args.warm_start_encoder),
+        allow_changed=tuple(args.allow_changed),
     )
-    metrics = train(cfg)
+    from gmloco.train.resume import ResumeError
+
+    try:
+        metrics = train(cfg)
+    except ResumeError as err:
+        print(f"train_ts_chunk: {err}", file=sys.stderr)
+        sys.exit(2)
     ckpt = _newest(run_dir)
     assert ckpt is not None, f"train() left no checkpoint in {run_dir}"
     _copy_checkpoint(ckpt, args.out / "checkpoint.pt", slim=not args.full_checkpoint)
