@@ -145,7 +145,9 @@ def main(argv: Sequence[str] | None = None) -> int:
 
     Chunk starts come from the ``manifest.json`` beside the last source (the run the figure is for).
     """
-    p = argparse.ArgumentParser(prog="python -m gmloco.train.learning_curves", description=__doc__.splitlines()[0])
+    p = argparse.ArgumentParser(
+        prog="python -m gmloco.train.learning_curves", description=(__doc__ or "").splitlines()[0]
+    )
     p.add_argument("sources", nargs="+", help="run folders, curve.csv or chunk summary.json files, oldest first")
     p.add_argument("--out", required=True, help="PNG to write, e.g. artifacts/<run>/learning_curve.png")
     p.add_argument("--title", default=None, help="figure title (default: the last source's folder name)")

@@ -55,8 +55,11 @@ def gate_cells(cfg: GateCfg) -> list[GateCell]:
     """Every episode of the gate: per material forward, yaw and circle cells, then the held-out grid."""
     import gmloco.contact as gc
 
-    commands: list[tuple[CellKind, tuple[float, float, float]]] = [("forward", (v, 0.0, 0.0)) for v in cfg.speeds]
-    commands += [("yaw", (cfg.yaw_forward_speed, 0.0, w)) for w in cfg.yaw_rates]
+    commands: list[tuple[CellKind, tuple[float, float, float]]] = []
+    for v in cfg.speeds:
+        commands.append(("forward", (v, 0.0, 0.0)))
+    for w in cfg.yaw_rates:
+        commands.append(("yaw", (cfg.yaw_forward_speed, 0.0, w)))
     commands.append(("circle", (cfg.circle_speed, 0.0, cfg.circle_speed / cfg.circle_radius_m)))
     cells = []
     for name in cfg.materials:
@@ -147,7 +150,7 @@ def _onnx_actor(cfg: GateCfg, policy: GatePolicy) -> tuple[Any, Actor]:
 
     def act(obs: dict[str, torch.Tensor]) -> tuple[torch.Tensor, torch.Tensor | None]:
         x = obs["actor"].cpu().numpy().astype(np.float32)
-        out = np.concatenate([session.run(None, {name: x[i : i + 1]})[0] for i in range(len(x))])
+        out = np.concatenate([np.asarray(session.run(None, {name: x[i : i + 1]})[0]) for i in range(len(x))])
         return torch.as_tensor(out, device=env.device), None
 
     return env, act
