@@ -160,7 +160,11 @@ def _newest(folder: Path) -> Path | None:
 
 
 def _seed_run_dir(run_dir: Path, artifact: Path) -> int | None:
-    """Copy the committed checkpoint into an empty run directory; return its iteration."""
+    """Copy the committed checkpoint and its run config into an empty run directory; return its iteration.
+
+    The config (``train_cfg.json``, else the ``train_cfg`` of a chunk's ``summary.json``) is what the resume check
+    of ``gmloco.train.resume`` compares the chunk's config with.
+    """
     if _newest(run_dir) is not None or not (artifact / "checkpoint.pt").exists():
         return None
     import torch
@@ -169,6 +173,10 @@ def _seed_run_dir(run_dir: Path, artifact: Path) -> int | None:
     shutil.copy(artifact / "checkpoint.pt", run_dir / f"model_{it}.pt")
     if (artifact / "train_cfg.json").exists():
         shutil.copy(artifact / "train_cfg.json", run_dir / "train_cfg.json")
+    elif (artifact / "summary.json").exists():
+        saved = json.loads((artifact / "summary.json").read_text()).get("train_cfg")
+        if saved:
+            (run_dir / "train_cfg.json").write_text(json.dumps(saved, indent=1))
     return it
 
 
