@@ -24,6 +24,7 @@ KEYS = ("success_pct", "vel_error_mps", "yaw_rate_ratio", "heading_drift_deg", "
         (["--policy", "{tmp}"], "neither train_cfg.json nor a summary.json"),
         (["--policy", "artifacts/gm_loco_student_td", "--materials", "sand"], "unknown ['sand']"),
         (["--policy", "artifacts/gm_loco_student_td", "--yaw-rates", "0,1"], "0 has no achieved/commanded ratio"),
+        (["--policy", "artifacts/gm_loco_student_td", "--held-out-grid", "1,1"], "at least two points"),
     ],
 )
 def test_bad_input_exits_2(
@@ -44,7 +45,7 @@ def test_cpu_sized_gate_writes_every_key(run: str, tmp_path: Path, monkeypatch: 
     monkeypatch.chdir(REPO)
     out = tmp_path / "summary.json"
     argv = ["--policy", f"artifacts/{run}", "--out", str(out), "--episodes", "2", "--num-envs", "4", "--seconds", "2",
-            "--materials", "basalt,poppy_seed", "--speeds", "1.0", "--yaw-rates", "0.5", "--held-out-grid", "1,1"]  # fmt: skip
+            "--materials", "basalt,poppy_seed", "--speeds", "1.0", "--yaw-rates", "0.5", "--held-out-grid", "2,1"]  # fmt: skip
     assert main(argv) == 0
     summary = json.loads(out.read_text())
     assert set(KEYS) <= set(summary) and set(summary["pass"]) == {*KEYS, "all"}

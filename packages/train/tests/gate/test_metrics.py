@@ -23,14 +23,14 @@ def test_heading_drift_wraps_across_pi() -> None:
 
 
 def test_yaw_of_quat_recovers_a_rotation_about_z() -> None:
-    """q = (cos(a/2), 0, 0, sin(a/2)) has yaw a."""
+    """A quaternion (cos(a/2), 0, 0, sin(a/2)) has yaw a."""
     a = np.array([-2.0, 0.0, 0.7, 3.0])
     q = np.stack([np.cos(a / 2), 0 * a, 0 * a, np.sin(a / 2)], axis=-1)
     np.testing.assert_allclose(yaw_of_quat(q), a, atol=1e-12)
 
 
 def test_circle_reference_closes_after_one_period() -> None:
-    """v = 1 m/s, w = 0.5 rad/s: radius 2 m, back at the start after 4 pi s, 4 m across after 2 pi s."""
+    """At 1 m/s and 0.5 rad/s: radius 2 m, back at the start after 4 pi s, 4 m across after 2 pi s."""
     t = np.array([0.0, 2 * math.pi, 4 * math.pi])
     path = circle_reference(np.array([1.0, -1.0]), math.pi / 2, 1.0, 0.5, t)
     # Heading +y: the circle's centre is 2 m to the left (-x) of the start, the far point at (1 - 4, -1).
@@ -38,7 +38,7 @@ def test_circle_reference_closes_after_one_period() -> None:
 
 
 def test_circle_reference_zero_yaw_rate_is_a_line() -> None:
-    """w = 0: p(t) = p0 + v t along the heading."""
+    """A zero yaw rate gives the line p(t) = p0 + v t along the heading."""
     path = circle_reference(np.zeros(2), 0.0, 2.0, 0.0, np.array([0.0, 1.5]))
     np.testing.assert_allclose(path, [[0.0, 0.0], [3.0, 0.0]], atol=1e-12)
 

@@ -75,8 +75,11 @@ def _cfg(args: argparse.Namespace) -> GateCfg:
     if any(w == 0.0 for w in args.yaw_rates):
         raise ValueError("--yaw-rates: 0 has no achieved/commanded ratio; straight walking is in --speeds")
     grid = tuple(int(x) for x in args.held_out_grid.split(",")) if args.held_out_grid.count(",") == 1 else ()
-    if len(grid) != 2 or min(grid) < 1:
-        raise ValueError(f"--held-out-grid {args.held_out_grid!r}: expected two integers >= 1, e.g. 3,3")
+    if len(grid) != 2 or min(grid) < 1 or grid[0] * grid[1] < 2:
+        raise ValueError(
+            f"--held-out-grid {args.held_out_grid!r}: expected two integers >= 1 with at least two points (R^2 of "
+            "the decoded eta needs more than one material), e.g. 3,3"
+        )
     return GateCfg(
         policy_dir=args.policy,
         out_path=args.out,
