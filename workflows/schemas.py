@@ -136,6 +136,10 @@ class FootClearanceForm(str, Enum):
 
     penalty = "penalty"
     reward = "reward"
+    touchdown = "touchdown"
+    """The penalty plus the swing's lift out of its footprint, paid at touchdown (12 cm cap)."""
+    sinkage = "sinkage"
+    """The touchdown terms with a target of 9 cm above the surface plus the footprint's depth (at most 20 cm)."""
 
 
 class TerrainName(str, Enum):

@@ -67,28 +67,13 @@ def _merge_curve(path: Path, new: dict[str, list[float]]) -> list[dict[str, floa
     return ordered
 
 
-def _plot(rows: list[dict[str, float]], path: Path, title: str, chunks: list[dict[str, Any]] | None = None) -> None:
-    """Mean reward and episode length against iteration; dashed lines where a chunk started (notes say why)."""
-    import matplotlib
+def _plot(dest: Path, title: str) -> None:
+    """``learning_curve.png`` of the merged ``curve.csv`` (``gmloco.train.learning_curves``; dashed: chunk starts)."""
+    from gmloco.train.learning_curves import chunk_starts, fig_learning_curves, read_curve
 
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
-    it = [r["iteration"] for r in rows]
-    fig, ax = plt.subplots(1, 2, figsize=(9, 3.2), constrained_layout=True)
-    ax[0].plot(it, [r["mean_reward"] for r in rows], lw=1)
-    ax[0].set(xlabel="PPO iteration", ylabel="mean episode reward", title=title)
-    ax[1].plot(it, [r["mean_episode_length"] for r in rows], lw=1, color="C1")
-    ax[1].set(xlabel="PPO iteration", ylabel="mean episode length [steps of 20 ms]")
-    starts = sorted({float(c["resumed_from_iteration"]) for c in chunks or [] if c.get("resumed_from_iteration")})
-    for a in ax:
-        a.grid(alpha=0.3)
-        for x in starts:
-            a.axvline(x, ls="--", lw=0.7, color="0.5")
-    if starts:
-        ax[0].text(0.01, 0.02, "dashed: chunk starts (manifest notes)", transform=ax[0].transAxes, fontsize=7)
-    fig.savefig(path, dpi=110)
-    plt.close(fig)
+    fig_learning_curves(
+        read_curve(dest / "curve.csv"), dest / "learning_curve.png", title, chunk_starts(dest / "manifest.json")
+    )
 
 
 def main() -> None:
@@ -108,7 +93,7 @@ def main() -> None:
         _write_json(dest / "checks.json", summary["checks"])  # teacher-student: eta R2, parity, action error
     if summary.get("last_values"):
         _write_json(dest / "last_values.json", summary["last_values"])  # per-term rewards, terminations, curricula
-    rows = _merge_curve(dest / "curve.csv", summary["curve"])
+    _merge_curve(dest / "curve.csv", summary["curve"])
     manifest_path = dest / "manifest.json"
     manifest = json.loads(manifest_path.read_text()) if manifest_path.exists() else {"run": args.run, "chunks": []}
     manifest["chunks"].append(
@@ -130,7 +115,7 @@ def main() -> None:
     script = summary.get("script", "scripts/gpu/train_chunk.py")
     manifest["produced_by"] = f"{script} on the GPU machine, merged by scripts/gpu/collect_chunk.py"
     _write_json(manifest_path, manifest)
-    _plot(rows, dest / "learning_curve.png", args.run, manifest["chunks"])
+    _plot(dest, args.run)
     print(f"{dest}: iteration {manifest['iteration']}, {manifest['gpu_minutes_total']:.1f} GPU-minutes in total")
 
 

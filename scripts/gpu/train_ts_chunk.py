@@ -45,8 +45,13 @@ CURVE_TAGS = {
     "Train/mean_episode_length": "mean_episode_length",
     "Perf/total_fps": "env_steps_per_s",
     "Policy/mean_std": "action_std",
+    "Metrics/twist/error_vel_yaw": "yaw_rate_error",
+    "Metrics/twist/error_heading": "heading_error",
+    "Episode_Reward/track_yaw_target_exp": "reward_track_yaw_target",
+    "Episode_Reward/track_ang_vel_z_exp": "reward_track_ang_vel_z",
 }
-"""TensorBoard scalars of the curve besides the ``Loss/*`` terms (which are all taken)."""
+"""TensorBoard scalars of the curve besides the ``Loss/*`` terms (which are all taken); the yaw-tracking ones feed
+the yaw panel of ``gmloco.train.learning_curves``."""
 
 
 def _parse(argv: list[str] | None) -> argparse.Namespace:
@@ -82,10 +87,11 @@ def _parse(argv: list[str] | None) -> argparse.Namespace:
     )
     p.add_argument(
         "--foot-clearance",
-        choices=["penalty", "reward", "touchdown"],
+        choices=["penalty", "reward", "touchdown", "sinkage"],
         default=None,
         help="GranularTaskCfg.foot_clearance (default: the task's, the L2 penalty); 'touchdown' pays each swing's "
-        "lift out of the footprint at touchdown; pass the same value to every chunk of a run",
+        "lift out of the footprint at touchdown; 'sinkage' as touchdown with a swing target of 9 cm above the surface "
+        "plus the footprint's depth; pass the same value to every chunk of a run",
     )
     p.add_argument(
         "--foot-faces",
@@ -93,6 +99,14 @@ def _parse(argv: list[str] | None) -> argparse.Namespace:
         default=None,
         help="GranularTaskCfg.foot_faces (default: the task's, the sole only); 'box' samples all six faces of the "
         "foot box, so a buried swinging foot meets sand; pass the same value to every chunk of a run",
+    )
+    p.add_argument(
+        "--allow-changed",
+        action="append",
+        default=[],
+        metavar="KEY",
+        help="config key (dotted, or a prefix such as task.reward_weights) a resumed chunk may change on purpose "
+        "(repeatable); without it a chunk whose config differs from the run's train_cfg.json is refused",
     )
     p.add_argument("--teacher-checkpoint", type=Path, default=None)
     p.add_argument(
@@ -146,7 +160,11 @@ def _newest(folder: Path) -> Path | None:
 
 
 def _seed_run_dir(run_dir: Path, artifact: Path) -> int | None:
-    """Copy the committed checkpoint into an empty run directory; return its iteration."""
+    """Copy the committed checkpoint and its run config into an empty run directory; return its iteration.
+
+    The config (``train_cfg.json``, else the ``train_cfg`` of a chunk's ``summary.json``) is what the resume check
+    of ``gmloco.train.resume`` compares the chunk's config with.
+    """
     if _newest(run_dir) is not None or not (artifact / "checkpoint.pt").exists():
         return None
     import torch
@@ -155,6 +173,10 @@ def _seed_run_dir(run_dir: Path, artifact: Path) -> int | None:
     shutil.copy(artifact / "checkpoint.pt", run_dir / f"model_{it}.pt")
     if (artifact / "train_cfg.json").exists():
         shutil.copy(artifact / "train_cfg.json", run_dir / "train_cfg.json")
+    elif (artifact / "summary.json").exists():
+        saved = json.loads((artifact / "summary.json").read_text()).get("train_cfg")
+        if saved:
+            (run_dir / "train_cfg.json").write_text(json.dumps(saved, indent=1))
     return it
 
 
@@ -408,8 +430,15 @@ def main(argv: list[str] | None = None) -> dict[str, Any]:
         warm_start_student_encoder=None
         if init is None or args.warm_start_encoder is None
         else str(args.warm_start_encoder),
+        allow_changed=tuple(args.allow_changed),
     )
-    metrics = train(cfg)
+    from gmloco.train.resume import ResumeError
+
+    try:
+        metrics = train(cfg)
+    except ResumeError as err:
+        print(f"train_ts_chunk: {err}", file=sys.stderr)
+        sys.exit(2)
     ckpt = _newest(run_dir)
     assert ckpt is not None, f"train() left no checkpoint in {run_dir}"
     _copy_checkpoint(ckpt, args.out / "checkpoint.pt", slim=not args.full_checkpoint)

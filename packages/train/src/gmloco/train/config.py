@@ -165,7 +165,7 @@ class GranularTaskCfg:
     tens of thousands of iterations; 0.1 fits it into a ~2k-iteration budget (ramp over 1.5k iterations, stages
     at 1k and 1.5k). Below 1, the wide initial tracking kernel (std 1 m/s, where standing still already earns
     ~70 % of the tracking reward) is left before the policy settles on standing."""
-    foot_clearance: Literal["penalty", "reward", "touchdown"] = "penalty"
+    foot_clearance: Literal["penalty", "reward", "touchdown", "sinkage"] = "penalty"
     """Swing-height term. ``"penalty"``: the GM-Loco project page's ``foot_clearance_l2`` (weight -2, zero for
     still feet); ``"reward"``: the public code's exp form (weight +5), which pays its maximum to feet that do not
     move, so a policy that stands still earns it in full (measured: 62 % of the term's maximum at iteration 1,400
@@ -174,7 +174,11 @@ class GranularTaskCfg:
     swing), which pays neither standing nor an early fall (the penalty alone at weight -300 taught a teacher to fall
     early, results/mpm_eval/probes/swing_trip/README.md). With ``foot_faces="box"`` it trained ``artifacts/gm_loco_teacher_td``,
     whose student is the first policy to walk 10 s on MPM sand (results/mpm_eval/probes/touchdown_lift/README.md); the weight
-    is that run's, not tuned against others."""
+    is that run's, not tuned against others. ``"sinkage"``: the same two terms (same names and weights) with a
+    terrain-aware target: 9 cm above the surface plus the depth of the foot's last footprint, at most 20 cm
+    (``mdp.foot_clearance_sinkage_l2``, ``mdp.swing_apex_sinkage_at_touchdown``), so soft ground, where the feet sink
+    deeper, asks for a higher apex, as the project page's swing (~9 cm stiff, ~16 cm soft); the touchdown mode's
+    fixed 12 cm lift cap stops paying at a 5 cm apex out of a 7 cm footprint."""
     yaw_command: Literal["yaw_target", "heading_envs"] = "yaw_target"
     """Heading command. ``"yaw_target"`` (GM-Loco's code): every env holds a yaw target that integrates the
     commanded w_z (``mdp.commands.YawTargetVelocityCommand``), rewarded by ``track_yaw_target_exp`` (weight 4), and

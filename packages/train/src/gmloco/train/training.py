@@ -3,7 +3,8 @@
 
 A run lives in one directory. Calling :func:`train` again with the same config resumes from the newest
 checkpoint there and continues until ``max_iterations`` iterations are done in total, so a killed or
-time-boxed run is continued by repeating the same call.
+time-boxed run is continued by repeating the same call. A call with another config, or a run directory whose
+checkpoints are damaged, is handled by :mod:`gmloco.train.resume` before anything is written.
 """
 
 from __future__ import annotations
@@ -12,6 +13,7 @@ import copy
 import json
 import math
 import os
+import sys
 import time
 from collections.abc import Callable
 from dataclasses import asdict, dataclass, field
@@ -19,13 +21,9 @@ from pathlib import Path
 from typing import Any, Literal
 
 from gmloco.train.config import GranularTaskCfg
+from gmloco.train.resume import check_resume_cfg, resumable_checkpoint
 
 __all__ = ["TrainRunCfg", "train"]
-
-_RUN_CFG_FILE = "train_cfg.json"
-"""Resolved run config written on the first call (compared on resume)."""
-_RESUME_INVARIANT = ("task", "num_envs", "num_steps_per_env", "hidden_dims", "seed")
-"""Fields that must not change between the calls of one run."""
 
 
 @dataclass
@@ -76,20 +74,9 @@ class TrainRunCfg:
     """Student only, with ``init_checkpoint`` a teacher: an earlier student checkpoint whose history encoder (TCN +
     normalizer) replaces the fresh one when ``run_dir`` has no checkpoint (distilling from a new teacher); None: a
     fresh encoder."""
-
-
-def _check_resume_cfg(run_dir: Path, cfg: TrainRunCfg) -> None:
-    """Write the run config on the first call; refuse to resume a run whose invariants changed."""
-    current = json.loads(json.dumps(asdict(cfg), default=str))
-    path = run_dir / _RUN_CFG_FILE
-    if path.exists():
-        saved = json.loads(path.read_text())
-        changed = [k for k in _RESUME_INVARIANT if saved.get(k) != current.get(k)]
-        if changed:
-            raise ValueError(f"{run_dir} was started with a different {changed}; use another run_dir")
-    tmp = path.with_suffix(".tmp")
-    tmp.write_text(json.dumps(current, indent=1))
-    os.replace(tmp, path)
+    allow_changed: tuple[str, ...] = ()
+    """Dotted config keys (or prefixes, e.g. ``task.reward_weights``) a resumed call may change on purpose; any
+    other change of :data:`gmloco.train.resume.RESUME_INVARIANT` is refused."""
 
 
 def _make_env(cfg: TrainRunCfg) -> Any:
@@ -152,14 +139,15 @@ def train(cfg: TrainRunCfg, on_iteration: Callable[[int, int], None] | None = No
     os.environ.setdefault("GIT_PYTHON_REFRESH", "quiet")
     run_dir = Path(cfg.run_dir).resolve()
     run_dir.mkdir(parents=True, exist_ok=True)
-    _check_resume_cfg(run_dir, cfg)
+    check_resume_cfg(run_dir, json.loads(json.dumps(asdict(cfg), default=str)), cfg.allow_changed)
+    checkpoint, skipped = resumable_checkpoint(run_dir) if cfg.resume else (None, [])
+    for line in skipped:
+        print(f"train: {line}; resuming from {checkpoint}", file=sys.stderr)
 
     from gmloco.train.rl.export import export_policy_onnx
-    from gmloco.train.rl.runner import latest_checkpoint
 
     env = _make_env(cfg)
     runner = _make_runner(cfg, env, run_dir)
-    checkpoint = latest_checkpoint(run_dir) if cfg.resume else None
     if checkpoint is not None:
         runner.load(str(checkpoint))
     elif cfg.init_checkpoint is not None:
@@ -178,6 +166,7 @@ def train(cfg: TrainRunCfg, on_iteration: Callable[[int, int], None] | None = No
         export_policy_onnx(runner, run_dir / "policy.onnx", cfg.task, run_name=run_dir.name, extra=extra)
     env.close()
     summary.update(resumed_from_iteration=float(resumed_from), wall_seconds=time.monotonic() - start)
+    summary["corrupt_checkpoints_skipped"] = float(len(skipped))
     clean = {k: (v if math.isfinite(v) else None) for k, v in summary.items()}
     (run_dir / "metrics.json").write_text(json.dumps(clean, indent=1))
     return summary

@@ -38,10 +38,13 @@ __all__ = [
     "flat_orientation_l2",
     "foot_clearance",
     "foot_clearance_l2",
+    "foot_clearance_sinkage_l2",
     "joint_acc_l2",
     "joint_vel_l2",
     "lin_vel_z_l2",
     "no_fly",
+    "sinkage_clearance_target",
+    "swing_apex_sinkage_at_touchdown",
     "swing_height_at_touchdown",
     "track_ang_vel_z_exp",
     "track_heading_exp",
@@ -90,8 +93,13 @@ def _clearance(
     return torch.exp(-_clearance_error(height, speed_xy, target, tanh_mult) / std)
 
 
-def _clearance_error(height: torch.Tensor, speed_xy: torch.Tensor, target: float, tanh_mult: float) -> torch.Tensor:
-    """sum_f (h_f - target)^2 tanh(k |v_f,xy|) [m^2] for feet heights h [m] and speeds [m/s]; 0 for still feet."""
+def _clearance_error(
+    height: torch.Tensor, speed_xy: torch.Tensor, target: float | torch.Tensor, tanh_mult: float
+) -> torch.Tensor:
+    """sum_f (h_f - target)^2 tanh(k |v_f,xy|) [m^2] for feet heights h [m] and speeds [m/s]; 0 for still feet.
+
+    ``target`` [m] is one height, or one per foot ``[W, 2]``.
+    """
     return (torch.square(height - target) * torch.tanh(tanh_mult * speed_xy)).sum(dim=1)
 
 
@@ -328,6 +336,59 @@ def foot_clearance_l2(env: ManagerBasedRlEnv, target_height: float, tanh_mult: f
     feet = get_sand(env).feet.update()
     speed = torch.linalg.vector_norm(feet.vel_w[..., :2], dim=-1)
     return _clearance_error(feet.height, speed, target_height, tanh_mult)
+
+
+def sinkage_clearance_target(
+    sinkage: torch.Tensor, target_height: float, sinkage_gain: float, max_height: float
+) -> torch.Tensor:
+    """Return the swing height target min(h_0 + g max(s, 0), h_max) [m] for footprint depths s [m], shape of s.
+
+    The GM-Loco project page shows the swing apex rising from ~9 cm on stiff ground to ~16 cm on soft ground; a
+    target that grows with how deep the foot's last stance sank asks for that without a material label (a foot
+    that sank s must first climb s out of its footprint, and soft sand drags the foot box while it is buried).
+    """
+    return torch.clamp(target_height + sinkage_gain * torch.clamp(sinkage, min=0.0), max=max_height)
+
+
+def foot_clearance_sinkage_l2(
+    env: ManagerBasedRlEnv, target_height: float, sinkage_gain: float, max_height: float, tanh_mult: float
+) -> torch.Tensor:
+    """Speed-weighted squared miss of a swing target that grows with the footprint's depth (negative weight).
+
+    As :func:`foot_clearance_l2`, with the target of each foot :func:`sinkage_clearance_target` of the depth of its
+    current (in the air: last) stance below the free surface, ``-stance_low`` [m].
+    """
+    feet = get_sand(env).feet.update()
+    speed = torch.linalg.vector_norm(feet.vel_w[..., :2], dim=-1)
+    target = sinkage_clearance_target(-feet.stance_low, target_height, sinkage_gain, max_height)
+    return _clearance_error(feet.height, speed, target, tanh_mult)
+
+
+def _sinkage_lift_paid(
+    apex: torch.Tensor, lift: torch.Tensor, target_height: float, sinkage_gain: float, max_height: float
+) -> torch.Tensor:
+    """Lift of a finished swing [m], clipped to [0, s + target(s)] with s = lift - apex the footprint's depth.
+
+    The cap is the lift that puts the apex at :func:`sinkage_clearance_target` above the surface, so the payment
+    grows until then: on stiff ground (s ~ 0) up to h_0, from a 7 cm footprint up to 7 cm + h_0 + g 7 cm. The
+    fixed 12 cm lift cap of :func:`swing_height_at_touchdown` instead stops paying at a 5 cm apex there.
+    """
+    sinkage = torch.clamp(lift - apex, min=0.0)
+    cap = sinkage + sinkage_clearance_target(sinkage, target_height, sinkage_gain, max_height)
+    return torch.minimum(torch.clamp(lift, min=0.0), cap)
+
+
+def swing_apex_sinkage_at_touchdown(
+    env: ManagerBasedRlEnv, target_height: float, sinkage_gain: float, max_height: float, command_name: str
+) -> torch.Tensor:
+    """Sum over feet touching down this step of the finished swing's lift, capped at the sinkage-aware target [m].
+
+    :func:`_sinkage_lift_paid` of the swing's apex and lift (``last_swing_apex``, ``last_swing_lift``); paid only
+    for completed swings while a motion is commanded, as :func:`swing_height_at_touchdown`.
+    """
+    feet = get_sand(env).feet.update()
+    paid = _sinkage_lift_paid(feet.last_swing_apex, feet.last_swing_lift, target_height, sinkage_gain, max_height)
+    return (paid * feet.first_contact).sum(dim=1) * _moving(_command(env, command_name), 0.05)
 
 
 def undesired_contacts(env: ManagerBasedRlEnv, sensor_name: str) -> torch.Tensor:

@@ -107,6 +107,8 @@ def _clearance_term(task: GranularTaskCfg) -> dict[str, RewardTermCfg]:
                 func=mdp.foot_clearance, weight=5.0, params={"target_height": 0.10, "std": 0.05, "tanh_mult": 2.0}
             )
         }
+    if task.foot_clearance == "sinkage":
+        return _sinkage_clearance_terms()
     terms = {
         "foot_clearance_l2": RewardTermCfg(
             func=mdp.foot_clearance_l2, weight=-2.0, params={"target_height": 0.10, "tanh_mult": 2.0}
@@ -122,6 +124,26 @@ def _clearance_term(task: GranularTaskCfg) -> dict[str, RewardTermCfg]:
             params={"target_height": 0.12, "command_name": CMD, "relative": True},
         )
     return terms
+
+
+SINKAGE_CLEARANCE = {"target_height": 0.09, "sinkage_gain": 1.0, "max_height": 0.20}
+"""Swing target of ``foot_clearance="sinkage"``: 9 cm above the surface on stiff ground (the project page's
+basalt-like apex) plus the footprint depth (gain 1: 7 cm sinkage in poppy seed, measured in
+artifacts/gm_loco_student_td/README.md as lift minus apex, gives ~16 cm), at most 20 cm [m, -, m]."""
+
+
+def _sinkage_clearance_terms() -> dict[str, RewardTermCfg]:
+    """The touchdown mode's two terms (names, weights) with the sinkage-aware target of :data:`SINKAGE_CLEARANCE`."""
+    return {
+        "foot_clearance_l2": RewardTermCfg(
+            func=mdp.foot_clearance_sinkage_l2, weight=-2.0, params={**SINKAGE_CLEARANCE, "tanh_mult": 2.0}
+        ),
+        "swing_height_at_touchdown": RewardTermCfg(
+            func=mdp.swing_apex_sinkage_at_touchdown,
+            weight=100.0,
+            params={**SINKAGE_CLEARANCE, "command_name": CMD},
+        ),
+    }
 
 
 def _feet_terms(task: GranularTaskCfg) -> dict[str, RewardTermCfg]:

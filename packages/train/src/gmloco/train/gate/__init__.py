@@ -1,0 +1,12 @@
+# SPDX-License-Identifier: Apache-2.0
+"""The training gate: a delivered policy scored per material and command in the granular training simulator.
+
+``python -m gmloco.train.gate --policy artifacts/<run> --out results/training_gate/summary.json`` writes issue 34's
+keys (``success_pct``, ``vel_error_mps``, ``yaw_rate_ratio``, ``heading_drift_deg``, ``circle_dtw_m``,
+``swing_apex_cm``, ``eta_r2_heldout``, ``gpu_minutes``) and a ``pass`` map against :class:`GateThresholdsCfg`.
+"""
+
+from gmloco.train.gate.config import GateCfg, GateThresholdsCfg
+from gmloco.train.gate.run import run_gate
+
+__all__ = ["GateCfg", "GateThresholdsCfg", "run_gate"]

@@ -1,0 +1,81 @@
+# SPDX-License-Identifier: Apache-2.0
+"""The gate's reduction of episode rows to the issue's keys and the pass map, on hand-made rows."""
+
+from __future__ import annotations
+
+import math
+from typing import Any
+
+import numpy as np
+import pytest
+
+from gmloco.train.gate.config import GateCfg, GateThresholdsCfg
+from gmloco.train.gate.rollout import GateCell
+from gmloco.train.gate.summary import gate_metrics, gate_pass
+
+
+def _cfg() -> GateCfg:
+    """Two materials, two speeds, one yaw rate, 2 episodes per cell."""
+    return GateCfg(materials=("basalt", "poppy_seed"), speeds=(0.5, 1.0), yaw_rates=(0.5,), repeats=2, apex_speed=1.0)
+
+
+def _row(kind: str, material: str, command: tuple[float, float, float], **values: Any) -> dict[str, Any]:
+    """An episode row with defaults of a perfect episode."""
+    cell = GateCell(kind, material, 1500.0, 0.5, 0.5, command)  # type: ignore[arg-type]
+    row = {"cell": cell, "failed": False, "vel_error": 0.05, "yaw_rate": command[2], "drift_deg": 1.0, "apex_m": []}
+    return row | values
+
+
+def _rows(apex_soft: float, failed_soft: bool = False) -> list[dict[str, Any]]:
+    """Rows of a policy whose swing apex is 0.09 m on basalt and ``apex_soft`` on poppy seed."""
+    rows = []
+    for m, apex in (("basalt", 0.09), ("poppy_seed", apex_soft)):
+        for v in (0.5, 1.0):
+            rows += [_row("forward", m, (v, 0.0, 0.0), apex_m=[apex, apex]) for _ in range(2)]
+        rows += [_row("yaw", m, (0.5, 0.0, 0.5), yaw_rate=0.47) for _ in range(2)]
+        rows += [_row("circle", m, (1.0, 0.0, 0.5), dtw_m=0.04) for _ in range(2)]
+    if failed_soft:
+        rows[2]["failed"] = True  # rows 0-1: basalt at 0.5 m/s, rows 2-3: basalt at 1.0 m/s
+    eta_true = np.linspace(0.1, 0.5, 50)
+    rows += [_row("held_out", "held_out_rho2100_mu0.700", (1.0, 0.0, 0.0), eta=(eta_true + 0.01, eta_true))]
+    return rows
+
+
+def test_metrics_of_a_passing_policy() -> None:
+    """Means per cell: success 100 %, ratio 0.94, apex 9 -> 16 cm, R^2 of a 1 cm offset on a 0.1-0.5 ramp."""
+    m = gate_metrics(_cfg(), _rows(0.16))
+    assert m["success_pct"] == {"basalt": {"0.5": 100.0, "1": 100.0}, "poppy_seed": {"0.5": 100.0, "1": 100.0}}
+    np.testing.assert_allclose(m["yaw_rate_ratio"]["basalt"]["0.5"], 0.94)
+    np.testing.assert_allclose([m["swing_apex_cm"]["basalt"], m["swing_apex_cm"]["poppy_seed"]], [9.0, 16.0])
+    # R^2 = 1 - n 0.01^2 / sum (y - mean)^2, y = linspace(0.1, 0.5, 50): var = 0.4^2 (n+1) / (12 (n-1)).
+    var = 0.4**2 * 51 / (12 * 49)
+    np.testing.assert_allclose(m["eta_r2_heldout"], 1.0 - 0.01**2 / var, rtol=1e-9)
+    m["gpu_minutes"] = 120.0
+    verdict = gate_pass(m, GateThresholdsCfg(), ("basalt", "poppy_seed"))
+    assert verdict == dict.fromkeys(verdict, True)
+
+
+@pytest.mark.parametrize(
+    ("change", "failing"),
+    [
+        ({"apex_soft": 0.12}, "swing_apex_cm"),
+        ({"failed_soft": True}, "success_pct"),
+        ({"gpu": 200.0}, "gpu_minutes"),
+        ({"gpu": None}, "gpu_minutes"),
+    ],
+)
+def test_pass_map_names_the_failing_key(change: dict[str, Any], failing: str) -> None:
+    """A 3 cm apex rise, one fall, 200 GPU minutes or none recorded fail their key and ``all`` only."""
+    m = gate_metrics(_cfg(), _rows(change.get("apex_soft", 0.16), change.get("failed_soft", False)))
+    m["gpu_minutes"] = change.get("gpu", 120.0)
+    verdict = gate_pass(m, GateThresholdsCfg(), ("basalt", "poppy_seed"))
+    assert {k for k, ok in verdict.items() if not ok} == {failing, "all"}
+
+
+def test_no_decoded_eta_fails_eta_key() -> None:
+    """A PPO baseline has no decoded eta: ``eta_r2_heldout`` is None and fails."""
+    rows = [r for r in _rows(0.16) if r["cell"].kind != "held_out"]
+    m = gate_metrics(_cfg(), rows) | {"gpu_minutes": 10.0}
+    assert m["eta_r2_heldout"] is None
+    assert not gate_pass(m, GateThresholdsCfg(), ("basalt", "poppy_seed"))["eta_r2_heldout"]
+    assert math.isclose(m["circle_dtw_m"]["basalt"], 0.04)
