@@ -18,12 +18,13 @@ from pathlib import Path
 from typing import Any, Literal
 
 from gmloco.train.config import GranularTaskCfg
+from gmloco.train.tasks.g1_jump.config import JumpTaskCfg
 
 __all__ = ["TrainRunCfg", "train"]
 
 _RUN_CFG_FILE = "train_cfg.json"
 """Resolved run config written on the first call (compared on resume)."""
-_RESUME_INVARIANT = ("task", "num_envs", "num_steps_per_env", "hidden_dims", "seed")
+_RESUME_INVARIANT = ("task", "jump", "num_envs", "num_steps_per_env", "hidden_dims", "seed")
 """Fields that must not change between the calls of one run."""
 
 
@@ -33,6 +34,10 @@ class TrainRunCfg:
 
     task: GranularTaskCfg = field(default_factory=GranularTaskCfg)
     """Task: contact model, terrain, materials, DR, rewards."""
+    jump: JumpTaskCfg | None = None
+    """The jump imitation task (``gmloco.train.tasks.g1_jump``) instead of the velocity task; None: walk. Its
+    ``base`` holds the contact model and DR; ``task`` is then unused. Needs ``export_onnx=False`` and
+    ``history_length=0``."""
     num_envs: int = 4096
     """Number of parallel environments."""
     max_iterations: int = 30_000
@@ -96,9 +101,14 @@ def _make_env(cfg: TrainRunCfg) -> Any:
     from mjlab.envs import ManagerBasedRlEnv
     from mjlab.rl import RslRlVecEnvWrapper
 
-    from gmloco.train.tasks.g1_granular import make_g1_granular_env_cfg
+    if cfg.jump is not None:
+        from gmloco.train.tasks.g1_jump.env_cfgs import make_g1_jump_env_cfg
 
-    env_cfg = make_g1_granular_env_cfg(cfg.task, cfg.num_envs, cfg.history_length)
+        env_cfg = make_g1_jump_env_cfg(cfg.jump, cfg.num_envs)
+    else:
+        from gmloco.train.tasks.g1_granular import make_g1_granular_env_cfg
+
+        env_cfg = make_g1_granular_env_cfg(cfg.task, cfg.num_envs, cfg.history_length)
     env_cfg.seed = cfg.seed
     return RslRlVecEnvWrapper(ManagerBasedRlEnv(cfg=env_cfg, device=cfg.device))
 
@@ -144,6 +154,11 @@ def train(cfg: TrainRunCfg) -> dict[str, float]:
         ``env_steps_per_second``, ``seconds_per_iteration`` (+ collection / learning parts),
         ``env_steps``, ``stopped_by_deadline``, ``resumed_from_iteration``, ``wall_seconds``.
     """
+    if cfg.jump is not None and (cfg.export_onnx or cfg.history_length > 0):
+        raise ValueError(
+            "the jump task has no ONNX deploy metadata and no history group: set export_onnx=False and "
+            "history_length=0 in TrainRunCfg"
+        )
     start = time.monotonic()
     deadline = None if cfg.max_minutes is None else start + 60.0 * cfg.max_minutes - cfg.export_reserve_s
     os.environ.setdefault("WANDB_MODE", "offline")
