@@ -12,9 +12,9 @@ import torch
 from gmloco.train.tasks.g1_jump.evaluation import JumpEvalCfg, evaluate_jump, fig_jump_trace, summarize
 
 
-def _stand(obs: torch.Tensor) -> torch.Tensor:
+def _stand(obs: dict[str, torch.Tensor]) -> torch.Tensor:
     """Zero action: hold the default pose."""
-    return torch.zeros(obs.shape[0], 29)
+    return torch.zeros(obs["actor"].shape[0], 29)
 
 
 @pytest.mark.slow

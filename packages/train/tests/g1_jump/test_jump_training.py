@@ -71,3 +71,14 @@ def test_two_iterations_then_resume_keep_the_assist_state(tmp_path: Path) -> Non
     assert assist["scale"] == pytest.approx(1.0)  # 2 envs x ~16 steps: far from the first judged round
     resumed = train(_cfg(tmp_path, max_iterations=3))
     assert resumed["resumed_from_iteration"] == 2 and resumed["iteration"] == 3
+
+
+def test_checkpoint_evaluates_in_the_training_simulator(tmp_path: Path) -> None:
+    """evaluate_jump_run loads the newest checkpoint of a run and scores one unassisted attempt on rigid ground."""
+    from gmloco.train.tasks.g1_jump.evaluation import JumpEvalCfg, evaluate_jump_run
+
+    train(_cfg(tmp_path, max_iterations=1))
+    summary, traces = evaluate_jump_run(tmp_path, JumpEvalCfg(contact_model="rigid", attempts=1))
+    assert summary["episodes"] == 1.0 and len(traces) == 1 and traces[0].base_pos.shape[0] > 0
+    with pytest.raises(ValueError, match="no jump training run"):
+        evaluate_jump_run(tmp_path / "missing", JumpEvalCfg(attempts=1))

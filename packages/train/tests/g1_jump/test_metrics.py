@@ -87,5 +87,5 @@ def test_trace_ending_before_one_second_after_landing_fails() -> None:
 def test_no_flight_scores_zero_height() -> None:
     """A robot that never leaves the ground has no take-off, height 0 and a 100 % height error."""
     m = jump_metrics(_trace(takeoff=150, touchdown=150))
-    assert not m.landing_success and np.isnan(m.takeoff_s)
+    assert not m.landing_success and np.isnan(m.takeoff_s) and np.isnan(m.takeoff_slip_cm)
     assert m.height == 0.0 and m.height_error_pct == pytest.approx(100.0)

@@ -21,10 +21,10 @@ from gmloco.train.config import ContactModelName
 from gmloco.train.tasks.g1_jump.config import JumpMotionName, JumpTaskCfg, g1_jump_task
 from gmloco.train.tasks.g1_jump.metrics import JumpMetrics, JumpTrace, jump_metrics
 
-__all__ = ["JumpEvalCfg", "evaluate_jump", "fig_jump_trace", "rollout_jump", "summarize"]
+__all__ = ["JumpEvalCfg", "evaluate_jump", "evaluate_jump_run", "fig_jump_trace", "rollout_jump", "summarize"]
 
-Policy = Callable[[torch.Tensor], torch.Tensor]
-"""Actor observation [N, D] -> action [N, 29]."""
+Policy = Callable[[dict[str, torch.Tensor]], torch.Tensor]
+"""Observation groups of the env (``actor``, ``critic``; each [N, D]) -> action [N, 29]."""
 
 
 @dataclass
@@ -86,7 +86,7 @@ def rollout_jump(env: Any, policy: Policy, steps: int | None = None) -> list[Jum
     ended = torch.full((env.num_envs,), steps, dtype=torch.long)
     for i in range(steps):
         with torch.inference_mode():
-            obs, _, terminated, truncated, _ = env.step(policy(obs["actor"]))
+            obs, _, terminated, truncated, _ = env.step(policy(obs))
         feet = sand.feet.update()
         pos = robot.data.root_link_pos_w
         rec["base"].append(pos - origin)
@@ -141,8 +141,8 @@ def summarize(metrics: list[JumpMetrics]) -> dict[str, float]:
     }
 
 
-def evaluate_jump(policy: Policy, cfg: JumpEvalCfg) -> tuple[dict[str, float], list[JumpTrace]]:
-    """Run ``cfg.attempts`` unassisted jumps with ``policy`` and return the summary and the traces."""
+def _make_env(cfg: JumpEvalCfg) -> Any:
+    """The play-mode jump env of ``cfg`` with ``cfg.attempts`` envs."""
     from mjlab.envs import ManagerBasedRlEnv
 
     from gmloco.train.tasks.g1_jump.env_cfgs import make_g1_jump_env_cfg
@@ -151,9 +151,52 @@ def evaluate_jump(policy: Policy, cfg: JumpEvalCfg) -> tuple[dict[str, float], l
         raise ValueError(f"attempts must be >= 1, got {cfg.attempts}")
     env_cfg = make_g1_jump_env_cfg(_task(cfg), cfg.attempts)
     env_cfg.seed = cfg.seed
-    env = ManagerBasedRlEnv(cfg=env_cfg, device=cfg.device)
+    return ManagerBasedRlEnv(cfg=env_cfg, device=cfg.device)
+
+
+def evaluate_jump(policy: Policy, cfg: JumpEvalCfg) -> tuple[dict[str, float], list[JumpTrace]]:
+    """Run ``cfg.attempts`` unassisted jumps with ``policy`` and return the summary and the traces."""
+    env = _make_env(cfg)
     try:
         traces = rollout_jump(env, policy)
+    finally:
+        env.close()
+    return summarize([jump_metrics(t) for t in traces]), traces
+
+
+def evaluate_jump_run(run_dir: str | Path, cfg: JumpEvalCfg) -> tuple[dict[str, float], list[JumpTrace]]:
+    """Evaluate the newest checkpoint of a jump training run (``train_cfg.json`` + ``model_<it>.pt``).
+
+    The motion, stacked actor frames and network widths come from the run's ``train_cfg.json``; ``cfg`` chooses
+    the contact model and material of the evaluation, so a PPO-Rigid policy can be scored on sand.
+
+    Raises:
+        ValueError: If ``run_dir`` holds no jump run or no checkpoint.
+    """
+    import json
+    from dataclasses import asdict
+
+    from mjlab.rl import RslRlVecEnvWrapper
+    from tensordict import TensorDict
+
+    from gmloco.train.rl.runner import GmlocoOnPolicyRunner, latest_checkpoint
+    from gmloco.train.tasks.g1_granular import make_g1_granular_ppo_cfg
+
+    run = Path(run_dir)
+    cfg_file, checkpoint = run / "train_cfg.json", latest_checkpoint(run)
+    saved = json.loads(cfg_file.read_text()) if cfg_file.is_file() else {}
+    if not saved.get("jump") or checkpoint is None:
+        raise ValueError(f"{run} holds no jump training run with a checkpoint (train_cfg.json with 'jump', model_*.pt)")
+    jump = saved["jump"]
+    cfg = replace(cfg, motion=jump["motion"], policy_history_length=int(jump["base"]["policy_history_length"]))
+    env = RslRlVecEnvWrapper(_make_env(cfg))
+    try:
+        agent = make_g1_granular_ppo_cfg(hidden_dims=tuple(saved["hidden_dims"]))
+        runner = GmlocoOnPolicyRunner(env, asdict(agent), None, cfg.device)
+        runner.load(str(checkpoint), map_location=cfg.device)
+        act = runner.get_inference_policy(cfg.device)
+        n = env.unwrapped.num_envs
+        traces = rollout_jump(env.unwrapped, lambda obs: act(TensorDict(obs, batch_size=[n])))
     finally:
         env.close()
     return summarize([jump_metrics(t) for t in traces]), traces

@@ -74,7 +74,7 @@ class JumpMetrics:
     ref_distance: float
     """The same for the reference [m]."""
     takeoff_slip_cm: float
-    """Largest horizontal sole displacement between the push-off start and the take-off [cm]."""
+    """Largest horizontal sole displacement between the push-off start and the take-off [cm] (nan: no take-off)."""
     sinkage_cm: float
     """Deepest sole sinkage below the free surface, over the whole attempt [cm] (0 on rigid ground)."""
 
@@ -116,9 +116,10 @@ def jump_metrics(trace: JumpTrace, hold_s: float = 1.0) -> JumpMetrics:
     z0, ref_z0 = trace.base_pos[0, 2], trace.ref_base_pos[0, 2]
     ref_height = float(trace.ref_base_pos[:, 2].max() - ref_z0)
     height = float(trace.base_pos[takeoff:touchdown, 2].max() - z0) if takeoff is not None else 0.0
-    lo = max(start, 0)
-    hi = max(takeoff - 1, lo) if takeoff is not None else trace.base_pos.shape[0] - 1  # last stance sample
-    slip = np.linalg.norm(trace.feet_pos[hi, :, :2] - trace.feet_pos[lo, :, :2], axis=-1).max()
+    slip = float("nan")
+    if takeoff is not None:
+        last = max(takeoff - 1, start)  # last stance sample
+        slip = float(np.linalg.norm(trace.feet_pos[last, :, :2] - trace.feet_pos[start, :, :2], axis=-1).max())
     sink = max(0.0, float(-(trace.foot_height - trace.sole_height).min()))
     nan = float("nan")
     return JumpMetrics(
@@ -130,6 +131,6 @@ def jump_metrics(trace: JumpTrace, hold_s: float = 1.0) -> JumpMetrics:
         height_error_pct=100.0 * abs(height - ref_height) / ref_height if ref_height > 0.0 else nan,
         distance=float(trace.base_pos[-1, 0] - trace.base_pos[0, 0]),
         ref_distance=float(trace.ref_base_pos[-1, 0] - trace.ref_base_pos[0, 0]),
-        takeoff_slip_cm=100.0 * float(slip),
+        takeoff_slip_cm=100.0 * slip,
         sinkage_cm=100.0 * sink,
     )
