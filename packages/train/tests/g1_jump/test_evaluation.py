@@ -46,3 +46,20 @@ def test_bad_attempts_and_empty_summary_are_refused() -> None:
         evaluate_jump(_stand, JumpEvalCfg(attempts=0))
     with pytest.raises(ValueError, match="no attempts"):
         summarize([])
+
+
+@pytest.mark.parametrize(
+    "argv",
+    [
+        ["--run", "x"],
+        ["--run", "x=/nonexistent/run"],
+        ["--run", "x=.", "--materials", "mud"],
+        ["--run", "x=.", "--attempts", "0"],
+    ],
+)
+def test_evaluate_cli_refuses_bad_arguments(argv: list[str], capsys: pytest.CaptureFixture[str]) -> None:
+    """Bad --run / --materials / --attempts exit with code 2 and say what to pass."""
+    from gmloco.train.tasks.g1_jump.evaluate import main
+
+    assert main(argv) == 2
+    assert "error: --" in capsys.readouterr().err

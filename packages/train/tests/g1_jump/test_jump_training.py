@@ -82,3 +82,21 @@ def test_checkpoint_evaluates_in_the_training_simulator(tmp_path: Path) -> None:
     assert summary["episodes"] == 1.0 and len(traces) == 1 and traces[0].base_pos.shape[0] > 0
     with pytest.raises(ValueError, match="no jump training run"):
         evaluate_jump_run(tmp_path / "missing", JumpEvalCfg(attempts=1))
+
+
+def test_evaluate_cli_writes_summary_figure_and_manifest(tmp_path: Path) -> None:
+    """The CLI scores a run on one material and writes strict-JSON summary.json, the figure and manifest.json."""
+    import json
+
+    from gmloco.train.tasks.g1_jump.evaluate import main
+
+    run = tmp_path / "run"
+    train(_cfg(run, max_iterations=1))
+    out = tmp_path / "results"
+    argv = ["--run", f"p={run}", "--materials", "dry_sand", "--attempts", "1", "--out", str(out)]
+    assert main(argv) == 0
+    scores = json.loads((out / "summary.json").read_text())["p"]["dry_sand"]["training_sim"]
+    assert set(scores) == {"success_pct", "height_error_pct", "takeoff_slip_cm", "sinkage_cm", "episodes"}
+    assert scores["episodes"] == 1.0
+    assert (out / "fig_jump_trace.png").stat().st_size > 10_000
+    assert json.loads((out / "manifest.json").read_text())["attempts"] == 1

@@ -8,7 +8,7 @@ from dataclasses import replace
 import numpy as np
 import pytest
 
-from gmloco.train.tasks.g1_jump.metrics import JumpTrace, detect_flight, jump_metrics
+from gmloco.train.tasks.g1_jump.metrics import JumpTrace, airborne, detect_flight, jump_metrics
 
 DT = 0.02
 """Sample period of the traces [s] (the policy rate)."""
@@ -49,11 +49,20 @@ def _trace(n: int = 150, takeoff: int = 50, touchdown: int = 65) -> JumpTrace:
 
 
 def test_detect_flight_finds_take_off_and_touch_down() -> None:
-    """Both feet off from sample 3 to 5: take-off 3, touch-down 6; a single foot off is not flight."""
-    contact = np.array([[1, 1], [1, 0], [1, 1], [0, 0], [0, 0], [0, 0], [0, 1], [1, 1]], dtype=bool)
-    assert detect_flight(contact) == (3, 6)
-    assert detect_flight(np.ones((5, 2), dtype=bool)) == (None, None)
-    assert detect_flight(contact[:6]) == (3, None)
+    """Airborne from sample 3 to 5: take-off 3, touch-down 6; never airborne: neither."""
+    flying = np.array([0, 0, 0, 1, 1, 1, 0, 0], dtype=bool)
+    assert detect_flight(flying) == (3, 6)
+    assert detect_flight(np.zeros(5, dtype=bool)) == (None, None)
+    assert detect_flight(flying[:6]) == (3, None)
+    assert detect_flight(flying, start=4) == (4, 6)
+
+
+def test_unloaded_feet_on_the_surface_are_not_flight() -> None:
+    """No contact force but soles still in the sand (an unloading foot on sand) is not airborne."""
+    trace = _trace()
+    sunk = replace(trace, foot_height=np.full_like(trace.foot_height, SOLE - 0.02))
+    assert airborne(trace)[55] and not airborne(sunk).any()
+    assert not jump_metrics(sunk).landing_success
 
 
 def test_metrics_of_a_clean_jump() -> None:

@@ -14,8 +14,10 @@ import numpy as np
 __all__ = [
     "FAILURE_MIN_BASE_HEIGHT",
     "FAILURE_TILT",
+    "FLIGHT_CLEARANCE",
     "JumpMetrics",
     "JumpTrace",
+    "airborne",
     "detect_flight",
     "jump_metrics",
 ]
@@ -24,6 +26,9 @@ FAILURE_TILT = np.radians(70.0)
 """Pelvis tilt from upright that counts as a fall [rad] (the walk task's ``fell_over`` termination)."""
 FAILURE_MIN_BASE_HEIGHT = 0.3
 """Pelvis height above the sand surface below which the robot has fallen [m] (``base_too_low``)."""
+FLIGHT_CLEARANCE = 0.01
+"""Height of both soles above the free surface (beyond their flat-foot height) that counts as flight [m]; a
+contact force below the threshold alone is not enough on sand, where an unloading foot reads as off."""
 
 
 @dataclass
@@ -60,7 +65,7 @@ class JumpMetrics:
     landing_success: bool
     """A take-off and a touch-down happened and no failure rule fired up to 1 s after the touch-down."""
     takeoff_s: float
-    """First time both feet were off the ground [s] (nan: no flight)."""
+    """First airborne time (:func:`airborne`) after the push-off start [s] (nan: no flight)."""
     touchdown_s: float
     """First contact after the take-off [s] (nan: no landing)."""
     height: float
@@ -83,14 +88,19 @@ class JumpMetrics:
         return asdict(self)
 
 
-def detect_flight(in_contact: np.ndarray, start: int = 0) -> tuple[int | None, int | None]:
-    """Return the first sample at or after ``start`` with both feet off, and the next sample with a foot on."""
-    airborne: np.ndarray = ~np.any(in_contact, axis=-1)
-    off = np.flatnonzero(airborne[start:])
+def airborne(trace: JumpTrace) -> np.ndarray:
+    """Samples with no foot in contact and both soles ``FLIGHT_CLEARANCE`` above the surface, shape [T] (bool)."""
+    clear = np.all(trace.foot_height > trace.sole_height + FLIGHT_CLEARANCE, axis=-1)
+    return ~np.any(trace.in_contact, axis=-1) & clear
+
+
+def detect_flight(flying: np.ndarray, start: int = 0) -> tuple[int | None, int | None]:
+    """Return the first sample at or after ``start`` that is airborne, and the next one that is not."""
+    off = np.flatnonzero(flying[start:])
     if off.size == 0:
         return None, None
     takeoff = start + int(off[0])
-    on = np.flatnonzero(~airborne[takeoff:])
+    on = np.flatnonzero(~flying[takeoff:])
     return takeoff, (takeoff + int(on[0]) if on.size else None)
 
 
@@ -112,7 +122,7 @@ def _landing_success(trace: JumpTrace, takeoff: int | None, touchdown: int | Non
 def jump_metrics(trace: JumpTrace, hold_s: float = 1.0) -> JumpMetrics:
     """Score one attempt; flight is searched from the push-off start on (earlier hops do not count)."""
     start = int(np.ceil(trace.push_start_s / trace.dt))
-    takeoff, touchdown = detect_flight(trace.in_contact, start)
+    takeoff, touchdown = detect_flight(airborne(trace), start)
     z0, ref_z0 = trace.base_pos[0, 2], trace.ref_base_pos[0, 2]
     ref_height = float(trace.ref_base_pos[:, 2].max() - ref_z0)
     height = float(trace.base_pos[takeoff:touchdown, 2].max() - z0) if takeoff is not None else 0.0
