@@ -1,11 +1,12 @@
 # SPDX-License-Identifier: Apache-2.0
 """Whole-body inverse kinematics of the G1 on its MuJoCo model (mujoco's Python API, CPU).
 
-Each frame runs Gauss-Newton steps over the free base and the 29 joints: the whole-body CoM, both sole sites
-(position and orientation, soles flat) and the pelvis orientation are tasks solved by a damped pseudo-inverse,
-and a posture step toward the standing pose (waist and arms, which the jump holds still) acts in their null space.
-Frames are solved in order, each warm-started from the previous one, so the joint trajectory is as smooth as
-the task trajectory.
+Each frame runs Gauss-Newton steps over the free base and the 29 joints. The whole-body CoM, both sole sites
+(position and orientation, soles flat) and, when asked, the angular momentum about the CoM over the step from
+the previous frame are primary tasks, solved by a damped pseudo-inverse; the pelvis orientation is primary
+without the momentum task and a null-space task with it; a posture step toward the standing pose (waist and
+arms) acts in the remaining null space. Frames are solved in order, each warm-started from the previous one, so
+the joint trajectory is as smooth as the task trajectory.
 """
 
 from __future__ import annotations
