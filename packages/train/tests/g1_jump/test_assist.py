@@ -8,7 +8,7 @@ from dataclasses import replace
 import pytest
 import torch
 
-from gmloco.train.tasks.g1_jump.assist import AssistState, assist_wrench
+from gmloco.train.tasks.g1_jump.assist import AssistState, assist_wrench, judged_episodes
 from gmloco.train.tasks.g1_jump.config import JumpAssistCfg
 
 IDENTITY = torch.tensor([[1.0, 0.0, 0.0, 0.0]])
@@ -81,3 +81,10 @@ def test_state_round_trips_through_a_checkpoint_dict() -> None:
     other = AssistState(scale=1.0)
     other.load_state_dict(state.state_dict())
     assert other == state
+
+
+def test_only_episodes_with_the_jump_are_judged() -> None:
+    """Of 4 finished episodes, 3 started before the 1.02 s take-off; 2 of those timed out (succeeded)."""
+    timed_out = torch.tensor([True, False, True, True])
+    start = torch.tensor([0.0, 0.5, 1.0, 1.5])  # the last one started after the take-off
+    assert judged_episodes(timed_out, start, 1.02) == (2, 3)

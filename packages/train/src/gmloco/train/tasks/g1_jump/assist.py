@@ -29,6 +29,7 @@ __all__ = [
     "assist_scale_curriculum",
     "assist_wrench",
     "get_assist",
+    "judged_episodes",
 ]
 
 
@@ -173,6 +174,16 @@ class AssistedJointPositionAction(JointPositionAction):
         self.last_force = force
 
 
+def judged_episodes(timed_out: torch.Tensor, start_time: torch.Tensor, t_takeoff: float) -> tuple[int, int]:
+    """Successes and count of the finished episodes that contain the jump (started before ``t_takeoff`` [s]).
+
+    Episodes that reference state initialization started after the take-off only land or stand; counting them
+    would let the scale drop before the policy can take off.
+    """
+    jumped = start_time < t_takeoff
+    return int((timed_out & jumped).sum().item()), int(jumped.sum().item())
+
+
 def assist_scale_curriculum(env: ManagerBasedRlEnv, env_ids: torch.Tensor) -> dict[str, float]:
     """Curriculum term: count reset envs that timed out (success) against those that failed, update the scale.
 
@@ -181,8 +192,10 @@ def assist_scale_curriculum(env: ManagerBasedRlEnv, env_ids: torch.Tensor) -> di
     """
     from gmloco.train.tasks.g1_jump.command import get_jump
 
-    state, cfg = get_assist(env), get_jump(env).cfg.task.assist
+    jump = get_jump(env)
+    state, cfg = get_assist(env), jump.cfg.task.assist
     if isinstance(env_ids, torch.Tensor) and env.common_step_counter > 0 and env_ids.numel() > 0:
         timed_out = env.termination_manager.time_outs[env_ids]
-        state.update(cfg, int(timed_out.sum().item()), len(env_ids), env.num_envs)
+        successes, episodes = judged_episodes(timed_out, jump.start_time[env_ids], jump.ref.t_takeoff)
+        state.update(cfg, successes, episodes, env.num_envs)
     return {"assist_scale": state.scale, "success_rate": state.success_rate}
