@@ -92,7 +92,7 @@ def _pelvis_wrench(env: Any) -> torch.Tensor:
 
 
 def test_assist_wrench_in_the_env(env: Any) -> None:
-    """Scale 0: no wrench on the pelvis; scale 0.5 with the base 5 cm low: the PD law, halved."""
+    """Scale 0: no wrench on the pelvis; scale 0.5 with the base 5 cm low: the PD law, halved; back to 0: none."""
     _place_on_reference(env, 0.2)
     robot = env.scene["robot"]
     root = torch.cat([robot.data.root_link_pos_w, robot.data.root_link_quat_w], dim=-1).clone()
@@ -120,6 +120,8 @@ def test_assist_wrench_in_the_env(env: Any) -> None:
     torch.testing.assert_close(wrench, torch.cat([force, torque], dim=-1))
     # 0.5 * kp_pos * 0.05 m = 0.5 * 2000 * 0.05 = 50 N upward
     assert wrench[:, 2].cpu().tolist() == pytest.approx([50.0] * env.num_envs, abs=1e-2)
+    state.scale = 0.0  # annealed away: the wrench written at 0.5 is cleared
+    assert torch.count_nonzero(_pelvis_wrench(env)) == 0
 
 
 def test_reference_state_initialization(env: Any) -> None:

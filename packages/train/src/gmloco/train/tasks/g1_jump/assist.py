@@ -143,13 +143,15 @@ class AssistedJointPositionAction(JointPositionAction):
         env.jump_assist = self.state  # type: ignore[attr-defined]
         self.last_force = torch.zeros(self.num_envs, 3, device=self.device)
         """Force applied at the last substep [N], world frame, [N, 3]."""
+        self._applied = False
 
     def apply_actions(self) -> None:
         """Set the joint targets, then the wrench of the current base state."""
         super().apply_actions()
         if self.state.scale <= 0.0:
-            if self.last_force.abs().max() > 0.0:
+            if self._applied:  # clear the last wrench once (a Python flag: no device sync per substep)
                 self._write(torch.zeros_like(self.last_force), torch.zeros_like(self.last_force))
+                self._applied = False
             return
         from gmloco.train.tasks.g1_jump.command import get_jump
 
@@ -167,6 +169,7 @@ class AssistedJointPositionAction(JointPositionAction):
             jump.reference("base_ang_vel"),
         )
         self._write(force, torque)
+        self._applied = True
 
     def _write(self, force: torch.Tensor, torque: torch.Tensor) -> None:
         """Write the wrench into the pelvis ``xfrc_applied``."""
