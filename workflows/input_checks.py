@@ -56,8 +56,20 @@ def _analyze_logs_problem(section: DictConfig) -> tuple[str, str] | None:
     return None
 
 
+def _jump_problem(section: DictConfig) -> tuple[str, str] | None:
+    """The jump imitation task trains vanilla PPO only."""
+    if section.get("jump") is not None and str(section.algorithm.value) != "ppo":
+        return "train_teacher.algorithm", (
+            f"bad value for 'train_teacher.algorithm': {section.algorithm.value}; train_teacher.jump needs "
+            "algorithm=ppo (the jump imitation task, +exp=jump_rft3d or +exp=jump_rigid)."
+        )
+    return None
+
+
 def input_problem(cfg: DictConfig) -> tuple[str, str] | None:
     """First problem with the inputs of the selected stages, as ``(key, message)``; else None."""
+    if "train_teacher" in cfg.stages and (found := _jump_problem(cfg.train_teacher)) is not None:
+        return found
     if "mismatch" in cfg.stages and (found := _mismatch_problem(cfg.mismatch)) is not None:
         return found
     if "analyze_logs" in cfg.stages:

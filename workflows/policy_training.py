@@ -22,6 +22,7 @@ from stage_registry import StageIncompleteError
 
 __all__ = [
     "distill_overrides",
+    "jump_task_cfg",
     "newest_checkpoint",
     "ppo_cfg",
     "run_training",
@@ -69,6 +70,29 @@ def task_cfg(section: DictConfig) -> Any:
         policy_history_length=int(section.policy_history_length),
         curriculum_scale=float(section.get("curriculum_scale", 1.0)),
         foot_clearance=str(getattr(clearance, "value", clearance)),  # type: ignore[arg-type]
+    )
+
+
+def jump_task_cfg(section: DictConfig) -> Any:
+    """Return the ``JumpTaskCfg`` of a train section whose ``jump`` node is set (contact model, motion, assist)."""
+    from gmloco.train.tasks.g1_jump.config import g1_jump_task
+
+    jump = section.jump
+    task = g1_jump_task(str(section.contact_model.value), str(jump.motion.value))  # type: ignore[arg-type]
+    assist = replace(
+        task.assist,
+        enabled=float(jump.assist_initial_scale) > 0.0,
+        initial_scale=float(jump.assist_initial_scale),
+        scale_step=float(jump.assist_scale_step),
+        success_threshold=float(jump.assist_success_threshold),
+    )
+    base = replace(task.base, policy_history_length=int(section.policy_history_length))
+    return replace(
+        task,
+        base=base,
+        hold_s=float(jump.hold_s),
+        rsi_probability=float(jump.rsi_probability),
+        assist=assist,
     )
 
 

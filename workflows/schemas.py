@@ -28,6 +28,8 @@ __all__ = [
     "DistillCfg",
     "EvalMpmCfg",
     "ExportCfg",
+    "JumpMotion",
+    "JumpSectionCfg",
     "MismatchCfg",
     "PathsCfg",
     "PipelineCfg",
@@ -150,6 +152,31 @@ class TerrainName(str, Enum):
     deep = "deep"
 
 
+class JumpMotion(str, Enum):
+    """Jump references shipped with ``gmloco.train.tasks.g1_jump`` (``data/jump_<name>.npz``)."""
+
+    vertical = "vertical"
+    forward = "forward"
+
+
+@dataclass
+class JumpSectionCfg:
+    """The jump imitation task of the train stage (``gmloco.train.tasks.g1_jump.JumpTaskCfg``, issue 39)."""
+
+    motion: JumpMotion = JumpMotion.vertical
+    """Reference motion: 8 cm vertical jump or 10 cm forward jump."""
+    hold_s: float = ranged(1.0, ge=0)
+    """Time the episode runs on after the reference ends, holding its standing frame [s]."""
+    rsi_probability: float = ranged(0.8, ge=0, le=1)
+    """Probability that a reset starts at a random time of the reference (reference state initialization)."""
+    assist_initial_scale: float = ranged(1.0, ge=0, le=1)
+    """Scale of the assistive base wrench at the start of training (ZEST, Sleiman et al. 2026); 0 disables it."""
+    assist_scale_step: float = ranged(0.02, gt=0, le=1)
+    """Scale removed each time the moving success rate clears ``assist_success_threshold``."""
+    assist_success_threshold: float = ranged(0.8, gt=0, le=1)
+    """Moving fraction of episodes ending without a failure above which the assist scale drops."""
+
+
 class PpoSchedule(str, Enum):
     """Learning-rate schedule of rsl-rl's PPO."""
 
@@ -232,6 +259,9 @@ class TrainTeacherCfg(PolicyTrainingCfg):
     """Teacher terrain encoder widths (paper)."""
     history_length: int = ranged(50, ge=1)
     """N, frames of the ``history`` group the teacher encoder reads (the student reads the same N)."""
+    jump: JumpSectionCfg | None = None
+    """Train the jump imitation task (``+exp=jump_rft3d|jump_rigid``, needs ``algorithm: ppo``) instead of the
+    velocity task; ``terrain`` and ``foot_clearance`` are then unused. null: the velocity task."""
 
 
 @dataclass

@@ -5,6 +5,9 @@
 
 * ``ppo`` (``+exp=ppo_rft3d|ppo_heuristic_rft|ppo_cone_multi|ppo_rigid``): vanilla PPO with that contact model;
   writes ``model_<it>.pt``, TensorBoard events and ``policy.onnx`` (+ ``policy.json``, mjlab deploy metadata).
+* ``ppo`` with ``train_teacher.jump`` set (``+exp=jump_rft3d|jump_rigid``): the jump imitation task of
+  ``gmloco.train.tasks.g1_jump`` (tracking rewards, phase observation, assistive base wrench annealed by a
+  curriculum); writes ``model_<it>.pt`` and TensorBoard events (the assist state travels in the checkpoints).
 * ``vae_teacher`` (``+exp=gm_loco``): ``TeacherPPO`` with the ``TeacherActor`` (VAE terrain encoder over the critic
   group and the ``history`` group, eta decoder) and the asymmetric MLP critic; writes ``model_<it>.pt`` (the
   ``distill`` stage reads the newest one) and TensorBoard events.
@@ -25,7 +28,7 @@ from typing import Any
 
 from omegaconf import DictConfig
 
-from policy_training import run_training, task_cfg, teacher_cfg, vanilla_ppo_overrides
+from policy_training import jump_task_cfg, run_training, task_cfg, teacher_cfg, vanilla_ppo_overrides
 
 __all__ = ["main", "run"]
 
@@ -34,6 +37,15 @@ def run(cfg: DictConfig) -> dict[str, float | None]:
     """Train (or resume) the stage's policy and return its metrics."""
     section = cfg.train_teacher
     run_cfg: dict[str, Any] = {"task": task_cfg(section), "hidden_dims": tuple(int(d) for d in section.hidden_dims)}
+    if section.get("jump") is not None:
+        if section.algorithm.value != "ppo":
+            raise ValueError(
+                f"train_teacher.jump needs train_teacher.algorithm=ppo, got {section.algorithm.value}; "
+                "the jump imitation task trains vanilla PPO (+exp=jump_rft3d or +exp=jump_rigid)"
+            )
+        # The jump policy has no deploy metadata yet, so no ONNX export here.
+        run_cfg |= {"jump": jump_task_cfg(section), "rsl_rl_overrides": vanilla_ppo_overrides(section)}
+        return run_training(cfg, "train_teacher", **run_cfg, export_onnx=False)
     if section.algorithm.value == "ppo":
         run_cfg |= {"rsl_rl_overrides": vanilla_ppo_overrides(section), "export_onnx": True}
     else:

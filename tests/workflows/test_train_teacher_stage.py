@@ -45,3 +45,46 @@ def test_no_warm_start_by_default(compose: Callable[..., DictConfig], monkeypatc
     seen = _captured(monkeypatch)
     train_teacher.run(compose("+exp=gm_loco"))
     assert "warm_start_ppo" not in seen
+
+
+@pytest.mark.parametrize(("exp", "contact_model"), [("jump_rft3d", "rft3d"), ("jump_rigid", "rigid")])
+def test_jump_exps_train_the_jump_task(
+    compose: Callable[..., DictConfig], monkeypatch: pytest.MonkeyPatch, exp: str, contact_model: str
+) -> None:
+    """``+exp=jump_*`` hands a ``JumpTaskCfg`` with its contact model, vanilla PPO settings and no ONNX export."""
+    seen = _captured(monkeypatch)
+    train_teacher.run(compose(f"+exp={exp}", "train_teacher.jump.assist_scale_step=0.05"))
+    jump = seen["jump"]
+    assert jump.base.contact_model == contact_model and jump.motion == "vertical"
+    assert jump.assist.enabled and jump.assist.initial_scale == 1.0 and jump.assist.scale_step == 0.05
+    assert seen["export_onnx"] is False and seen["rsl_rl_overrides"]["algorithm"]["entropy_coef"] == 0.005
+
+
+def test_jump_exps_differ_only_in_the_contact_model(compose: Callable[..., DictConfig]) -> None:
+    """PPO-3D-RFT and PPO-Rigid are trained the same way: the two train sections differ in contact_model alone."""
+    from omegaconf import OmegaConf
+
+    a = OmegaConf.to_container(compose("+exp=jump_rft3d").train_teacher, resolve=True, enum_to_str=True)
+    b = OmegaConf.to_container(compose("+exp=jump_rigid").train_teacher, resolve=True, enum_to_str=True)
+    assert isinstance(a, dict) and isinstance(b, dict)
+    # out_dir follows the run directory, which is named after the experiment
+    assert {k for k in a if a[k] != b[k]} - {"out_dir"} == {"contact_model"}
+
+
+def test_jump_with_the_vae_teacher_is_refused(compose: Callable[..., DictConfig]) -> None:
+    """train_teacher.jump with algorithm=vae_teacher is a composition error naming the key and the fix."""
+    from config_errors import ConfigInputError
+
+    with pytest.raises(ConfigInputError, match="needs algorithm=ppo") as info:
+        compose("+exp=jump_rft3d", "train_teacher.algorithm=vae_teacher")
+    assert info.value.key == "train_teacher.algorithm"
+
+
+def test_jump_stage_trains_at_smoke_scale(compose: Callable[..., DictConfig], tmp_path: Any) -> None:
+    """``+exp=jump_rigid`` at smoke scale on the CPU trains 2 iterations and writes its checkpoint."""
+    cfg = compose(
+        "+exp=jump_rigid", "+scale=smoke", "device=cpu", f"run_dir={tmp_path}", "train_teacher.policy_history_length=1"
+    )
+    metrics = train_teacher.run(cfg)
+    assert metrics["iteration"] == 2.0
+    assert (tmp_path / "train_teacher" / "model_2.pt").exists()

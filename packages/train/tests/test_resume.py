@@ -11,6 +11,7 @@ import pytest
 import torch
 
 from gmloco.train.resume import (
+    RUN_CFG_FILE,
     ResumeError,
     check_resume_cfg,
     config_differences,
@@ -107,3 +108,14 @@ def test_no_readable_checkpoint_is_refused(tmp_path: Path) -> None:
     torch.save({"weights": 1}, tmp_path / "model_5.pt")
     with pytest.raises(ResumeError, match=r"every checkpoint .* is unreadable.*no 'iter' entry"):
         resumable_checkpoint(tmp_path)
+
+
+def test_field_added_later_at_its_default_does_not_block(tmp_path: Path) -> None:
+    """A saved config without a newer field resumes while that field keeps its default, and refuses otherwise."""
+    saved = {"task": {"contact_model": "rft3d"}, "seed": 1}
+    (tmp_path / RUN_CFG_FILE).write_text(json.dumps(saved))
+    defaults = {"task": {"contact_model": "rft3d", "new_term": None}, "seed": 42}
+    check_resume_cfg(tmp_path, {"task": {"contact_model": "rft3d", "new_term": None}, "seed": 1}, defaults=defaults)
+    (tmp_path / RUN_CFG_FILE).write_text(json.dumps(saved))
+    with pytest.raises(ResumeError, match=r"task\.new_term: absent -> 0\.5"):
+        check_resume_cfg(tmp_path, {"task": {"contact_model": "rft3d", "new_term": 0.5}, "seed": 1}, defaults=defaults)

@@ -28,6 +28,7 @@ RUN_CFG_FILE = "train_cfg.json"
 """Resolved run config written on the first call (compared on resume)."""
 RESUME_INVARIANT = (
     "task",
+    "jump",
     "num_envs",
     "num_steps_per_env",
     "hidden_dims",
@@ -44,14 +45,22 @@ class ResumeError(ValueError):
     """A run directory that must not be resumed with this config, or whose checkpoints are all unreadable."""
 
 
-def config_differences(saved: Any, current: Any, prefix: str = "") -> list[str]:
-    """Return ``"key: saved -> current"`` for every leaf where two JSON documents differ (dotted keys)."""
+def config_differences(saved: Any, current: Any, prefix: str = "", defaults: Any = _MISSING) -> list[str]:
+    """Return ``"key: saved -> current"`` for every leaf where two JSON documents differ (dotted keys).
+
+    ``defaults`` (the config's default values, same layout): a key the saved document lacks counts as unchanged
+    while the current value is its default, so a field added to the config after a run started, left at the
+    behaviour the run trained with, does not block the resume.
+    """
     if isinstance(saved, Mapping) and isinstance(current, Mapping):
         out: list[str] = []
+        sub = defaults if isinstance(defaults, Mapping) else {}
         for key in list(saved) + [k for k in current if k not in saved]:
-            out += config_differences(saved.get(key, _MISSING), current.get(key, _MISSING), f"{prefix}{key}.")
+            out += config_differences(
+                saved.get(key, _MISSING), current.get(key, _MISSING), f"{prefix}{key}.", sub.get(key, _MISSING)
+            )
         return out
-    if saved == current:
+    if saved == current or (saved is _MISSING and defaults is not _MISSING and current == defaults):
         return []
     show = lambda v: "absent" if v is _MISSING else json.dumps(v)  # noqa: E731
     return [f"{prefix.rstrip('.')}: {show(saved)} -> {show(current)}"]
@@ -63,13 +72,16 @@ def _experiment(cfg: Mapping[str, Any]) -> str:
     return str(actor).rsplit(":", 1)[-1] if actor else "vanilla PPO"
 
 
-def check_resume_cfg(run_dir: Path, current: dict[str, Any], allowed: Iterable[str] = ()) -> None:
+def check_resume_cfg(
+    run_dir: Path, current: dict[str, Any], allowed: Iterable[str] = (), defaults: Mapping[str, Any] | None = None
+) -> None:
     """Write ``current`` as the run config on the first call; refuse a later call that changes an invariant.
 
     Args:
         run_dir: The run directory.
         current: ``TrainRunCfg`` as JSON.
         allowed: Dotted keys (or key prefixes, e.g. ``task.reward_weights``) accepted as changed.
+        defaults: The config's defaults as JSON: a key the saved config lacks is unchanged at its default.
 
     Raises:
         ResumeError: Naming each differing key, saved -> current, and what to do.
@@ -81,7 +93,9 @@ def check_resume_cfg(run_dir: Path, current: dict[str, Any], allowed: Iterable[s
         changed = [
             d
             for k in RESUME_INVARIANT
-            for d in config_differences(saved.get(k, _MISSING), current.get(k, _MISSING), f"{k}.")
+            for d in config_differences(
+                saved.get(k, _MISSING), current.get(k, _MISSING), f"{k}.", (defaults or {}).get(k, _MISSING)
+            )
             if not any(d.split(":", 1)[0] == a or d.startswith(f"{a}.") for a in keep)
         ]
         if changed:

@@ -22,6 +22,7 @@ from typing import Any, Literal
 
 from gmloco.train.config import GranularTaskCfg
 from gmloco.train.resume import check_resume_cfg, resumable_checkpoint
+from gmloco.train.tasks.g1_jump.config import JumpTaskCfg
 
 __all__ = ["TrainRunCfg", "train"]
 
@@ -32,6 +33,10 @@ class TrainRunCfg:
 
     task: GranularTaskCfg = field(default_factory=GranularTaskCfg)
     """Task: contact model, terrain, materials, DR, rewards."""
+    jump: JumpTaskCfg | None = None
+    """The jump imitation task (``gmloco.train.tasks.g1_jump``) instead of the velocity task; None: walk. Its
+    ``base`` holds the contact model and DR; ``task`` is then unused. Needs ``export_onnx=False`` and
+    ``history_length=0``."""
     num_envs: int = 4096
     """Number of parallel environments."""
     max_iterations: int = 30_000
@@ -84,9 +89,14 @@ def _make_env(cfg: TrainRunCfg) -> Any:
     from mjlab.envs import ManagerBasedRlEnv
     from mjlab.rl import RslRlVecEnvWrapper
 
-    from gmloco.train.tasks.g1_granular import make_g1_granular_env_cfg
+    if cfg.jump is not None:
+        from gmloco.train.tasks.g1_jump.env_cfgs import make_g1_jump_env_cfg
 
-    env_cfg = make_g1_granular_env_cfg(cfg.task, cfg.num_envs, cfg.history_length)
+        env_cfg = make_g1_jump_env_cfg(cfg.jump, cfg.num_envs)
+    else:
+        from gmloco.train.tasks.g1_granular import make_g1_granular_env_cfg
+
+        env_cfg = make_g1_granular_env_cfg(cfg.task, cfg.num_envs, cfg.history_length)
     env_cfg.seed = cfg.seed
     return RslRlVecEnvWrapper(ManagerBasedRlEnv(cfg=env_cfg, device=cfg.device))
 
@@ -139,7 +149,13 @@ def train(cfg: TrainRunCfg, on_iteration: Callable[[int, int], None] | None = No
     os.environ.setdefault("GIT_PYTHON_REFRESH", "quiet")
     run_dir = Path(cfg.run_dir).resolve()
     run_dir.mkdir(parents=True, exist_ok=True)
-    check_resume_cfg(run_dir, json.loads(json.dumps(asdict(cfg), default=str)), cfg.allow_changed)
+    if cfg.jump is not None and (cfg.export_onnx or cfg.history_length > 0):
+        raise ValueError(
+            "the jump task has no ONNX deploy metadata and no history group: set export_onnx=False and "
+            "history_length=0 in TrainRunCfg"
+        )
+    as_json = lambda c: json.loads(json.dumps(asdict(c), default=str))  # noqa: E731
+    check_resume_cfg(run_dir, as_json(cfg), cfg.allow_changed, defaults=as_json(TrainRunCfg()))
     checkpoint, skipped = resumable_checkpoint(run_dir) if cfg.resume else (None, [])
     for line in skipped:
         print(f"train: {line}; resuming from {checkpoint}", file=sys.stderr)

@@ -28,7 +28,7 @@ def latest_checkpoint(run_dir: str | Path) -> Path | None:
 
 
 class GmlocoOnPolicyRunner(MjlabOnPolicyRunner):
-    """mjlab's runner plus: time-boxed ``learn``, tmp + ``os.replace`` saves, floor levels in checkpoints.
+    """mjlab's runner plus: time-boxed ``learn``, tmp + ``os.replace`` saves, floor levels and assist in checkpoints.
 
     After :meth:`learn`, :attr:`summary` holds the run's metrics (see :meth:`_summary`).
     """
@@ -126,6 +126,9 @@ class GmlocoOnPolicyRunner(MjlabOnPolicyRunner):
         """Write the checkpoint to ``path + '.tmp'`` then ``os.replace`` it (a kill never leaves half a file)."""
         sand = getattr(self.env.unwrapped, "sand", None)
         infos = {**(infos or {}), "sand_floor_level": None if sand is None else sand.floor_level.cpu()}
+        assist = getattr(self.env.unwrapped, "jump_assist", None)
+        if assist is not None:
+            infos["jump_assist"] = assist.state_dict()
         tmp = f"{path}.tmp"
         super().save(tmp, infos)
         os.replace(tmp, path)
@@ -133,7 +136,9 @@ class GmlocoOnPolicyRunner(MjlabOnPolicyRunner):
     def load(
         self, path: str, load_cfg: dict | None = None, strict: bool = True, map_location: str | None = None
     ) -> dict:
-        """Load a checkpoint, restoring the floor levels (mjlab's runner restores the env step counter).
+        """Load a checkpoint, restoring the floor levels and the jump assist state.
+
+        mjlab's runner restores the env step counter.
 
         A slim checkpoint (saved without ``optimizer_state_dict``, as the committed artifacts are) restores the
         weights and the iteration and starts a fresh optimizer.
@@ -145,6 +150,9 @@ class GmlocoOnPolicyRunner(MjlabOnPolicyRunner):
         infos = super().load(path, load_cfg, strict, map_location or self.device)
         levels = (infos or {}).get("sand_floor_level")
         env = self.env.unwrapped
+        assist = (infos or {}).get("jump_assist")
+        if assist is not None and getattr(env, "jump_assist", None) is not None:
+            env.jump_assist.load_state_dict(assist)
         if levels is not None and levels.shape[0] == env.num_envs:
             get_sand(env).floor_level.copy_(levels.to(env.device))
         return infos

@@ -1,0 +1,140 @@
+# SPDX-License-Identifier: Apache-2.0
+"""Write the shipped jump references and their manifest: ``python -m gmloco.train.tasks.g1_jump.make_reference``.
+
+Synthesizes every reference of :func:`shipped_references` (CoM / foot profile, whole-body IK on mjlab's G1
+MuJoCo model), runs the rigid-ground plausibility checks on it, and writes ``data/jump_<name>.npz`` plus
+``data/manifest.json`` (configs, versions, check results, peak torques against the effort limits) atomically.
+
+Options: ``--out DIR`` writes somewhere else (default: the package's ``data/`` folder); ``--check`` rebuilds in
+memory and exits 1 when a shipped file differs from a fresh build by more than 1e-6 rad / m.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import sys
+import tempfile
+from dataclasses import asdict
+from pathlib import Path
+
+import numpy as np
+
+from gmloco.train.tasks.g1_jump.ik import load_g1_model
+from gmloco.train.tasks.g1_jump.plausibility import check_plausibility
+from gmloco.train.tasks.g1_jump.profile import JumpProfileCfg
+from gmloco.train.tasks.g1_jump.reference import (
+    REFERENCE_DIR,
+    JumpSynthesisCfg,
+    load_reference,
+    save_reference,
+    synthesize_reference,
+)
+
+__all__ = ["main", "shipped_references"]
+
+MODULE = "gmloco.train.tasks.g1_jump.make_reference"
+"""Module path written into the manifest."""
+
+
+def shipped_references() -> list[JumpSynthesisCfg]:
+    """The references the package ships: a vertical jump (8 cm CoM rise) and a 10 cm forward jump.
+
+    The forward jump is 10 cm long: with zero angular momentum about the CoM the torso counter-rotates against the
+    legs' extension, and at 15 cm and beyond the waist pitch reaches its joint limit during the push-off.
+    """
+    return [
+        JumpSynthesisCfg(profile=JumpProfileCfg(name="vertical")),
+        JumpSynthesisCfg(profile=JumpProfileCfg(name="forward", distance=0.10, takeoff_rise=-0.05)),
+    ]
+
+
+def _versions() -> dict[str, str]:
+    """Versions of the packages that made the references."""
+    from importlib.metadata import version
+
+    return {name: version(name) for name in ("mujoco", "mjlab", "numpy")}
+
+
+def _write_json(path: Path, payload: dict[str, object]) -> None:
+    """Write ``payload`` as JSON to ``path`` atomically."""
+    fd, tmp = tempfile.mkstemp(dir=path.parent, suffix=".json")
+    with os.fdopen(fd, "w") as f:
+        json.dump(payload, f, indent=1)
+        f.write("\n")
+    os.chmod(tmp, 0o644)
+    os.replace(tmp, path)
+
+
+def build(out: Path) -> dict[str, object]:
+    """Synthesize, check and write every shipped reference to ``out``; returns the manifest."""
+    model = load_g1_model()
+    entries = {}
+    for cfg in shipped_references():
+        ref, ik_error = synthesize_reference(cfg, model)
+        report = check_plausibility(model, ref)
+        path = out / f"jump_{ref.name}.npz"
+        save_reference(ref, path)
+        entries[ref.name] = {
+            "file": path.name,
+            "samples": int(ref.qpos.shape[0]),
+            "fps": ref.fps,
+            "duration_s": ref.duration,
+            "takeoff_s": ref.t_takeoff,
+            "touchdown_s": ref.t_touchdown,
+            "ik_max_task_error_m": ik_error,
+            "synthesis": asdict(cfg),
+            "plausibility": report.to_dict(),
+        }
+    manifest = {
+        "command": f"python -m {MODULE}",
+        "method": (
+            "quintic CoM height per phase (continuous force, zero at take-off and touch-down), ballistic flight, "
+            "horizontal force parallel to the vertical one; min-jerk foot lift; whole-body IK on mjlab's G1 MJCF "
+            "(CoM, soles, zero angular momentum about the CoM as primary tasks, pelvis lean and posture in the null "
+            "space); velocities by central differences; rigid-ground inverse dynamics (mj_inverse, minimum-norm "
+            "sole wrenches) for the plausibility report"
+        ),
+        "model": "mjlab asset_zoo unitree_g1 g1.xml (MuJoCo Menagerie lineage, BSD-3-Clause) + mjlab G1 armature",
+        "versions": _versions(),
+        "references": entries,
+    }
+    _write_json(out / "manifest.json", manifest)
+    return manifest
+
+
+def _check(out: Path) -> int:
+    """Compare the files in ``out`` with a fresh build; 0 if they agree."""
+    model = load_g1_model()
+    status = 0
+    for cfg in shipped_references():
+        fresh, _ = synthesize_reference(cfg, model)
+        shipped = load_reference(out / f"jump_{fresh.name}.npz")
+        diff = float(np.abs(fresh.qpos - shipped.qpos).max()) if fresh.qpos.shape == shipped.qpos.shape else np.inf
+        print(f"{fresh.name}: max |qpos difference| = {diff:.2e}")
+        status |= int(diff > 1e-6)
+    return status
+
+
+def main(argv: list[str] | None = None) -> int:
+    """Command-line entry; returns the exit code (2 on bad arguments)."""
+    parser = argparse.ArgumentParser(prog=f"python -m {MODULE}", description=(__doc__ or "").splitlines()[0])
+    parser.add_argument("--out", type=Path, default=REFERENCE_DIR, help="output folder (default: package data)")
+    parser.add_argument("--check", action="store_true", help="compare the files in --out with a fresh build")
+    args = parser.parse_args(argv)
+    if args.out.exists() and not args.out.is_dir():
+        print(f"error: --out {args.out} is a file; pass a folder", file=sys.stderr)
+        return 2
+    args.out.mkdir(parents=True, exist_ok=True)
+    if args.check:
+        return _check(args.out)
+    manifest = build(args.out)
+    for name, entry in manifest["references"].items():  # type: ignore[union-attr]
+        p = entry["plausibility"]
+        print(f"{name}: {entry['samples']} samples, max torque / effort limit {p['max_torque_ratio']:.2f}")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
