@@ -80,6 +80,11 @@ class _RoughBowl:
         self.spec_id, self.truth, self.amp, self.period = spec_id, truth, amp, period
         self.train = np.ones(4, bool)
         self.calls = 0
+        self.y, self.sigma, self.weight = np.zeros((4, 6)), 1.0, 1.0
+
+    def simulate(self, params: dict[str, np.ndarray], mask: np.ndarray | None = None) -> np.ndarray:
+        """The replay whose residual against the zero recording is :meth:`resid` (y - sim) / sigma * weight."""
+        return -self.resid(params, mask).reshape(self.y.shape)
 
     def resid(self, params: dict[str, np.ndarray], mask: np.ndarray | None = None) -> np.ndarray:
         self.calls += 1
