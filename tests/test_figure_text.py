@@ -87,25 +87,25 @@ def saved(monkeypatch: pytest.MonkeyPatch) -> Iterator[list[tuple[list[str], lis
 
 
 def _speed_sweep(rows: list[dict[str, Any]], path: Path) -> None:
-    from gmloco.eval.figures_mpm import fig_mpm_speed_sweep
+    from gmloco.eval.report.figures_mpm import fig_mpm_speed_sweep
 
     fig_mpm_speed_sweep(rows, path, LONG_POLICY)
 
 
 def _transition(rows: list[dict[str, Any]], path: Path) -> None:
-    from gmloco.eval.figures_mpm import fig_mpm_transition
+    from gmloco.eval.report.figures_mpm import fig_mpm_transition
 
     fig_mpm_transition(rows, path, LONG_POLICY)
 
 
 def _by_speed(rows: list[dict[str, Any]], path: Path) -> None:
-    from gmloco.eval.figures_mpm import fig_policies_by_speed
+    from gmloco.eval.report.figures_mpm import fig_policies_by_speed
 
     fig_policies_by_speed([(LONG_POLICY, rows), ("ppo_rft3d", rows)], path, "dry_sand / straight")
 
 
 def _per_terrain(rows: list[dict[str, Any]], path: Path) -> None:
-    from gmloco.eval.figures_mpm import fig_per_terrain
+    from gmloco.eval.report.figures_mpm import fig_per_terrain
 
     fig_per_terrain([(LONG_POLICY, rows), ("ppo_rft3d", rows), ("ppo_rigid", rows)], path)
 

@@ -1,5 +1,5 @@
 # SPDX-License-Identifier: Apache-2.0
-"""Box-intrusion study (issue 5): thin CLI around ``gmloco.eval.box_study.run``.
+"""Box-intrusion study (issue 5): thin CLI around ``gmloco.eval.box.study.run``.
 
 Resumable and time-boxed (call it again with the same ``--out-dir`` to continue); runs with plain python::
 
@@ -25,7 +25,7 @@ __all__ = ["main"]
 
 def main() -> None:
     """Parse the command line, run the study (or the convergence comparison), print the summary."""
-    from gmloco.eval.box_study import BoxStudyCfg, box_study_smoke_cfg, run
+    from gmloco.eval.box.study import BoxStudyCfg, box_study_smoke_cfg, run
     from gmloco.eval.mpm.bed import SandBedCfg
     from gmloco.eval.mpm.box_scene import MpmSolverCfg
 
@@ -64,7 +64,7 @@ def main() -> None:
     p.add_argument("--smoke", action="store_true", help="CPU smoke: 1 trial, tiny bed, 0.2 s")
     a = p.parse_args()
     if a.convergence:
-        from gmloco.eval.box_study_checks import write_voxel_convergence
+        from gmloco.eval.box.checks import write_voxel_convergence
 
         print(json.dumps(write_voxel_convergence(a.convergence, Path(a.out_dir) / "convergence.json"), indent=1))
         return

@@ -1,7 +1,7 @@
 # SPDX-License-Identifier: Apache-2.0
 """Stage ``eval_mpm``: the exported policy walking on Newton implicit-MPM sand, scored by the paper's metrics (issue 9).
 
-Thin wrapper around ``gmloco.eval.g1_eval.run``: G1s (MuJoCo through Newton's ``SolverMuJoCo``) coupled two-way
+Thin wrapper around ``gmloco.eval.g1.run.run``: G1s (MuJoCo through Newton's ``SolverMuJoCo``) coupled two-way
 with ``SolverImplicitMPM`` sand, the ONNX policy at 50 Hz over 200 Hz physics; ``robots_per_batch`` episodes at
 once, each robot on its own sand window that moves with it (``moving_window=false``: a static bed covering the
 course). Writes ``episodes.jsonl`` (one line per episode, the resume state), ``summary.json`` (temporary file +
@@ -14,8 +14,8 @@ Run alone (time-boxed and resumable; works with plain ``python`` and ``PYTHONPAT
     python workflows/eval_mpm.py +exp=gm_loco run_dir=runs/gm_loco/<name> max_minutes=9
     python workflows/eval_mpm.py +exp=gm_loco run_dir=runs/gm_loco/<name> 'eval_mpm.gpus=[0,1,2,3]'   # four GPUs
 
-The GPU machine's command line without Hydra: ``python -m gmloco.eval.g1_eval_cli``; whether a cheaper MPM setting
-walks as the accepted one does: ``python -m gmloco.eval.convergence`` (``docs/mpm_eval.md``).
+The GPU machine's command line without Hydra: ``python -m gmloco.eval.g1.cli``; whether a cheaper MPM setting
+walks as the accepted one does: ``python -m gmloco.eval.studies.convergence`` (``docs/mpm_eval.md``).
 """
 
 from __future__ import annotations
@@ -33,7 +33,7 @@ from pipeline_report import say, stage_bar
 from stage_registry import StageIncompleteError
 
 if TYPE_CHECKING:
-    from gmloco.eval.g1_eval import G1EvalCfg
+    from gmloco.eval.g1.run import G1EvalCfg
 
 __all__ = ["eval_cfg", "main", "run"]
 
@@ -45,7 +45,7 @@ def _device(device: str) -> str | None:
 
 def eval_cfg(cfg: DictConfig) -> G1EvalCfg:
     """The ``G1EvalCfg`` of the pipeline's ``eval_mpm`` section (every field the section sets carried over)."""
-    from gmloco.eval.g1_eval import G1EvalCfg
+    from gmloco.eval.g1.run import G1EvalCfg
     from gmloco.eval.mpm.box_scene import MpmSolverCfg
     from gmloco.eval.mpm.window import SandWindowCfg
 
@@ -126,9 +126,9 @@ def run(cfg: DictConfig) -> dict[str, float]:
 
     With ``eval_mpm.gpus`` set, over those GPUs (one process each, every cell split into one share per GPU).
     """
-    from gmloco.eval.g1_eval import episode_specs
-    from gmloco.eval.g1_eval import run as run_eval
-    from gmloco.eval.g1_eval_gpus import run_on_gpus
+    from gmloco.eval.g1.gpus import run_on_gpus
+    from gmloco.eval.g1.run import episode_specs
+    from gmloco.eval.g1.run import run as run_eval
 
     gpus = [str(g) for g in cfg.eval_mpm.get("gpus", [])]
     ecfg = eval_cfg(cfg)

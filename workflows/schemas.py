@@ -4,7 +4,7 @@
 Each ``conf/<group>/*.yaml`` extends its schema through its defaults list (``- base_<group>``), so a typo in
 an override or a YAML file fails at composition with the key's name. The stage sections mirror the packages'
 ``FooCfg`` dataclasses (OmegaConf cannot hold their ``Literal`` fields); each ``workflows/<stage>.py`` converts
-its section into the package's dataclass. ``eval_mpm``'s section mirrors ``gmloco.eval.g1_eval.G1EvalCfg`` (issue 9).
+its section into the package's dataclass. ``eval_mpm``'s section mirrors ``gmloco.eval.g1.run.G1EvalCfg`` (issue 9).
 """
 
 from __future__ import annotations
@@ -328,7 +328,7 @@ class EvalMpmCfg(StageCfg):
     """Terrains (``gmloco.eval.mpm.window_terrain.terrain_cfg`` names: a medium, ``<medium>_rough``,
     ``<medium>_deep``, ``transition``)."""
     scenarios: list[str] = field(default_factory=lambda: ["straight", "circle"])
-    """``straight`` and/or ``circle`` (``gmloco.eval.g1_eval``)."""
+    """``straight`` and/or ``circle`` (``gmloco.eval.g1.run``)."""
     speeds: list[float] = field(default_factory=lambda: [1.0, 1.5, 2.0, 2.5], metadata=each(gt=0))
     """Forward-speed commands [m/s]; episode k uses ``speeds[k % len(speeds)]``."""
     circle_radius: float = ranged(2.0, gt=0)
@@ -363,7 +363,7 @@ class EvalMpmCfg(StageCfg):
     """Write the first episode of every (terrain, scenario, speed) as an MCAP recording."""
     gpus: list[int] = field(default_factory=list, metadata=each(integer=True, ge=0))
     """CUDA devices to spread the evaluation over: one process per GPU, each (terrain, scenario) cell split into one
-    share per GPU, pooled into this stage's outputs (``gmloco.eval.g1_eval_gpus``; the shares' folders under
+    share per GPU, pooled into this stage's outputs (``gmloco.eval.g1.gpus``; the shares' folders under
     ``<out_dir>/cells``). Empty: one process on the pipeline's ``device``. One GPU steps ~110-130 robot-frames/s at
     the default setting: 100 walking episodes of a cell take ~26-30 minutes on one GPU (``BENCHMARKS.md``)."""
 

@@ -20,7 +20,7 @@ from pathlib import Path
 
 import numpy as np
 
-from gmloco.eval.study_io import StudyRecords
+from gmloco.eval.studies.study_io import StudyRecords
 
 REBOUND = 0.02
 """Backward travel from the furthest point that counts as a rebound [m]."""

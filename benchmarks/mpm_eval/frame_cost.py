@@ -2,9 +2,9 @@
 """Wall-clock cost of one MPM frame against the particles in the solve, and the time-box fit's model of it (issue 9).
 
 Reads every run of the square- and reach-window rows (``FOLDERS``) whose episodes carry the wall clock (``elapsed_s``, ``end_frame``), takes each
-scene's stretch with all its lanes walking (``gmloco.eval.run_rates.running_rates``) and pools the frames and seconds
+scene's stretch with all its lanes walking (``gmloco.eval.studies.run_rates.running_rates``) and pools the frames and seconds
 per built size (particles, lanes). Fits ``frame_s = a + b * particles`` and compares it with the model
-``gmloco.eval.g1_eval_fit`` uses to fit cells into a time box: a measured full cell's frame, scaled by lanes above
+``gmloco.eval.g1.cost`` uses to fit cells into a time box: a measured full cell's frame, scaled by lanes above
 ``FRAME_COST_FLOOR``. Writes ``frame_cost.json`` and ``fig_frame_cost.png`` beside this script.
 
     python benchmarks/mpm_eval/frame_cost.py
@@ -17,9 +17,9 @@ from pathlib import Path
 
 import numpy as np
 
-from gmloco.eval.g1_eval import read_episodes
-from gmloco.eval.g1_eval_fit import FRAME_COST_FLOOR, CellCost, frame_seconds
-from gmloco.eval.run_rates import has_wall_clock, running_rates, scenes
+from gmloco.eval.g1.cost import FRAME_COST_FLOOR, CellCost, frame_seconds
+from gmloco.eval.g1.run import read_episodes
+from gmloco.eval.studies.run_rates import has_wall_clock, running_rates, scenes
 
 MPM_RESULTS = Path(__file__).resolve().parents[2] / "results" / "mpm_eval"  # the runs read, the outputs written
 FOLDERS = (  # the row folders whose episodes carry the wall clock

@@ -2,7 +2,7 @@
 """CPU probe: one exported policy driving the G1 on MPM dry sand (or a rigid floor), logged per frame.
 
 The scratch probe behind ``G1_SINKAGE.md``'s "policy on sand, 1 s" rows, made reusable for any exported policy
-(mjlab actor or gmloco student, ``gmloco.eval.g1_eval_policy.load_policy``). Same scene: ``G1MpmScene`` on
+(mjlab actor or gmloco student, ``gmloco.eval.g1.policy.load_policy``). Same scene: ``G1MpmScene`` on
 ``terrain_cfg("dry_sand", depth)``, 5 cm voxels, 50 Gauss-Seidel iterations, sparse grid, 100 Hz frames, 200 Hz
 physics; a static 0.6 x 0.5 m window (``--window small``) or the evaluation's moving 1.8 x 1.0 m window
 (``--window eval``). The numerics are defaults that ``--frame-dt``, ``--substeps``, ``--effective-mass`` and
@@ -23,7 +23,7 @@ from typing import Any
 
 import numpy as np
 
-from gmloco.eval.g1_eval_policy import StudentOnnxPolicy, load_policy
+from gmloco.eval.g1.policy import StudentOnnxPolicy, load_policy
 from gmloco.eval.mpm.box_scene import MpmSolverCfg, frame_dt_problem
 from gmloco.eval.mpm.g1_scene import G1MpmScene, G1MpmSceneCfg, SoleCfg
 from gmloco.eval.mpm.window import SandWindowCfg

@@ -3,7 +3,7 @@
 
 A batch of 25 robots steps together until its last robot's episode ends; a fallen robot's lane is idle from then
 on. Since the ablation-circle runs an idle lane's sand leaves the MPM solve (``G1EvalCfg.retire_idle_lanes``); before, it was
-stepped to the end. ``gmloco.eval.run_rates.running_rates`` splits each complete batch's wall time by how many
+stepped to the end. ``gmloco.eval.studies.run_rates.running_rates`` splits each complete batch's wall time by how many
 robots were still walking. This script pools those stretches, per setting (particles reserved) and per retire
 setting, into bins of robots walking, and draws the solver rate [MPM frames/s] against them.
 
@@ -24,8 +24,8 @@ from __future__ import annotations
 import json
 from pathlib import Path
 
-from gmloco.eval.g1_eval import read_episodes
-from gmloco.eval.run_rates import retire_setting, running_rates
+from gmloco.eval.g1.run import read_episodes
+from gmloco.eval.studies.run_rates import retire_setting, running_rates
 
 MPM_RESULTS = Path(__file__).resolve().parents[2] / "results" / "mpm_eval"  # the runs read, the outputs written
 BINS = ((25, 25), (10, 24), (4, 9), (1, 3))

@@ -143,7 +143,7 @@ def _scene_cfg(case: dict[str, Any], args: argparse.Namespace) -> Any:
 
 def _run_case(case: dict[str, Any], args: argparse.Namespace) -> dict[str, Any]:
     """Build, capture, step; return timings and the physics metrics of the convergence check."""
-    from gmloco.eval.g1_eval_policy import load_policy
+    from gmloco.eval.g1.policy import load_policy
     from gmloco.eval.mpm.g1_scene import G1MpmScene
 
     cfg = _scene_cfg(case, args)

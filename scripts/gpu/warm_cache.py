@@ -92,13 +92,13 @@ def main(argv: list[str] | None = None) -> None:
     )
     p.add_argument("--gpu-logs", nargs="*", default=[], help="logs of an earlier GPU run: also compile the block-size "
                    "variants of the modules it had to compile (their '(compiled)' lines)")  # fmt: skip
-    p.add_argument("eval_args", nargs="*", help="g1_eval_cli arguments of the tiny CPU episode (after --)")
+    p.add_argument("eval_args", nargs="*", help="gmloco.eval.g1.cli arguments of the tiny CPU episode (after --)")
     a = p.parse_args(argv)
     os.environ["WARP_CACHE_PATH"] = os.path.abspath(a.cache)
     import warp as wp
 
     wp.config.kernel_cache_dir = os.path.abspath(a.cache)
-    from gmloco.eval import g1_eval_cli
+    from gmloco.eval.g1 import cli as g1_cli
     from gmloco.eval.mpm import g1_scene
 
     build = g1_scene.G1MpmScene._build_robots
@@ -115,7 +115,7 @@ def main(argv: list[str] | None = None) -> None:
     with tempfile.TemporaryDirectory() as out:
         tiny = ["--out", out, "--device", "cpu", "--num-episodes", "1", "--episode-s", "0.1", "--voxel", "0.05",
                 "--robots-per-batch", "2", "--no-mcap", "--fresh"]  # fmt: skip
-        g1_eval_cli.main(tiny + a.eval_args)
+        g1_cli.main(tiny + a.eval_args)
     print(f"[warm_cache] CPU episode done in {time.time() - t0:.0f} s; compiling for sm{a.arch} {a.formats}")
     wanted = wanted_from_logs(a.gpu_logs)
     done, failed, matched = _compile_loaded(a.arch, a.formats, wanted)

@@ -34,7 +34,7 @@ def test_section_settings_reach_the_eval_cfg(compose: Callable[..., DictConfig])
 
 def test_default_section_matches_the_eval_defaults(compose: Callable[..., DictConfig]) -> None:
     """Without overrides the pipeline scores at ``G1EvalCfg``'s defaults (one accepted setting, not two)."""
-    from gmloco.eval.g1_eval import G1EvalCfg
+    from gmloco.eval.g1.run import G1EvalCfg
 
     out = eval_mpm.eval_cfg(compose("+exp=gm_loco", "+scale=full"))
     base = G1EvalCfg()
@@ -48,8 +48,8 @@ def test_gpus_send_the_stage_to_the_several_gpu_runner(
     compose: Callable[..., DictConfig], monkeypatch: pytest.MonkeyPatch
 ) -> None:
     """eval_mpm.gpus=[0,1] runs run_on_gpus with those GPUs and the section's config; empty runs in process."""
-    import gmloco.eval.g1_eval as g1_eval
-    import gmloco.eval.g1_eval_gpus as g1_eval_gpus
+    import gmloco.eval.g1.gpus as g1_eval_gpus
+    import gmloco.eval.g1.run as g1_eval
 
     calls: list[tuple[str, object]] = []
     monkeypatch.setattr(g1_eval_gpus, "run_on_gpus", lambda c, g: calls.append(("gpus", g)) or ({"m": 1.0}, True))

@@ -14,7 +14,7 @@ import json
 import numpy as np
 
 from gmloco.contact import MATERIAL_PRESETS
-from gmloco.eval.box import BoxCfg
+from gmloco.eval.box.config import BoxCfg
 from gmloco.eval.mpm.bed import SandBedCfg
 from gmloco.eval.mpm.box_scene import MpmBoxScene, MpmBoxSceneCfg, MpmSolverCfg
 

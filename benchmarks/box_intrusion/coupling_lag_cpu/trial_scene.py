@@ -6,7 +6,7 @@ from __future__ import annotations
 from dataclasses import replace
 
 from gmloco.contact import MaterialCfg
-from gmloco.eval.box_study import BoxStudyCfg, sample_media
+from gmloco.eval.box.study import BoxStudyCfg, sample_media
 from gmloco.eval.mpm.box_scene import MpmBoxScene, MpmBoxSceneCfg, MpmSolverCfg
 
 

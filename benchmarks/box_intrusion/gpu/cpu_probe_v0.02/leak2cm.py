@@ -13,8 +13,8 @@ import time
 from dataclasses import replace
 
 from gmloco.contact import MaterialCfg
-from gmloco.eval.box import BoxCfg
-from gmloco.eval.box_study import BoxStudyCfg, sample_media
+from gmloco.eval.box.config import BoxCfg
+from gmloco.eval.box.study import BoxStudyCfg, sample_media
 from gmloco.eval.mpm.bed import SandBedCfg
 from gmloco.eval.mpm.box_scene import MpmBoxScene, MpmBoxSceneCfg, MpmSolverCfg
 

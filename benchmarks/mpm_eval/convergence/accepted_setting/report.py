@@ -51,8 +51,8 @@ def _row(label: str, dev: str, rows: list[dict], verdict: str) -> str:
 
 
 def convergence_table() -> list[str]:
-    """One row per setting, with ``gmloco.eval.convergence``'s verdict against R."""
-    from gmloco.eval.convergence import compare_runs
+    """One row per setting, with ``gmloco.eval.studies.convergence``'s verdict against R."""
+    from gmloco.eval.studies.convergence import compare_runs
 
     ref = load(REF)
     lines = ["| setting | GPU | episodes | success | falls (any time) | mean sinkage [cm] | max sinkage [cm] | velocity error "

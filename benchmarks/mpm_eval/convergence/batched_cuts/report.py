@@ -46,11 +46,11 @@ def main() -> None:
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
-    from gmloco.eval.convergence import compare_runs
+    from gmloco.eval.studies.convergence import compare_runs
 
     ref_rows = load(GROUPS[0][1])
     lines = ["| configuration | episodes | success | alive time median [s] (min-max) | mean sinkage [cm] | "
-             "velocity error [m/s] | sole reached the floor | against A (`gmloco.eval.convergence`) |",
+             "velocity error [m/s] | sole reached the floor | against A (`gmloco.eval.studies.convergence`) |",
              "|---|---|---|---|---|---|---|---|"]  # fmt: skip
     fig, ax = plt.subplots(1, 2, figsize=(12, 3.8))
     for k, (label, names) in enumerate(GROUPS):

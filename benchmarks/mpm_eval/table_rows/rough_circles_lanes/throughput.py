@@ -14,9 +14,9 @@ from __future__ import annotations
 import json
 from pathlib import Path
 
-from gmloco.eval.g1_eval import read_episodes
-from gmloco.eval.run_rates import TARGET_ROBOT_FRAMES_PER_S as TARGET_RF_S
-from gmloco.eval.run_rates import run_rate
+from gmloco.eval.g1.run import read_episodes
+from gmloco.eval.studies.run_rates import TARGET_ROBOT_FRAMES_PER_S as TARGET_RF_S
+from gmloco.eval.studies.run_rates import run_rate
 
 RESULTS_HOME = Path(__file__).resolve().parents[4] / "results/mpm_eval/table_rows/rough_circles_lanes"
 """The results folder this script reads and writes (its data lives under ``results/``, the code here)."""

@@ -35,7 +35,7 @@ FRAMES = 60
 def run_case(age: int, size_x: float, size_y: float) -> list[dict[str, float]]:
     """Sinkage [mm] and sand force [N] of the box every 10 frames after it is set down."""
     from gmloco.contact import MATERIAL_PRESETS
-    from gmloco.eval.box import BoxCfg
+    from gmloco.eval.box.config import BoxCfg
     from gmloco.eval.mpm.bed import SandBedCfg
     from gmloco.eval.mpm.box_scene import MpmBoxScene, MpmBoxSceneCfg, MpmSolverCfg
 

@@ -26,7 +26,7 @@ from typing import Any, Literal, get_args
 
 import numpy as np
 
-from gmloco.eval.box import BoxCfg
+from gmloco.eval.box.config import BoxCfg
 from gmloco.eval.mpm.bed import SandBedCfg, add_bed_container, bed_particle_positions
 from gmloco.eval.mpm.coupled_setup import make_coupled_states, make_mpm_solver
 from gmloco.eval.mpm.materials import GranularMaterial, MpmMaterialCfg, apply_mpm_material, mpm_material

@@ -39,7 +39,7 @@ from typing import Any
 
 import numpy as np
 
-from gmloco.eval.g1_eval_policy import MjlabOnnxPolicy, PolicySpec, StudentOnnxPolicy
+from gmloco.eval.g1.policy import MjlabOnnxPolicy, PolicySpec, StudentOnnxPolicy
 from gmloco.eval.metrics.locomotion import quat_wxyz_to_roll_pitch_yaw
 from gmloco.eval.mpm.box_scene import MpmSolverCfg, frame_dt_problem, model_gravity
 from gmloco.eval.mpm.coupled_setup import make_coupled_states, make_mpm_solver
