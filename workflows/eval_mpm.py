@@ -33,7 +33,7 @@ from pipeline_report import say, stage_bar
 from stage_registry import StageIncompleteError
 
 if TYPE_CHECKING:
-    from gmloco.eval.g1.run import G1EvalCfg
+    from gmloco.eval.g1.config import G1EvalCfg
 
 __all__ = ["eval_cfg", "main", "run"]
 
@@ -45,7 +45,7 @@ def _device(device: str) -> str | None:
 
 def eval_cfg(cfg: DictConfig) -> G1EvalCfg:
     """The ``G1EvalCfg`` of the pipeline's ``eval_mpm`` section (every field the section sets carried over)."""
-    from gmloco.eval.g1.run import G1EvalCfg
+    from gmloco.eval.g1.config import G1EvalCfg
     from gmloco.eval.mpm.box_scene import MpmSolverCfg
     from gmloco.eval.mpm.window import SandWindowCfg
 
@@ -126,8 +126,8 @@ def run(cfg: DictConfig) -> dict[str, float]:
 
     With ``eval_mpm.gpus`` set, over those GPUs (one process each, every cell split into one share per GPU).
     """
+    from gmloco.eval.g1.config import episode_specs
     from gmloco.eval.g1.gpus import run_on_gpus
-    from gmloco.eval.g1.run import episode_specs
     from gmloco.eval.g1.run import run as run_eval
 
     gpus = [str(g) for g in cfg.eval_mpm.get("gpus", [])]

@@ -4,7 +4,7 @@
 Each ``conf/<group>/*.yaml`` extends its schema through its defaults list (``- base_<group>``), so a typo in
 an override or a YAML file fails at composition with the key's name. The stage sections mirror the packages'
 ``FooCfg`` dataclasses (OmegaConf cannot hold their ``Literal`` fields); each ``workflows/<stage>.py`` converts
-its section into the package's dataclass. ``eval_mpm``'s section mirrors ``gmloco.eval.g1.run.G1EvalCfg`` (issue 9).
+its section into the package's dataclass. ``eval_mpm``'s section mirrors ``gmloco.eval.g1.config.G1EvalCfg`` (issue 9).
 """
 
 from __future__ import annotations

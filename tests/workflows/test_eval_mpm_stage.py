@@ -34,7 +34,7 @@ def test_section_settings_reach_the_eval_cfg(compose: Callable[..., DictConfig])
 
 def test_default_section_matches_the_eval_defaults(compose: Callable[..., DictConfig]) -> None:
     """Without overrides the pipeline scores at ``G1EvalCfg``'s defaults (one accepted setting, not two)."""
-    from gmloco.eval.g1.run import G1EvalCfg
+    from gmloco.eval.g1.config import G1EvalCfg
 
     out = eval_mpm.eval_cfg(compose("+exp=gm_loco", "+scale=full"))
     base = G1EvalCfg()

@@ -4,7 +4,7 @@
 Reads every row's ``episodes.jsonl`` (each episode's largest sole reach from the pelvis, its yaw frame) and the
 recordings (the first episode of every speed: the pelvis heading over time). An episode whose soles, over the
 whole walk, never reached beyond the window's extent along the heading (less the 2 cm margin of
-``gmloco.eval.g1.run.window_exit_cause``) and still left the window left it because the robot turned: the window is
+``gmloco.eval.g1.score.window_exit_cause``) and still left the window left it because the robot turned: the window is
 a box of the grid's axes. Writes ``heading.json`` and ``fig_heading.png`` beside this script.
 
     python benchmarks/mpm_eval/table_rows/per_terrain/heading_fig.py
@@ -19,7 +19,7 @@ from pathlib import Path
 import numpy as np
 
 from gmloco.deploy.logs.reader import read_log
-from gmloco.eval.g1.run import WINDOW_EXIT_MARGIN_M
+from gmloco.eval.g1.score import WINDOW_EXIT_MARGIN_M
 from gmloco.eval.metrics.locomotion import quat_wxyz_to_roll_pitch_yaw
 
 RESULTS_HOME = Path(__file__).resolve().parents[4] / "results/mpm_eval/table_rows/per_terrain"

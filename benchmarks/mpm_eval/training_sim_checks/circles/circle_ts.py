@@ -5,7 +5,7 @@ On MPM dry sand the student finished none of 75 circle episodes (``../../table_r
 student (its ``StudentPPO`` checkpoint, whose ONNX export the MPM evaluation runs) in the granular training simulator
 (3D-RFT on the whole foot box, as it was trained) with the MPM evaluation's circle command, (v, 0, v / R) with
 R = 2 m held for 10 s, v = 1.0 / 1.5 / 2.0 / 2.5 m/s, on dry sand and basalt, ``--repeats`` envs per cell, and
-scores each walk with the MPM evaluation's rules (:func:`gmloco.eval.g1.run.score_episode`'s progress rule and
+scores each walk with the MPM evaluation's rules (:func:`gmloco.eval.g1.score.score_episode`'s progress rule and
 :mod:`gmloco.eval.metrics.locomotion`): course finished, DTW path error, mean yaw-rate error, the heading's turn.
 Writes ``circle_ts.json`` beside this script.
 

@@ -80,7 +80,7 @@ def test_cell_capacity_factor_below_one_is_refused(capsys: pytest.CaptureFixture
 
 def test_window_defaults_are_the_evaluation_defaults() -> None:
     """Without window flags the command line scores at ``G1EvalCfg``'s window (size and lead) and bed."""
-    from gmloco.eval.g1.run import G1EvalCfg
+    from gmloco.eval.g1.config import G1EvalCfg
 
     a, base = _parse(["--out", "x"]), G1EvalCfg()
     assert (a.window_length, a.window_width, a.window_lead) == (base.window.length, base.window.width, base.window.lead)
@@ -92,7 +92,7 @@ def test_shard_reaches_the_config_and_bad_shards_are_refused(
 ) -> None:
     """--shard 1/4 scores a quarter of each cell: with four speeds, the 25 episodes at 1.5 m/s."""
     import gmloco.eval.g1.cli as cli
-    from gmloco.eval.g1.run import episode_specs
+    from gmloco.eval.g1.config import episode_specs
 
     seen = {}
 
@@ -115,7 +115,7 @@ def test_cli_args_give_back_the_config() -> None:
     from dataclasses import replace
 
     from gmloco.eval.g1.cli import cfg_from_args, cli_args
-    from gmloco.eval.g1.run import G1EvalCfg
+    from gmloco.eval.g1.config import G1EvalCfg
     from gmloco.eval.mpm.window import SandWindowCfg
 
     base = G1EvalCfg()
@@ -171,7 +171,7 @@ def test_resuming_a_folder_at_another_window_exits_2(tmp_path: Path, capsys: pyt
     from gmloco.eval.g1.cli import cfg_from_args
     from gmloco.eval.g1.run import resume_problem
 
-    policy = Path(__file__).resolve().parents[3] / "artifacts" / "ppo_rft3d" / "policy.onnx"
+    policy = Path(__file__).resolve().parents[4] / "artifacts" / "ppo_rft3d" / "policy.onnx"
     if not policy.exists():
         pytest.skip(f"no exported policy at {policy}")
     out = tmp_path / "run"

@@ -13,8 +13,9 @@ import numpy as np
 import pytest
 
 from gmloco.eval.g1.cli import _parse, cfg_from_args
+from gmloco.eval.g1.config import G1EvalCfg, episode_specs
 from gmloco.eval.g1.gpus import CELLS_DIR, run_on_gpus
-from gmloco.eval.g1.run import G1EvalCfg, episode_specs, score_episode
+from gmloco.eval.g1.score import score_episode
 
 
 def _walk(speed: float, steps: int, fall_at: int | None, dt: float = 0.02) -> dict:

@@ -82,7 +82,7 @@ def test_one_rule_implementation(tmp_path: Path) -> None:
 
     policy = load_policy(_policy_file(tmp_path, "yaw_target"))
     assert isinstance(policy, StudentOnnxPolicy) and isinstance(policy.runner.yaw_target, YawTargetCommand)
-    src = Path(__file__).resolve().parents[1] / "src"
+    src = Path(__file__).resolve().parents[2] / "src"
     copies = [
         p for p in src.rglob("*.py") if "def corrected_yaw_rate" in p.read_text() or "yaw_target +" in p.read_text()
     ]

@@ -14,17 +14,11 @@ from typing import ClassVar, Literal
 import numpy as np
 import pytest
 
-from gmloco.eval.g1.run import (
-    EpisodeSpec,
-    G1EvalCfg,
-    cell_minutes_left,
-    episode_batches,
-    episode_specs,
-    exit_in_fall,
-    run_cell,
-    score_episode,
-    summarize,
-)
+from gmloco.eval.g1.cell import run_cell
+from gmloco.eval.g1.config import EpisodeSpec, G1EvalCfg, episode_batches, episode_specs
+from gmloco.eval.g1.score import score_episode
+from gmloco.eval.g1.timebox import cell_minutes_left
+from gmloco.eval.metrics.episodes import exit_in_fall, summarize
 from gmloco.eval.mpm.g1_scene import LOG_FIELDS
 from gmloco.eval.mpm.window import SandWindowCfg
 from gmloco.eval.report.tables_mpm import table_speeds, table_terrains
@@ -102,7 +96,7 @@ def test_a_sole_outside_the_sand_window_flags_the_episode() -> None:
 
 def test_a_run_reports_the_soles_reach_against_its_window(capsys: pytest.CaptureFixture[str]) -> None:
     """The largest reach over the episodes against the window's extent; a warning names the earliest exit."""
-    from gmloco.eval.g1.run import report_window
+    from gmloco.eval.g1.window_report import report_window
 
     rows = [
         {
@@ -133,7 +127,7 @@ def test_a_run_reports_the_soles_reach_against_its_window(capsys: pytest.Capture
 
 def test_a_covering_window_grows_only_where_the_soles_reached_past_it() -> None:
     """The per-terrain runs' poppy-seed reach against the tables' window, a turning walk, and a reach already held."""
-    from gmloco.eval.g1.run import covering_window
+    from gmloco.eval.g1.window_report import covering_window
 
     tables = SandWindowCfg(length=1.4, width=0.6, lead=0.2)  # 0.5 m behind, 0.9 ahead, 0.3 beside
     w = covering_window((0.73, 0.13, 0.31), tables, turned=False)
@@ -151,11 +145,11 @@ def test_one_turning_window_serves_straight_and_circle() -> None:
 
     1.4 x 0.6 m, lead 0.2 m: hypot = 1.5232 m, + 0.4 = 1.9232 m; the circle adds its 4 m diameter.
     """
-    from gmloco.eval.g1.run import _window_and_lanes
+    from gmloco.eval.g1.lanes import window_and_lanes
 
     cfg = G1EvalCfg()
-    straight, lane_s = _window_and_lanes([EpisodeSpec("dry_sand", "straight", 1.0, 0)], cfg)
-    circle, lane_c = _window_and_lanes([EpisodeSpec("dry_sand", "circle", 1.0, 0)], cfg)
+    straight, lane_s = window_and_lanes([EpisodeSpec("dry_sand", "straight", 1.0, 0)], cfg)
+    circle, lane_c = window_and_lanes([EpisodeSpec("dry_sand", "circle", 1.0, 0)], cfg)
     assert straight == circle == cfg.window and cfg.window.turn_with_robot
     span = math.hypot(1.4, 0.6) + 0.4
     assert lane_s == pytest.approx(span + cfg.lane_gap)
@@ -164,11 +158,11 @@ def test_one_turning_window_serves_straight_and_circle() -> None:
 
 def test_a_window_on_the_grid_axes_becomes_a_square_on_a_circle() -> None:
     """A window that does not turn: on a circle it is max(length, width) square; straight it is as set."""
-    from gmloco.eval.g1.run import _window_and_lanes
+    from gmloco.eval.g1.lanes import window_and_lanes
 
     cfg = replace(G1EvalCfg(), window=replace(G1EvalCfg().window, turn_with_robot=False))
-    straight, lane_s = _window_and_lanes([EpisodeSpec("dry_sand", "straight", 1.0, 0)], cfg)
-    circle, lane_c = _window_and_lanes([EpisodeSpec("dry_sand", "circle", 1.0, 0)], cfg)
+    straight, lane_s = window_and_lanes([EpisodeSpec("dry_sand", "straight", 1.0, 0)], cfg)
+    circle, lane_c = window_and_lanes([EpisodeSpec("dry_sand", "circle", 1.0, 0)], cfg)
     assert (straight.length, straight.width) == (cfg.window.length, cfg.window.width)
     side = max(cfg.window.length, cfg.window.width)
     assert (circle.length, circle.width, circle.lead) == (side, side, cfg.window.lead)
@@ -382,6 +376,7 @@ def test_without_refill_lanes_idle_and_batches_get_their_own_solver(monkeypatch:
     """refill=False: batches of 2, 2, 1 episodes, one scene each, no resets; the run writes all 5 episodes."""
     cfg, _ = _cell(monkeypatch, {0: 3}, refill=False)
     monkeypatch.setattr("gmloco.eval.g1.run.load_policy", lambda path, n=1: _Policy())
+    monkeypatch.setattr("gmloco.eval.g1.cell.load_policy", lambda path, n=1: _Policy())
     _, complete = _run_in(cfg, monkeypatch)
     assert complete and len(_LaneScene.made) == 3 and all(not s.resets for s in _LaneScene.made)
 
@@ -408,18 +403,23 @@ def _time_boxed(
     A frame costs 0.25 s per lane on a stand-in clock; the time box is 30 s. The pre-build prior prices a frame at
     ``prior_lane_s`` per lane, built at once (0: every cell fits until its probe has measured it).
     """
+    import gmloco.eval.g1.cell as g1_cell
     import gmloco.eval.g1.run as g1_eval
+    import gmloco.eval.g1.timebox as g1_timebox
     from gmloco.eval.g1.cost import CellCost
 
-    monkeypatch.setattr(g1_eval, "prior_cost", lambda per_lane, n, sweeps: CellCost(n, prior_lane_s * n, 0.0))
+    monkeypatch.setattr(g1_timebox, "prior_cost", lambda per_lane, n, sweeps: CellCost(n, prior_lane_s * n, 0.0))
 
     cfg, _ = _cell(monkeypatch, falls or {}, **({"num_episodes": 4, "robots_per_batch": 4} | kw), max_minutes=0.5,
                    fit_time_box=fit, out_dir=str(tmp_path))  # fmt: skip
     monkeypatch.setattr(_LaneScene, "TICK", 0.25)
     monkeypatch.setattr(_LaneScene, "now", [0.0])
-    monkeypatch.setattr(g1_eval, "time", SimpleNamespace(perf_counter=lambda: _LaneScene.now[0]))
+    clock = SimpleNamespace(perf_counter=lambda: _LaneScene.now[0])
+    for module in (g1_eval, g1_cell, g1_timebox):  # the run, its episode loop and the time box read one clock
+        monkeypatch.setattr(module, "time", clock)
     monkeypatch.setattr(g1_eval, "FIT_PROBE_S", 4.0)
     monkeypatch.setattr(g1_eval, "load_policy", lambda path, n=1: _Policy())
+    monkeypatch.setattr(g1_cell, "load_policy", lambda path, n=1: _Policy())
     monkeypatch.setattr(g1_eval, "write_outputs", lambda *a, **k: None)
     _, complete = g1_eval.run(cfg)
     log = tmp_path / "episodes.jsonl"
@@ -481,19 +481,19 @@ def test_a_share_whose_walk_cannot_end_is_not_built(monkeypatch: pytest.MonkeyPa
 def test_the_prior_prices_the_cell_build_cell_scene_builds() -> None:
     """The prior counts the batch's window as the scene solves it: the terrain's depth, one window for every walk."""
     from gmloco.eval.g1.cost import PRIOR_FRAME_S_AT_ZERO, PRIOR_FRAME_S_PER_MILLION
-    from gmloco.eval.g1.run import _prior_cost
+    from gmloco.eval.g1.timebox import cell_prior_cost
 
     cfg = replace(G1EvalCfg(), robots_per_batch=25, scenarios=("straight", "circle"))
     specs = episode_specs(cfg)
     straight = [s for s in specs if s.scenario == "straight"]
     circle = [s for s in specs if s.scenario == "circle"]
     per_lane = 94 * 40 * 20  # 1.4 x 0.6 m at 1.5 cm spacing, 30 cm deep
-    cost = _prior_cost(straight, cfg)
+    cost = cell_prior_cost(straight, cfg)
     assert cost.lanes == 25
     assert cost.frame_s == pytest.approx(PRIOR_FRAME_S_AT_ZERO + PRIOR_FRAME_S_PER_MILLION * 25 * per_lane / 1e6)
-    assert _prior_cost(circle, cfg).frame_s == cost.frame_s  # the turning window serves the circle as it is
+    assert cell_prior_cost(circle, cfg).frame_s == cost.frame_s  # the turning window serves the circle as it is
     fixed = replace(cfg, window=replace(cfg.window, turn_with_robot=False))
-    assert _prior_cost(circle, fixed).frame_s > cost.frame_s  # a window on the grid's axes: 94 x 94 on a circle
+    assert cell_prior_cost(circle, fixed).frame_s > cost.frame_s  # a window on the grid's axes: 94 x 94 on a circle
 
 
 def _run_in(cfg: G1EvalCfg, monkeypatch: pytest.MonkeyPatch) -> tuple[dict, bool]:
@@ -581,7 +581,7 @@ def _grid_scene(fail: bool, calls: list[int]) -> SimpleNamespace:
 
 def test_grid_overflow_invalidates_the_cell() -> None:
     """A sparse grid that outgrew its reserved cells: an error naming the capacity and --cell-capacity-factor."""
-    from gmloco.eval.g1.run import check_grid_capacity
+    from gmloco.eval.g1.cell import check_grid_capacity
     from gmloco.eval.mpm.box_scene import MpmSolverCfg
 
     calls: list[int] = []
@@ -596,7 +596,7 @@ def test_grid_capacity_is_not_checked_without_a_reserved_sparse_grid(
     grid_type: Literal["sparse", "dense"], capacity: int
 ) -> None:
     """Newton's per-step allocation (capacity -1) or a dense grid: the overflow check is never asked."""
-    from gmloco.eval.g1.run import check_grid_capacity
+    from gmloco.eval.g1.cell import check_grid_capacity
     from gmloco.eval.mpm.box_scene import MpmSolverCfg
 
     calls: list[int] = []
@@ -606,7 +606,7 @@ def test_grid_capacity_is_not_checked_without_a_reserved_sparse_grid(
 
 def test_grid_within_capacity_passes() -> None:
     """A sparse grid inside its reserved cells: checked once, no error."""
-    from gmloco.eval.g1.run import check_grid_capacity
+    from gmloco.eval.g1.cell import check_grid_capacity
     from gmloco.eval.mpm.box_scene import MpmSolverCfg
 
     calls: list[int] = []
@@ -616,7 +616,8 @@ def test_grid_within_capacity_passes() -> None:
 
 def test_grid_capacity_pads_without_changing_the_walk() -> None:
     """1.5x and 3x the windows' cells reserved: the same pelvis trajectory (the capacity only pads the solve)."""
-    from gmloco.eval.g1.run import build_cell_scene, load_policy
+    from gmloco.eval.g1.cell import build_cell_scene
+    from gmloco.eval.g1.policy import load_policy
 
     base = G1EvalCfg()
     final = {}
@@ -681,7 +682,7 @@ def test_an_exit_shortly_before_a_fall_came_with_the_fall() -> None:
 
 def test_heading_turn_wraps_around() -> None:
     """A heading going from 170 to -170 degrees turned 20 degrees, not 340; only alive samples count."""
-    from gmloco.eval.g1.run import heading_turn_deg
+    from gmloco.eval.g1.score import heading_turn_deg
 
     yaw = np.radians([170.0, 180.0, -170.0, 90.0])
     assert math.isclose(heading_turn_deg(yaw, 3), 20.0, rel_tol=1e-9)
@@ -694,12 +695,14 @@ def test_each_group_records_its_best_walk_once_per_cell(monkeypatch: pytest.Monk
     Episode 0 falls at step 3, episodes 1-4 stand the 0.2 s out: episode 1 (the first of the longest) is recorded; a
     resumed run replaces it only with a better walk than its sidecar's.
     """
+    import gmloco.eval.g1.cell as g1_cell
     import gmloco.eval.g1.record as g1_eval_record
     import gmloco.eval.g1.run as g1_eval
 
     cfg, _ = _cell(monkeypatch, {0: 3})
     cfg = replace(cfg, record_mcap=True)
     monkeypatch.setattr(g1_eval, "load_policy", lambda path, n=1: _Policy())
+    monkeypatch.setattr(g1_cell, "load_policy", lambda path, n=1: _Policy())
     monkeypatch.setattr(g1_eval, "write_outputs", lambda *a, **k: None)
     written: list[str] = []
 

@@ -19,7 +19,7 @@ from gmloco.eval.mpm.g1_scene import (
 )
 from gmloco.eval.mpm.window import SandWindowCfg
 
-POLICY = Path(__file__).resolve().parents[3] / "artifacts" / "ppo_rft3d" / "policy.onnx"
+POLICY = Path(__file__).resolve().parents[4] / "artifacts" / "ppo_rft3d" / "policy.onnx"
 
 
 @pytest.fixture(scope="module")

@@ -9,8 +9,8 @@ from pathlib import Path
 
 import pytest
 
+from gmloco.eval.metrics.episodes import wilson_interval
 from gmloco.eval.report.paper_tables import combine, main
-from gmloco.eval.report.tables_mpm import wilson_interval
 
 SETTING = {"solver": {"voxel_size": 0.03, "max_iterations": 500, "frame_dt": 0.005}, "window": {"length": 1.4},
            "bed_depth": 0.3, "episode_s": 10.0, "failure": {"max_tilt": 0.785}, "course_slack": 0.2,

@@ -10,8 +10,8 @@ from pathlib import Path
 import pytest
 
 from gmloco.eval.g1.cli import _parse, cfg_from_args
+from gmloco.eval.g1.config import G1EvalCfg, episode_specs
 from gmloco.eval.g1.queue import check_tasks, file_tasks
-from gmloco.eval.g1.run import G1EvalCfg, episode_specs
 from gmloco.eval.mpm.window import SandWindowCfg
 from gmloco.eval.studies.tables_todo import cfg_from_summary, main, todo
 

@@ -14,8 +14,9 @@ import json
 import sys
 from dataclasses import replace
 
+from gmloco.eval.g1.config import G1EvalCfg
 from gmloco.eval.g1.policy import policy_problem
-from gmloco.eval.g1.run import G1EvalCfg, resume_problem, run
+from gmloco.eval.g1.run import resume_problem, run
 from gmloco.eval.mpm.box_scene import frame_dt_problem
 from gmloco.eval.mpm.window import SandWindowCfg
 

@@ -3,7 +3,7 @@
 
 A cell's MPM state (millions of particles) is not checkpointed, so an episode still running at the time box is
 lost with all its frames: the reach-window runs lost two basalt shares whole (25 robots each, walking 6-8 s of their 10 s
-when the box closed; ~27 GPU-minutes). ``g1_eval`` therefore measures what a cell costs in its first stretch
+when the box closed; ~27 GPU-minutes). ``g1.run`` therefore measures what a cell costs in its first stretch
 (:class:`CellCost`: wall seconds per frame with all its lanes walking, and the build) and, when its running walks
 would not end before the time box if no robot fell, stops it and rebuilds it with the lanes that do fit
 (:func:`fit_lanes`); later cells of the same (terrain, scenario) get those lanes before they are built, and a lane

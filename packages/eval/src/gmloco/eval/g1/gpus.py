@@ -4,7 +4,7 @@
 One GPU steps ~110-130 robot-frames/s at the accepted setting, so 100 walking episodes of one cell take ~26-30
 minutes on it (``BENCHMARKS.md``). :func:`run_on_gpus` splits each (terrain, scenario) cell of a ``G1EvalCfg`` into
 one share per GPU (``--shard I/N``: the episodes whose index k has k % N == I), runs the shares through
-:mod:`gmloco.eval.g1.queue` (one ``g1_eval_cli`` process per GPU, the whole queue time-boxed to
+:mod:`gmloco.eval.g1.queue` (one ``g1.cli`` process per GPU, the whole queue time-boxed to
 ``cfg.max_minutes``), and pools them into the outputs a one-process run writes under ``cfg.out_dir``:
 ``episodes.jsonl`` (pooled; the same episode keys as a one-process run, so either kind resumes the other:
 share folders without episodes start from their share of it),
@@ -20,8 +20,11 @@ from pathlib import Path
 from typing import Any
 
 from gmloco.eval.g1.cli import cli_args
+from gmloco.eval.g1.config import G1EvalCfg, episode_specs
 from gmloco.eval.g1.queue import Launch, QueueTask, TaskResult, cell_tasks, row_spans, run_queue
-from gmloco.eval.g1.run import G1EvalCfg, episode_specs, read_episodes, report_window, summarize, write_outputs
+from gmloco.eval.g1.run import read_episodes, write_outputs
+from gmloco.eval.g1.window_report import report_window
+from gmloco.eval.metrics.episodes import summarize
 
 __all__ = ["CELLS_DIR", "run_on_gpus"]
 
@@ -70,7 +73,7 @@ def run_on_gpus(
     Args:
         cfg: The evaluation (its ``device`` and ``shard`` are set per process; each GPU is the process's ``cuda:0``).
         gpus: ``CUDA_VISIBLE_DEVICES`` values, one process at a time on each.
-        launch: Process starter (tests pass a stand-in; default: ``g1_eval_cli`` processes).
+        launch: Process starter (tests pass a stand-in; default: ``g1.cli`` processes).
         poll_s: How often the queue looks at its processes [s].
 
     Raises:

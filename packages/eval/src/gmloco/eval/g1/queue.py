@@ -1,13 +1,13 @@
 # SPDX-License-Identifier: Apache-2.0
 """Several GPUs, one evaluation each: the MPM evaluation's cells spread over a machine's GPUs (issue 9).
 
-One ``g1_eval_cli`` process drives one GPU; running several on one GPU does not pay (the window-behind-pelvis runs: seven side by side
+One ``g1.cli`` process drives one GPU; running several on one GPU does not pay (the window-behind-pelvis runs: seven side by side
 on an H100 summed ~112 robot-frames/s against ~150 for one alone). On a machine with N GPUs this tool splits the
 evaluation into one task per (terrain, scenario) cell, each with its own run folder ``OUT/<terrain>__<scenario>``
 (with ``--shards N``: N tasks per cell, ``OUT/<terrain>__<scenario>__share<I>ofN``, each scoring the episodes whose
 index k has k % N == I, so a long row runs on N GPUs at once and its first row is done first),
 and keeps every GPU busy from a shared queue (a GPU takes the next task when its last one ends). Each task is
-time-boxed to what is left of ``--max-minutes`` and resumable like any ``g1_eval`` run (same ``--out``); a task that
+time-boxed to what is left of ``--max-minutes`` and resumable like any evaluation run (same ``--out``); a task that
 would get less than a minute is not started. Afterwards, combine the folders with ``gmloco.eval.report.paper_tables``
 (the queue prints the command: the folders share one label, so they are pooled into one policy's rows).
 
@@ -15,8 +15,8 @@ would get less than a minute is not started. Afterwards, combine the folders wit
         --terrains basalt dry_sand poppy_seed --scenarios straight circle --max-minutes 25
         -- --policy artifacts/gm_loco_student_td/policy.onnx
 
-``--check`` parses every task's arguments as ``g1_eval_cli`` will and exits: run it on the CPU before spending
-device time on a job. Everything after ``--`` goes to every ``g1_eval_cli`` call (policy, window, numerics, episodes). Writes
+``--check`` parses every task's arguments as ``g1.cli`` will and exits: run it on the CPU before spending
+device time on a job. Everything after ``--`` goes to every ``g1.cli`` call (policy, window, numerics, episodes). Writes
 ``OUT/queue.json`` (per task: GPU, return code, start and minutes, log file; per row split into shares: its
 wall-clock from the first share's start to the last one's end, ``row_spans``).
 
@@ -62,7 +62,7 @@ MIN_TASK_MINUTES = 1.0
 
 @dataclass(frozen=True)
 class QueueTask:
-    """One ``g1_eval_cli`` call: a run folder name and its arguments (without ``--out`` and ``--max-minutes``)."""
+    """One ``g1.cli`` call: a run folder name and its arguments (without ``--out`` and ``--max-minutes``)."""
 
     name: str
     argv: tuple[str, ...]
@@ -84,7 +84,7 @@ class TaskResult:
 
 
 _QUEUE_FLAGS = ("--out", "--max-minutes", "--device")
-"""``g1_eval_cli`` arguments the queue sets per task."""
+"""``g1.cli`` arguments the queue sets per task."""
 
 
 def cell_tasks(terrains: list[str], scenarios: list[str], argv: list[str], shards: int = 1) -> list[QueueTask]:
@@ -157,10 +157,10 @@ def _command(task: QueueTask, out_root: Path, minutes: float | None) -> list[str
 
 
 def check_tasks(tasks: list[QueueTask]) -> None:
-    """Parse every task's arguments as ``g1_eval_cli`` will (before device time is spent on a typo).
+    """Parse every task's arguments as ``g1.cli`` will (before device time is spent on a typo).
 
     Raises:
-        ValueError: A task's arguments do not parse; the message names the task and what ``g1_eval_cli`` said.
+        ValueError: A task's arguments do not parse; the message names the task and what ``g1.cli`` said.
     """
     import contextlib
     import io
@@ -257,7 +257,7 @@ def row_spans(results: list[TaskResult]) -> dict[str, dict[str, Any]]:
 
 
 def _policy_label(argv: list[str]) -> str:
-    """The folder name of ``--policy`` among ``g1_eval_cli`` arguments (``policy`` when none is given)."""
+    """The folder name of ``--policy`` among ``g1.cli`` arguments (``policy`` when none is given)."""
     if "--policy" not in argv or argv.index("--policy") + 1 >= len(argv):
         return "policy"
     return Path(argv[argv.index("--policy") + 1]).parent.name or "policy"

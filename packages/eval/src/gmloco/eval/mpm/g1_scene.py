@@ -27,7 +27,7 @@
   fixed capacity (``max_active_cell_count > 0``).
 * Observation: the mjlab velocity-task terms: base angular velocity (pelvis, body frame), projected gravity,
   command (v_x, v_y, w_z), joint_pos - q_0, joint_vel, last action. The policy gets the pelvis heading too, so
-  a ``yaw_target`` policy observes w_z with the heading correction it was trained with (``g1_eval_policy``).
+  a ``yaw_target`` policy observes w_z with the heading correction it was trained with (``g1.policy``).
 """
 
 from __future__ import annotations

@@ -25,7 +25,7 @@ def _by_speed(rs: list[dict[str, Any]], key: str) -> tuple[np.ndarray, np.ndarra
 
 def _success_with_interval(groups: list[list[dict[str, Any]]]) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Per group of episodes: (count, success rate [%] (NaN for none), [G, 2] 95 % Wilson interval [%])."""
-    from gmloco.eval.report.tables_mpm import wilson_interval
+    from gmloco.eval.metrics.episodes import wilson_interval
 
     n = np.array([len(g) for g in groups])
     wins = np.array([sum(bool(r["success"]) for r in g) for g in groups])

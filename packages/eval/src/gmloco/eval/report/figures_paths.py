@@ -1,7 +1,7 @@
 # SPDX-License-Identifier: Apache-2.0
 """Executed against commanded paths of the MPM evaluation's recorded episodes (what the DTW path error scores).
 
-Each ``g1_eval`` run records the best walk of every (terrain, scenario, speed) group (a success if any, else the
+Each evaluation run records the best walk of every (terrain, scenario, speed) group (a success if any, else the
 longest time alive; runs before the square-window runs: the first episode to end, often an early fall) as
 ``recordings/<terrain>__<scenario>__v<speed>.mcap``: one episode, not the group's typical one. :func:`recorded_path` reads one back as the pelvis path in its
 start frame (start at the origin, heading +x) with the command it walked; :func:`fig_paths` draws a panel per policy
@@ -42,10 +42,10 @@ class RecordedPath:
 
 
 def recorded_path(recording: str | Path) -> RecordedPath:
-    """Read one episode recording (``g1_eval_record`` schema) as its path in the start frame and its command.
+    """Read one episode recording (``g1.record`` schema) as its path in the start frame and its command.
 
     Raises:
-        KeyError: The recording holds no odometry or no velocity command (not a ``g1_eval`` episode).
+        KeyError: The recording holds no odometry or no velocity command (not an evaluation episode).
     """
     from gmloco.deploy.logs import read_log
     from gmloco.eval.metrics.locomotion import quat_wxyz_to_roll_pitch_yaw

@@ -197,10 +197,10 @@ class AdaptationTrace:
 
 
 def adaptation_trace(recording: str | Path) -> AdaptationTrace:
-    """Read a ``g1_eval`` recording (``g1_eval_record`` schema) as its course position, soles and decoded eta.
+    """Read an evaluation recording (``g1.record`` schema) as its course position, soles and decoded eta.
 
     Raises:
-        KeyError: The recording lacks odometry or the simulated foot contact (not a ``g1_eval`` episode).
+        KeyError: The recording lacks odometry or the simulated foot contact (not an evaluation episode).
     """
     from gmloco.deploy.logs import read_log
 

@@ -1,8 +1,8 @@
 # SPDX-License-Identifier: Apache-2.0
-"""The paper's MPM tables across policies: several ``g1_eval`` runs, one table (issue 9).
+"""The paper's MPM tables across policies: several evaluation runs, one table (issue 9).
 
 GM-Loco's contact-model ablation and per-terrain tables put several policies side by side. Each policy is scored
-by its own ``g1_eval`` run (often over several machines: a run folder resumes from its ``episodes.jsonl``); this
+by its own evaluation run (often over several machines: a run folder resumes from its ``episodes.jsonl``); this
 tool labels each run's episodes with the policy's name and writes the combined tables:
 
     python -m gmloco.eval.report.paper_tables --run td=RUN_DIR --run clr50=RUN_DIR [...] --out DIR [--episodes 100]
@@ -54,7 +54,7 @@ WINDOW_EXIT_NOTE_PCT = 5.0
 
 
 def _summary(run_dir: Path) -> dict[str, Any]:
-    """A ``g1_eval`` run's ``summary.json``."""
+    """An evaluation run's ``summary.json``."""
     path = run_dir / "summary.json"
     if not path.is_file():
         raise FileNotFoundError(f"{run_dir}: no summary.json; pass a g1_eval output folder (python -m "
@@ -63,7 +63,7 @@ def _summary(run_dir: Path) -> dict[str, Any]:
 
 
 def setting_of(summary: dict[str, Any]) -> dict[str, Any]:
-    """The MPM setting of a ``g1_eval`` run: ``SETTING_KEYS`` of its ``summary.json`` cfg."""
+    """The MPM setting of an evaluation run: ``SETTING_KEYS`` of its ``summary.json`` cfg."""
     return {k: summary["cfg"].get(k) for k in SETTING_KEYS}
 
 
@@ -311,7 +311,7 @@ def _window_share_rows(rows: list[list[Any]], exits: dict[str, float], column: s
     """Key -> a ``column`` of the ``exits`` rows that recorded it (runs from the per-terrain runs on).
 
     ``window_exit_turn_pct``: % of episodes that left the window early because the robot turned;
-    ``window_exit_fall_pct``: % whose early exit came within ``g1_eval.FALL_EXIT_S`` before their fall.
+    ``window_exit_fall_pct``: % whose early exit came within ``metrics.episodes.FALL_EXIT_S`` before their fall.
     """
     from gmloco.eval.report.tables_mpm import TERRAIN_COLUMNS
 
@@ -327,7 +327,7 @@ def _window_exit_note(
 
     With the share of each row's exits by the robot's turn and the share that came with the fall.
     """
-    from gmloco.eval.g1.run import FALL_EXIT_S
+    from gmloco.eval.metrics.episodes import FALL_EXIT_S
 
     if not exits:
         return ""

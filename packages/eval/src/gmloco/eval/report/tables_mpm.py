@@ -7,7 +7,7 @@
   per-terrain and contact-model tables;
   ``window_exit_pct``: episodes whose soles left the sand window early, a validity check, NaN for older runs;
   ``window_exit_turn_pct``: those of them that left it because the robot turned (the window does not turn), NaN for
-  runs before the per-terrain runs; ``window_exit_fall_pct``: those of them whose exit came within ``g1_eval.FALL_EXIT_S``
+  runs before the per-terrain runs; ``window_exit_fall_pct``: those of them whose exit came within ``metrics.episodes.FALL_EXIT_S``
   before the fall (a stumble's trailing sole: the walk was already lost);
   several policies' ``episodes.jsonl`` concatenated give the ablation rows).
 * ``table_speeds``: success rate per commanded forward speed (rows terrain x scenario).
@@ -30,6 +30,8 @@ from typing import Any
 
 import numpy as np
 
+from gmloco.eval.metrics.episodes import exit_in_fall, wilson_interval
+
 __all__ = [
     "ABLATION_COLUMNS",
     "PAPER_METRIC_KEYS",
@@ -42,7 +44,6 @@ __all__ = [
     "table_speeds",
     "table_terrains",
     "table_transition",
-    "wilson_interval",
     "write_table",
     "write_tables",
 ]
@@ -60,22 +61,6 @@ def _mean(rows: list[dict[str, Any]], key: str) -> float:
     return float(np.mean(vals)) if vals else float("nan")
 
 
-def wilson_interval(successes: int, n: int, z: float = 1.959964) -> tuple[float, float]:
-    """95 % Wilson score interval of a success rate, as fractions (NaN, NaN for no episodes).
-
-    With 100 episodes a rate of 50 % is known to about +-10 points; with 8, 8 of 8 only says "at least 68 %".
-    """
-    if n <= 0:
-        return float("nan"), float("nan")
-    p = successes / n
-    denom = 1.0 + z * z / n
-    centre = (p + z * z / (2 * n)) / denom
-    half = z * math.sqrt(p * (1 - p) / n + z * z / (4 * n * n)) / denom
-    lo = 0.0 if successes <= 0 else max(0.0, centre - half)  # exact at the ends (no 3e-16 for 0 of 69)
-    hi = 1.0 if successes >= n else min(1.0, centre + half)
-    return lo, hi
-
-
 def _cells(rows: list[dict[str, Any]]) -> dict[tuple[str, str], list[dict[str, Any]]]:
     """Rows grouped by (terrain, scenario), first-seen order."""
     out: dict[tuple[str, str], list[dict[str, Any]]] = {}
@@ -85,9 +70,7 @@ def _cells(rows: list[dict[str, Any]]) -> dict[tuple[str, str], list[dict[str, A
 
 
 def _exit_in_fall_pct(rows: list[dict[str, Any]]) -> float:
-    """% of episodes whose early window exit came with their fall (``g1_eval.exit_in_fall``; NaN: not checked)."""
-    from gmloco.eval.g1.run import exit_in_fall
-
+    """% of episodes whose early window exit came with their fall (``metrics.episodes.exit_in_fall``; NaN: not checked)."""
     checked = [r for r in rows if r.get("window_exit_early") is not None]
     return 100.0 * sum(exit_in_fall(r) for r in checked) / len(checked) if checked else float("nan")
 

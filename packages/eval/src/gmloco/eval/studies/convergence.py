@@ -1,7 +1,7 @@
 # SPDX-License-Identifier: Apache-2.0
 """Convergence check of an MPM setting (issue 9): does a cheaper or finer setting change the walk?
 
-Two ``g1_eval`` runs of the same policy, terrain and command, one at the reference setting and one at the
+Two evaluation runs of the same policy, terrain and command, one at the reference setting and one at the
 candidate (another voxel size, iteration count, window or bed), are compared episode by episode:
 
 * time alive (until the fall, or the episode length): two-sided Mann-Whitney U test (``scipy.stats``);
@@ -23,7 +23,7 @@ means "no difference that these episodes can detect", so the number of episodes 
     python -m gmloco.eval.studies.convergence --reference REF_RUN [REF_RUN ...] --candidate RUN [RUN ...]
         [--out verdict.json]
 
-where each RUN is a ``g1_eval`` output folder (its ``episodes.jsonl``) or the file itself; several runs of one
+where each RUN is an evaluation output folder (its ``episodes.jsonl``) or the file itself; several runs of one
 setting are pooled.
 """
 
@@ -92,7 +92,7 @@ class Verdict:
 
 
 def load_episodes(path: str | Path) -> list[dict[str, Any]]:
-    """Episode rows of a ``g1_eval`` run folder or of an ``episodes.jsonl`` file."""
+    """Episode rows of an evaluation run folder or of an ``episodes.jsonl`` file."""
     p = Path(path)
     p = p / "episodes.jsonl" if p.is_dir() else p
     if not p.is_file():

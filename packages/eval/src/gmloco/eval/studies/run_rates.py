@@ -1,9 +1,9 @@
 # SPDX-License-Identifier: Apache-2.0
 """What a GPU run's MPM-evaluation runs cost, read back from their own records (issue 9).
 
-Every episode line of a ``g1_eval`` run holds its batch's solver rate (``frames_per_s``: MPM frames per second of
+Every episode line of an evaluation run holds its batch's solver rate (``frames_per_s``: MPM frames per second of
 the whole batch), particle count, lanes and build time; a queue's ``queue.json`` holds each task's minutes and each
-row's wall-clock over its shares (``g1_eval_queue``). This module turns a study folder laid out as the GPU jobs
+row's wall-clock over its shares (``g1.queue``). This module turns a study folder laid out as the GPU jobs
 leave it (``runs/<task>/episodes.jsonl``, ``logs/queue.json``) into one ``throughput.json``:
 
 * per run: episodes, particles, lanes, median solver frames/s, robot-frames/s with every lane stepping

@@ -10,7 +10,7 @@ L-inf). The variants take turns frame after frame for ``cycles`` rounds, so each
 Outputs under ``out``: ``probes.jsonl`` (one line per probe frame: variant, frame, residual curve, eager wall
 time), ``summary.json`` (per variant: median residual at fixed sweep counts and the sweeps it needs to reach the
 first variant's residual at ``reference_iterations``) and ``fig_residuals.png``. The eager wall time includes a
-host read-back per residual check; the per-sweep cost under a CUDA graph is measured with ``g1_eval_cli``
+host read-back per residual check; the per-sweep cost under a CUDA graph is measured with ``g1.cli``
 (``--rheology-solver``) instead.
 """
 
@@ -212,7 +212,9 @@ def run_study(eval_cfg: Any, cfg: SolverStudyCfg, out: Path) -> dict[str, Any]:
     """Walk, probe, write ``probes.jsonl``, ``summary.json`` and the figure; return the summary."""
     import sys
 
-    from gmloco.eval.g1.run import build_cell_scene, episode_specs, load_policy
+    from gmloco.eval.g1.cell import build_cell_scene
+    from gmloco.eval.g1.config import episode_specs
+    from gmloco.eval.g1.policy import load_policy
 
     out.mkdir(parents=True, exist_ok=True)
     specs = episode_specs(eval_cfg)
@@ -251,7 +253,7 @@ def run_study(eval_cfg: Any, cfg: SolverStudyCfg, out: Path) -> dict[str, Any]:
 
 def main(argv: list[str] | None = None) -> None:
     """CLI: ``python -m gmloco.eval.studies.solver_study --policy P --out DIR [--variants gs,jacobi ...]``."""
-    from gmloco.eval.g1.run import G1EvalCfg
+    from gmloco.eval.g1.config import G1EvalCfg
 
     p = argparse.ArgumentParser(description=(__doc__ or "").split("\n")[0])
     p.add_argument("--policy", required=True, help="exported policy (ONNX with its metadata)")

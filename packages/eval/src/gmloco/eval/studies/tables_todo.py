@@ -5,7 +5,7 @@ Reads the runs behind the tables (``--run`` / ``--runs-file``, as ``gmloco.eval.
 (policy, terrain, scenario) row:
 
 * **reruns**: rows in which more than ``WINDOW_EXIT_NOTE_PCT`` % of the episodes had a sole leave its sand window
-  early. The rerun takes the window that holds the row's recorded reach (``g1_eval.covering_window`` of the reach
+  early. The rerun takes the window that holds the row's recorded reach (``g1.window_report.covering_window`` of the reach
   that all but half that share of its walks stayed within: the rear or front grown where the soles passed it, a
   square where the robot turned out of it), one share per speed;
 * **resumes**: run folders of rows short of ``--episodes`` (time boxes), each resumed under its own name (copy the
@@ -14,7 +14,7 @@ Reads the runs behind the tables (``--run`` / ``--runs-file``, as ``gmloco.eval.
 The task file holds one ``NAME g1_eval_cli-arguments`` line per task (``python -m gmloco.eval.g1.queue
 --tasks FILE``), resumes first (they finish rows), then reruns, most exits first, each with a comment saying why. A
 row can appear in both: the resume completes it at its window, the rerun replaces it. Exits within
-``g1_eval.FALL_EXIT_S`` before a fall (a stumble's trailing sole) are not counted (``--fall-exits`` counts them):
+``metrics.episodes.FALL_EXIT_S`` before a fall (a stumble's trailing sole) are not counted (``--fall-exits`` counts them):
 the reach-window runs reran two rows made of such exits at a window no sole left and neither changed.
 
     python -m gmloco.eval.studies.tables_todo --runs-file results/mpm_eval/tables/runs.txt --out /tmp/todo_tasks.txt
@@ -32,17 +32,11 @@ from pathlib import Path
 from typing import Any
 
 from gmloco.eval.g1.cli import cli_args
-from gmloco.eval.g1.run import (
-    FALL_EXIT_S,
-    WINDOW_TURN_SHARE,
-    G1EvalCfg,
-    covering_window,
-    episode_specs,
-    exit_in_fall,
-    reach_fits,
-    reach_quantile,
-    read_episodes,
-)
+from gmloco.eval.g1.config import G1EvalCfg, episode_specs
+from gmloco.eval.g1.run import read_episodes
+from gmloco.eval.g1.score import reach_fits
+from gmloco.eval.g1.window_report import WINDOW_TURN_SHARE, covering_window, reach_quantile
+from gmloco.eval.metrics.episodes import FALL_EXIT_S, exit_in_fall
 from gmloco.eval.metrics.locomotion import FailureCfg
 from gmloco.eval.mpm.box_scene import MpmSolverCfg
 from gmloco.eval.mpm.window import SandWindowCfg
@@ -114,7 +108,7 @@ def todo(
     """The tasks that complete the tables of ``runs`` (label, run folder): resumes first, then window reruns.
 
     A row is rerun when more than ``exit_pct`` % of its episodes left the window early, not counting exits that
-    came with the fall (``g1_eval.exit_in_fall``) unless ``fall_exits``; a row left out for that is said in
+    came with the fall (``metrics.episodes.exit_in_fall``) unless ``fall_exits``; a row left out for that is said in
     ``notes``.
 
     Raises:
