@@ -18,7 +18,7 @@ from pathlib import Path
 import numpy as np
 
 from gmloco.eval.g1.cost import FRAME_COST_FLOOR, CellCost, frame_seconds
-from gmloco.eval.g1.run import read_episodes
+from gmloco.eval.metrics.episodes import read_episodes
 from gmloco.eval.studies.run_rates import has_wall_clock, running_rates, scenes
 
 MPM_RESULTS = Path(__file__).resolve().parents[2] / "results" / "mpm_eval"  # the runs read, the outputs written

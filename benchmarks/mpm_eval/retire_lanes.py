@@ -24,7 +24,7 @@ from __future__ import annotations
 import json
 from pathlib import Path
 
-from gmloco.eval.g1.run import read_episodes
+from gmloco.eval.metrics.episodes import read_episodes
 from gmloco.eval.studies.run_rates import retire_setting, running_rates
 
 MPM_RESULTS = Path(__file__).resolve().parents[2] / "results" / "mpm_eval"  # the runs read, the outputs written

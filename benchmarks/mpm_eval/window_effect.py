@@ -17,8 +17,7 @@ from pathlib import Path
 
 from scipy.stats import fisher_exact
 
-from gmloco.eval.g1.run import read_episodes
-from gmloco.eval.metrics.episodes import wilson_interval
+from gmloco.eval.metrics.episodes import read_episodes, wilson_interval
 
 MPM_RESULTS = Path(__file__).resolve().parents[2] / "results" / "mpm_eval"  # the runs read, the outputs written
 ROWS = {

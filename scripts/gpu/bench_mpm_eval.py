@@ -117,8 +117,8 @@ def _key(c: dict[str, Any]) -> str:
 
 def _scene_cfg(case: dict[str, Any], args: argparse.Namespace) -> Any:
     """Scene of one case: moving window (window, multi, stand) or a static bed over a 2.5 m/s x 10 s course."""
+    from gmloco.eval.g1.scene import G1MpmSceneCfg
     from gmloco.eval.mpm.box_scene import MpmSolverCfg
-    from gmloco.eval.mpm.g1_scene import G1MpmSceneCfg
     from gmloco.eval.mpm.window import SandWindowCfg
     from gmloco.eval.mpm.window_terrain import terrain_cfg
 
@@ -144,7 +144,7 @@ def _scene_cfg(case: dict[str, Any], args: argparse.Namespace) -> Any:
 def _run_case(case: dict[str, Any], args: argparse.Namespace) -> dict[str, Any]:
     """Build, capture, step; return timings and the physics metrics of the convergence check."""
     from gmloco.eval.g1.policy import load_policy
-    from gmloco.eval.mpm.g1_scene import G1MpmScene
+    from gmloco.eval.g1.scene import G1MpmScene
 
     cfg = _scene_cfg(case, args)
     policy = load_policy(args.policy, case["robots"])

@@ -99,7 +99,7 @@ def main(argv: list[str] | None = None) -> None:
 
     wp.config.kernel_cache_dir = os.path.abspath(a.cache)
     from gmloco.eval.g1 import cli as g1_cli
-    from gmloco.eval.mpm import g1_scene
+    from gmloco.eval.g1 import scene as g1_scene
 
     build = g1_scene.G1MpmScene._build_robots
 

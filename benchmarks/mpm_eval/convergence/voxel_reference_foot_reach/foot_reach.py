@@ -38,8 +38,8 @@ def reach(path: Path, near: float) -> dict:
     import mujoco
 
     from gmloco.deploy.logs.reader import read_log
+    from gmloco.eval.g1.soles import SoleCfg, g1_mjcf_path, sole_box_corners
     from gmloco.eval.metrics.locomotion import quat_wxyz_to_roll_pitch_yaw
-    from gmloco.eval.mpm.g1_scene import SoleCfg, g1_mjcf_path, sole_box_corners
 
     log = read_log(path)
     t_q, q = log.signal("lowstate.q")

@@ -4,7 +4,7 @@
 The counterpart of ``benchmarks/mpm_eval/policy_probe.py`` in the simulator the policies were trained in: the play env
 of ``gmloco.train.evaluation`` (``_build_env``, the baseline's observation layout from the ONNX metadata), one env,
 material pinned to a preset, fixed forward command. It logs, at every 50 Hz policy step, the same quantities as the
-MPM probe, computed on the same sole box (``gmloco.eval.mpm.g1_scene.SoleCfg`` in the ankle-roll-link frame): the
+MPM probe, computed on the same sole box (``gmloco.eval.g1.soles.SoleCfg`` in the ankle-roll-link frame): the
 depth of each sole's lowest corner (``low``) and mid-plane (``mid``, mean of the 8 corners) below the free surface
 (z = 0), the sole pitch (positive = heel down), the vertical granular force on each foot, pelvis height / x / v_x /
 pitch. Appends one JSON record per run to ``--log``.
@@ -23,7 +23,7 @@ from typing import Any
 import numpy as np
 import torch
 
-from gmloco.eval.mpm.g1_scene import SoleCfg
+from gmloco.eval.g1.soles import SoleCfg
 from gmloco.train import evaluation as ev
 from gmloco.train.sand import FOOT_BODIES
 

@@ -20,7 +20,7 @@ from pathlib import Path
 import torch
 
 import gmloco.train.evaluation_ts as ets
-from gmloco.eval.mpm.g1_scene import SoleCfg
+from gmloco.eval.g1.soles import SoleCfg
 from gmloco.train.sand import FOOT_BODIES
 
 RESULTS_HOME = Path(__file__).resolve().parents[4] / "results/mpm_eval/probes/swing_trip"

@@ -17,7 +17,7 @@ from pathlib import Path
 import numpy as np
 from scipy.stats import mannwhitneyu
 
-from gmloco.eval.g1.run import read_episodes
+from gmloco.eval.metrics.episodes import read_episodes
 
 RESULTS_HOME = Path(__file__).resolve().parents[4] / "results/mpm_eval/table_rows/basalt_rough_square_window"
 """The results folder this script reads and writes (its data lives under ``results/``, the code here)."""

@@ -14,7 +14,7 @@ from __future__ import annotations
 import json
 from pathlib import Path
 
-from gmloco.eval.g1.run import read_episodes
+from gmloco.eval.metrics.episodes import read_episodes
 from gmloco.eval.studies.run_rates import TARGET_ROBOT_FRAMES_PER_S as TARGET_RF_S
 from gmloco.eval.studies.run_rates import run_rate
 

@@ -16,10 +16,10 @@ import pytest
 
 from gmloco.eval.g1.cell import run_cell
 from gmloco.eval.g1.config import EpisodeSpec, G1EvalCfg, episode_batches, episode_specs
+from gmloco.eval.g1.scene import LOG_FIELDS
 from gmloco.eval.g1.score import score_episode
 from gmloco.eval.g1.timebox import cell_minutes_left
 from gmloco.eval.metrics.episodes import exit_in_fall, summarize
-from gmloco.eval.mpm.g1_scene import LOG_FIELDS
 from gmloco.eval.mpm.window import SandWindowCfg
 from gmloco.eval.report.tables_mpm import table_speeds, table_terrains
 
@@ -320,7 +320,7 @@ class _Policy:
 
 
 def _cell(monkeypatch: pytest.MonkeyPatch, falls: dict[int, int], **kw: object) -> tuple[G1EvalCfg, list[EpisodeSpec]]:
-    import gmloco.eval.mpm.g1_scene as g1_scene
+    import gmloco.eval.g1.scene as g1_scene
 
     monkeypatch.setattr(g1_scene, "G1MpmScene", _LaneScene)
     monkeypatch.setattr(_LaneScene, "FALLS", falls)
@@ -555,7 +555,7 @@ def test_episodes_are_read_up_to_a_partial_last_line(tmp_path: Path) -> None:
     """A run killed mid-write leaves half a line: skipped (and cut off with repair); damage earlier is an error."""
     import json
 
-    from gmloco.eval.g1.run import read_episodes
+    from gmloco.eval.metrics.episodes import read_episodes
 
     path = tmp_path / "episodes.jsonl"
     path.write_text(json.dumps({"key": "a"}) + "\n" + json.dumps({"key": "b"}) + "\n" + '{"key": "c", "succ')

@@ -9,7 +9,8 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from gmloco.eval.studies.convergence import ConvergenceCfg, compare_runs, load_episodes, main
+from gmloco.eval.metrics.episodes import load_episodes
+from gmloco.eval.studies.convergence import ConvergenceCfg, compare_runs, main
 
 
 def _rows(alive: np.ndarray, sink: float, success_frac: float, speed: float = 1.0, vel: float = 0.2) -> list[dict]:

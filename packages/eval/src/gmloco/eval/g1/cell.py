@@ -2,7 +2,7 @@
 """The episode loop of one (terrain, scenario) cell: robots in lanes of one MPM solver, refilled as episodes end.
 
 The deadline checks inside the loop ask :mod:`gmloco.eval.g1.timebox` (and the GPU cost model behind it) whether a
-walk can still end; the physics is :class:`gmloco.eval.mpm.g1_scene.G1MpmScene`.
+walk can still end; the physics is :class:`gmloco.eval.g1.scene.G1MpmScene`.
 """
 
 from __future__ import annotations
@@ -37,7 +37,7 @@ def build_cell_scene(specs: list[EpisodeSpec], cfg: G1EvalCfg, policy: Any) -> t
     One lane per robot, each commanded as its episode; the active-cell capacity is sized from the windows
     (``cell_capacity_factor``); ``policy`` is reloaded for the lane count if it was built for another.
     """
-    from gmloco.eval.mpm.g1_scene import G1MpmScene, G1MpmSceneCfg
+    from gmloco.eval.g1.scene import G1MpmScene, G1MpmSceneCfg
 
     n = min(cfg.robots_per_batch, len(specs))
     terrain, window, lane, per_lane = cell_sand(specs, cfg)
@@ -189,7 +189,7 @@ def _lane_log(
     scene: Any, r: int, a: int, b: int, spec: EpisodeSpec, terrain: Any, build_s: float, n: int
 ) -> dict[str, Any]:
     """One episode's log: lane ``r``'s policy-rate samples ``a:b`` (``score_episode``'s input)."""
-    from gmloco.eval.mpm.g1_scene import LOG_FIELDS
+    from gmloco.eval.g1.scene import LOG_FIELDS
     from gmloco.eval.mpm.window_terrain import terrain_surface_height
 
     arr = {name: np.asarray(getattr(scene, name)[a:b])[:, r] for name in LOG_FIELDS}

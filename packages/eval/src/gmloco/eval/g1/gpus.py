@@ -22,9 +22,9 @@ from typing import Any
 from gmloco.eval.g1.cli import cli_args
 from gmloco.eval.g1.config import G1EvalCfg, episode_specs
 from gmloco.eval.g1.queue import Launch, QueueTask, TaskResult, cell_tasks, row_spans, run_queue
-from gmloco.eval.g1.run import read_episodes, write_outputs
+from gmloco.eval.g1.run import write_outputs
 from gmloco.eval.g1.window_report import report_window
-from gmloco.eval.metrics.episodes import summarize
+from gmloco.eval.metrics.episodes import read_episodes, summarize
 
 __all__ = ["CELLS_DIR", "run_on_gpus"]
 

@@ -52,9 +52,9 @@ from gmloco.eval.g1.policy import load_policy
 from gmloco.eval.g1.score import score_episode
 from gmloco.eval.g1.timebox import cell_prior_cost, lanes_in_time_box
 from gmloco.eval.g1.window_report import report_window
-from gmloco.eval.metrics.episodes import summarize
+from gmloco.eval.metrics.episodes import read_episodes, summarize
 
-__all__ = ["read_episodes", "recording_rank", "resume_problem", "run", "write_outputs"]
+__all__ = ["recording_rank", "resume_problem", "run", "write_outputs"]
 
 
 def _recording_path(out: Path, spec: EpisodeSpec) -> Path:
@@ -97,34 +97,6 @@ def _record(log: dict[str, Any], row: dict[str, Any], cfg: G1EvalCfg, out: Path)
     tmp = path.with_suffix(".json.tmp")  # tmp + replace: a kill never leaves half a sidecar
     tmp.write_text(json.dumps(side) + "\n")
     tmp.replace(path.with_suffix(".json"))
-
-
-def read_episodes(path: Path, repair: bool = False) -> list[dict[str, Any]]:
-    """Episode rows of an ``episodes.jsonl``, read up to the damage.
-
-    Episodes are appended one line at a time, so a run killed mid-write can leave a partial last line: it is
-    skipped with a note on stderr (with ``repair``, cut off the file so a resumed run appends after the last whole
-    episode). A damaged line before the last means the file was edited: ValueError naming the line.
-    """
-    import sys
-
-    text = path.read_text()
-    lines = text.splitlines()
-    rows: list[dict[str, Any]] = []
-    for k, line in enumerate(lines):
-        if not line.strip():
-            continue
-        try:
-            rows.append(json.loads(line))
-        except json.JSONDecodeError as exc:
-            if k < len(lines) - 1:
-                raise ValueError(f"{path}:{k + 1}: not an episode record ({exc}); remove the line or rerun with "
-                                 "--fresh") from exc  # fmt: skip
-            print(f"{path}: last line is a partial record (run stopped while writing); it is skipped",
-                  file=sys.stderr)  # fmt: skip
-            if repair:
-                path.write_text("".join(f"{good}\n" for good in lines[:k]))
-    return rows
 
 
 def resume_problem(cfg: G1EvalCfg) -> str | None:

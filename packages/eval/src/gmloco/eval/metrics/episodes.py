@@ -1,14 +1,25 @@
 # SPDX-License-Identifier: Apache-2.0
-"""Scored episode rows (``episodes.jsonl``): their summary per group, success intervals and falls after a window exit."""
+"""Scored episode rows (``episodes.jsonl``): reading them, their summary per group, success intervals, fall exits."""
 
 from __future__ import annotations
 
+import json
 import math
+from pathlib import Path
 from typing import Any
 
 import numpy as np
 
-__all__ = ["FALL_EXIT_S", "FALL_REASONS", "METRIC_KEYS", "exit_in_fall", "summarize", "wilson_interval"]
+__all__ = [
+    "FALL_EXIT_S",
+    "FALL_REASONS",
+    "METRIC_KEYS",
+    "exit_in_fall",
+    "load_episodes",
+    "read_episodes",
+    "summarize",
+    "wilson_interval",
+]
 
 
 def wilson_interval(successes: int, n: int, z: float = 1.959964) -> tuple[float, float]:
@@ -76,3 +87,45 @@ def summarize(rows: list[dict[str, Any]]) -> dict[str, float]:
             sum(bool(r["success"]) for r in rs), len(rs)
         )
     return out
+
+
+def read_episodes(path: Path, repair: bool = False) -> list[dict[str, Any]]:
+    """Episode rows of an ``episodes.jsonl``, read up to the damage.
+
+    Episodes are appended one line at a time, so a run killed mid-write can leave a partial last line: it is
+    skipped with a note on stderr (with ``repair``, cut off the file so a resumed run appends after the last whole
+    episode). A damaged line before the last means the file was edited: ValueError naming the line.
+    """
+    import sys
+
+    text = path.read_text()
+    lines = text.splitlines()
+    rows: list[dict[str, Any]] = []
+    for k, line in enumerate(lines):
+        if not line.strip():
+            continue
+        try:
+            rows.append(json.loads(line))
+        except json.JSONDecodeError as exc:
+            if k < len(lines) - 1:
+                raise ValueError(f"{path}:{k + 1}: not an episode record ({exc}); remove the line or rerun with "
+                                 "--fresh") from exc  # fmt: skip
+            print(f"{path}: last line is a partial record (run stopped while writing); it is skipped",
+                  file=sys.stderr)  # fmt: skip
+            if repair:
+                path.write_text("".join(f"{good}\n" for good in lines[:k]))
+    return rows
+
+
+def load_episodes(path: str | Path) -> list[dict[str, Any]]:
+    """Episode rows of an evaluation run folder or of an ``episodes.jsonl`` file."""
+    p = Path(path)
+    p = p / "episodes.jsonl" if p.is_dir() else p
+    if not p.is_file():
+        raise FileNotFoundError(f"{path}: no episodes.jsonl here; pass a g1_eval output folder or its episodes.jsonl")
+    if p.suffix != ".jsonl":
+        raise ValueError(f"{path}: not an episodes file (.jsonl); pass a g1_eval output folder or its episodes.jsonl")
+    rows = read_episodes(p)
+    if not rows:
+        raise ValueError(f"{p}: no episodes; run the evaluation first (python -m gmloco.eval.g1.cli)")
+    return rows

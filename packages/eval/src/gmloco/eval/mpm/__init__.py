@@ -3,21 +3,15 @@
 
 from gmloco.eval.mpm.bed import SandBedCfg, bed_particle_positions, emit_sand_bed
 from gmloco.eval.mpm.box_scene import MpmBoxScene, MpmBoxSceneCfg, MpmSolverCfg
-from gmloco.eval.mpm.g1_scene import G1MpmScene, G1MpmSceneCfg, MjlabOnnxPolicy, PolicySpec, SoleCfg
 from gmloco.eval.mpm.materials import GranularMaterial, MpmMaterialCfg, apply_mpm_material, mpm_material
 
 __all__ = [
-    "G1MpmScene",
-    "G1MpmSceneCfg",
     "GranularMaterial",
-    "MjlabOnnxPolicy",
     "MpmBoxScene",
     "MpmBoxSceneCfg",
     "MpmMaterialCfg",
     "MpmSolverCfg",
-    "PolicySpec",
     "SandBedCfg",
-    "SoleCfg",
     "apply_mpm_material",
     "bed_particle_positions",
     "emit_sand_bed",

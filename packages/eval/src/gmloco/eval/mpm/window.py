@@ -51,7 +51,7 @@ def window_grid(nx: int, ny: int) -> int:
 def reach_within_window(cfg: SandWindowCfg, reach: tuple[float, float, float], margin: float = 0.0) -> bool:
     """Whether the soles' reach lies inside a moving window whose heading lags the robot's by up to ``turn_step``.
 
-    ``reach``: (behind, ahead, beside) the pelvis along its heading [m] (``g1_scene.sole_reach``); the reach box
+    ``reach``: (behind, ahead, beside) the pelvis along its heading [m] (``g1.soles.sole_reach``); the reach box
     [-behind, ahead] x [-beside, beside] is turned by the worst lag (0 for a window that does not turn) about the
     pelvis and must lie within the rectangle ``length x width`` centred ``lead`` ahead of it, less ``margin`` [m]
     (e.g. half a column for the window's whole-column steps).

@@ -91,6 +91,7 @@ def combine(
         ValueError: Two runs differ in their MPM setting (and ``allow_mixed`` is False), one label names runs of
             different policies, or a run holds no episodes.
     """
+    from gmloco.eval.metrics.episodes import load_episodes
     from gmloco.eval.report.tables_mpm import (
         ABLATION_COLUMNS,
         TERRAIN_COLUMNS,
@@ -103,7 +104,6 @@ def combine(
         table_transition,
         write_table,
     )
-    from gmloco.eval.studies.convergence import load_episodes
 
     grouped: dict[str, list[Path]] = {}
     for label, d in runs:

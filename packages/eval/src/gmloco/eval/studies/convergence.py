@@ -38,7 +38,9 @@ from typing import Any, Literal
 
 import numpy as np
 
-__all__ = ["ConvergenceCfg", "Verdict", "compare_runs", "incomplete_runs", "load_episodes", "main"]
+from gmloco.eval.metrics.episodes import load_episodes
+
+__all__ = ["ConvergenceCfg", "Verdict", "compare_runs", "incomplete_runs", "main"]
 
 Decision = Literal["accepted", "rejected", "undecided"]
 
@@ -89,22 +91,6 @@ class Verdict:
     """Median heading error (the paper's yaw tracking error), candidate and reference [deg]."""
     heading_error_p: float = 1.0
     """Two-sided Mann-Whitney p-value of the heading errors (1.0 when a run does not record them)."""
-
-
-def load_episodes(path: str | Path) -> list[dict[str, Any]]:
-    """Episode rows of an evaluation run folder or of an ``episodes.jsonl`` file."""
-    p = Path(path)
-    p = p / "episodes.jsonl" if p.is_dir() else p
-    if not p.is_file():
-        raise FileNotFoundError(f"{path}: no episodes.jsonl here; pass a g1_eval output folder or its episodes.jsonl")
-    if p.suffix != ".jsonl":
-        raise ValueError(f"{path}: not an episodes file (.jsonl); pass a g1_eval output folder or its episodes.jsonl")
-    from gmloco.eval.g1.run import read_episodes
-
-    rows = read_episodes(p)
-    if not rows:
-        raise ValueError(f"{p}: no episodes; run the evaluation first (python -m gmloco.eval.g1.cli)")
-    return rows
 
 
 def _episodes_wanted(cfg: dict[str, Any]) -> int | str:

@@ -29,7 +29,7 @@ from pathlib import Path
 from typing import Any
 
 from gmloco.eval.g1.queue import share_row
-from gmloco.eval.g1.run import read_episodes
+from gmloco.eval.metrics.episodes import read_episodes
 
 ROW_ROBOT_FRAMES = 100 * 10.0 / 0.005
 """Robot-frames of a row of 100 ten-second walking episodes at 5 ms frames."""

@@ -33,10 +33,9 @@ from typing import Any
 
 from gmloco.eval.g1.cli import cli_args
 from gmloco.eval.g1.config import G1EvalCfg, episode_specs
-from gmloco.eval.g1.run import read_episodes
 from gmloco.eval.g1.score import reach_fits
 from gmloco.eval.g1.window_report import WINDOW_TURN_SHARE, covering_window, reach_quantile
-from gmloco.eval.metrics.episodes import FALL_EXIT_S, exit_in_fall
+from gmloco.eval.metrics.episodes import FALL_EXIT_S, exit_in_fall, read_episodes
 from gmloco.eval.metrics.locomotion import FailureCfg
 from gmloco.eval.mpm.box_scene import MpmSolverCfg
 from gmloco.eval.mpm.window import SandWindowCfg

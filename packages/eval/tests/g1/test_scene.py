@@ -8,15 +8,10 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+from gmloco.eval.g1.policy import MjlabOnnxPolicy
+from gmloco.eval.g1.scene import G1MpmScene, G1MpmSceneCfg
+from gmloco.eval.g1.soles import needs_sand, sole_reach, soles_outside
 from gmloco.eval.mpm.box_scene import MpmSolverCfg, frame_dt_problem
-from gmloco.eval.mpm.g1_scene import (
-    G1MpmScene,
-    G1MpmSceneCfg,
-    MjlabOnnxPolicy,
-    needs_sand,
-    sole_reach,
-    soles_outside,
-)
 from gmloco.eval.mpm.window import SandWindowCfg
 
 POLICY = Path(__file__).resolve().parents[4] / "artifacts" / "ppo_rft3d" / "policy.onnx"
