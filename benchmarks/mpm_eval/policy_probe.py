@@ -24,7 +24,8 @@ from typing import Any
 import numpy as np
 
 from gmloco.eval.g1.policy import StudentOnnxPolicy, load_policy
-from gmloco.eval.g1.scene import G1MpmScene, G1MpmSceneCfg
+from gmloco.eval.g1.scene import G1MpmScene
+from gmloco.eval.g1.scene_cfg import G1MpmSceneCfg
 from gmloco.eval.g1.soles import SoleCfg
 from gmloco.eval.mpm.box_scene import MpmSolverCfg, frame_dt_problem
 from gmloco.eval.mpm.window import SandWindowCfg

@@ -117,7 +117,7 @@ def _key(c: dict[str, Any]) -> str:
 
 def _scene_cfg(case: dict[str, Any], args: argparse.Namespace) -> Any:
     """Scene of one case: moving window (window, multi, stand) or a static bed over a 2.5 m/s x 10 s course."""
-    from gmloco.eval.g1.scene import G1MpmSceneCfg
+    from gmloco.eval.g1.scene_cfg import G1MpmSceneCfg
     from gmloco.eval.mpm.box_scene import MpmSolverCfg
     from gmloco.eval.mpm.window import SandWindowCfg
     from gmloco.eval.mpm.window_terrain import terrain_cfg

@@ -35,7 +35,8 @@ def parse(text: str) -> dict:
 def run(solver: str, args: argparse.Namespace) -> None:
     """Walk ``args.frames`` frames with one rheology solver; append one line per frame to ``args.out``."""
     from gmloco.eval.g1.policy import load_policy
-    from gmloco.eval.g1.scene import G1MpmScene, G1MpmSceneCfg
+    from gmloco.eval.g1.scene import G1MpmScene
+    from gmloco.eval.g1.scene_cfg import G1MpmSceneCfg
     from gmloco.eval.mpm.box_scene import MpmSolverCfg
     from gmloco.eval.mpm.window import SandWindowCfg
     from gmloco.eval.mpm.window_terrain import terrain_cfg

@@ -9,7 +9,8 @@ import numpy as np
 import pytest
 
 from gmloco.eval.g1.policy import MjlabOnnxPolicy
-from gmloco.eval.g1.scene import G1MpmScene, G1MpmSceneCfg
+from gmloco.eval.g1.scene import G1MpmScene
+from gmloco.eval.g1.scene_cfg import G1MpmSceneCfg
 from gmloco.eval.g1.soles import needs_sand, sole_reach, soles_outside
 from gmloco.eval.mpm.box_scene import MpmSolverCfg, frame_dt_problem
 from gmloco.eval.mpm.window import SandWindowCfg

@@ -37,7 +37,8 @@ def build_cell_scene(specs: list[EpisodeSpec], cfg: G1EvalCfg, policy: Any) -> t
     One lane per robot, each commanded as its episode; the active-cell capacity is sized from the windows
     (``cell_capacity_factor``); ``policy`` is reloaded for the lane count if it was built for another.
     """
-    from gmloco.eval.g1.scene import G1MpmScene, G1MpmSceneCfg
+    from gmloco.eval.g1.scene import G1MpmScene
+    from gmloco.eval.g1.scene_cfg import G1MpmSceneCfg
 
     n = min(cfg.robots_per_batch, len(specs))
     terrain, window, lane, per_lane = cell_sand(specs, cfg)
@@ -189,7 +190,7 @@ def _lane_log(
     scene: Any, r: int, a: int, b: int, spec: EpisodeSpec, terrain: Any, build_s: float, n: int
 ) -> dict[str, Any]:
     """One episode's log: lane ``r``'s policy-rate samples ``a:b`` (``score_episode``'s input)."""
-    from gmloco.eval.g1.scene import LOG_FIELDS
+    from gmloco.eval.g1.scene_cfg import LOG_FIELDS
     from gmloco.eval.mpm.window_terrain import terrain_surface_height
 
     arr = {name: np.asarray(getattr(scene, name)[a:b])[:, r] for name in LOG_FIELDS}
