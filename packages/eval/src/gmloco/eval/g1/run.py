@@ -35,6 +35,12 @@ Outputs under ``out_dir``: ``episodes.jsonl`` (one line per finished episode; th
 ``summary.json`` (metrics per group, throughput, config), the paper-shaped tables (``tables_mpm``), figures
 (``figures_mpm``) and ``recordings/<terrain>__<scenario>__v<speed>.mcap`` (the best walk of every group: a success
 if any, else the longest time alive; ``.json`` beside it names the episode).
+
+Where the parts live: the config and episodes in :mod:`gmloco.eval.g1.config`, a cell's sand in
+:mod:`~gmloco.eval.g1.lanes`, the episode loop in :mod:`~gmloco.eval.g1.cell`, the time box around it in
+:mod:`~gmloco.eval.g1.timebox` (on the GPU cost model of :mod:`~gmloco.eval.g1.cost`), the metrics of one episode
+in :mod:`~gmloco.eval.g1.score`, the window report in :mod:`~gmloco.eval.g1.window_report`, and reading and
+summarising ``episodes.jsonl`` in :mod:`gmloco.eval.metrics.episodes`; this module runs them and writes the outputs.
 """
 
 from __future__ import annotations
