@@ -15,7 +15,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from gmloco.deploy.logs.g1 import G1_FEET, G1_JOINT_NAMES, joint_index
+from gmloco.deploy.g1 import G1_FEET, G1_JOINT_NAMES, joint_index
 from gmloco.deploy.logs.rotations import quat_to_rpy
 
 __all__ = ["ScriptedStepping", "ScriptedSteppingCfg", "g1_knees_bent_pose"]
