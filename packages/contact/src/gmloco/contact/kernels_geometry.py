@@ -1,16 +1,20 @@
 # SPDX-License-Identifier: Apache-2.0
-"""Warp kernels shared by all models: foot kinematics, terrain queries, wrench reduction, material scatter."""
+"""Warp kernels shared by all models: foot kinematics, terrain queries, wrench reduction, material scatter and eta."""
 
 from __future__ import annotations
 
+import math
 from typing import Any
 
 import warp as wp
+
+from gmloco.contact.materials import DR_RANGES_PAPER, GRAVITY, xi_max, xi_n
 
 __all__ = [
     "TerrainData",
     "eval_foot_wrench",
     "eval_foot_wrench_tiled",
+    "eval_material_eta",
     "eval_scatter_values",
     "foot_inputs_finite",
     "foot_partial_wrench",
@@ -272,4 +276,43 @@ def eval_scatter_values(ids: wp.array, values: wp.array, values_out: wp.array) -
     """Launch :func:`scatter_values_kernel` (in-place update of a per-world parameter array)."""
     wp.launch(
         scatter_values_kernel, dim=ids.shape[0], inputs=[ids, values], outputs=[values_out], device=values_out.device
+    )
+
+
+@wp.kernel
+def material_eta_kernel(
+    # Model:
+    rho_c: wp.array[float],
+    mu_int: wp.array[float],
+    gravity: float,
+    xi_max: float,
+    log_xi_min: float,
+    log_xi_max: float,
+    # Data in:
+    ids_in: wp.array[int],
+    # Data out:
+    eta_out: wp.array[float],
+    eta_log_out: wp.array[float],
+) -> None:
+    """Write eta = xi / xi_max and eta_log = (ln xi - ln xi_min) / (ln xi_max - ln xi_min) of world ids[i].
+
+    xi = xi_n(rho_c, mu_int) of the world's current material (gmloco.contact.materials.eta, both scales).
+    """
+    i = wp.tid()
+    w = ids_in[i]
+    xi = media_scaling(rho_c[w], mu_int[w], gravity)
+    eta_out[w] = xi / xi_max
+    eta_log_out[w] = (wp.log(xi) - log_xi_min) / (log_xi_max - log_xi_min)
+
+
+def eval_material_eta(model: Any, ids: wp.array, eta_out: wp.array, eta_log_out: wp.array) -> None:
+    """Launch :func:`material_eta_kernel` over the worlds ``ids`` (after their rho_c / mu_int were written)."""
+    dr = DR_RANGES_PAPER  # the range that defines eta (gmloco.contact.materials.eta)
+    lo, hi = float(xi_n(dr.rho_c[0], dr.mu_int[0])), xi_max(dr)
+    wp.launch(
+        material_eta_kernel,
+        dim=ids.shape[0],
+        inputs=[model.rho_c, model.mu_int, GRAVITY, hi, math.log(lo), math.log(hi), ids],
+        outputs=[eta_out, eta_log_out],
+        device=model.device,
     )
