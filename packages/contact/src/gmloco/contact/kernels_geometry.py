@@ -12,6 +12,7 @@ from gmloco.contact.materials import DR_RANGES_PAPER, GRAVITY, xi_max, xi_n
 
 __all__ = [
     "TerrainData",
+    "element_kinematics",
     "eval_foot_wrench",
     "eval_foot_wrench_tiled",
     "eval_material_eta",
@@ -111,6 +112,26 @@ def foot_point_kinematics(
     """Return rows (p_w, n_w, v_w): world position, outward normal, and velocity v + w x (R p_b) of a point."""
     r = rot * point_b
     return wp.matrix_from_rows(pos + r, rot * normal_b, lin_vel + wp.cross(ang_vel, r))
+
+
+@wp.func
+def element_kinematics(  # noqa: ANN201 (returns the tuple wp.mat33, float; Warp infers it)
+    terrain: TerrainData,
+    pos: wp.vec3,
+    rot: wp.mat33,
+    lin_vel: wp.vec3,
+    ang_vel: wp.vec3,
+    point_b: wp.vec3,
+    normal_b: wp.vec3,
+):
+    """Return a foot element's kinematics rows (x, n, v) and its depth below the local free surface [m].
+
+    The opening block of every element kernel (cone, 2D-RFT, 3D-RFT): :func:`foot_point_kinematics`, then
+    depth = z_s(x, y) - z (positive below the surface, :func:`terrain_height`).
+    """
+    kin = foot_point_kinematics(pos, rot, lin_vel, ang_vel, point_b, normal_b)
+    x = kin[0]
+    return kin, terrain_height(terrain, x[0], x[1]) - x[2]
 
 
 @wp.func
