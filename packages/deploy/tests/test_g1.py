@@ -15,6 +15,7 @@ from gmloco.deploy.g1 import (
     G1_EFFORT_LIMIT,
     G1_FOOT_BODIES,
     G1_JOINT_NAMES,
+    G1_KNEES_BENT_POSE,
     G1_STIFFNESS,
     G1_VELOCITY_LIMIT,
     g1_actuator,
@@ -82,3 +83,16 @@ def test_joint_order_and_feet_match_the_mjcf() -> None:
     assert tuple(model.joint(i).name for i in range(1, model.njnt)) == G1_JOINT_NAMES
     for body in G1_FOOT_BODIES:
         assert mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_BODY, body) >= 0, body
+
+
+def test_knees_bent_pose_matches_mjlab() -> None:
+    """The default standing pose equals mjlab's ``KNEES_BENT_KEYFRAME`` joint by joint (zero where unlisted)."""
+    pytest.importorskip("mjlab")
+    from mjlab.asset_zoo.robots.unitree_g1.g1_constants import KNEES_BENT_KEYFRAME
+
+    def angle(name: str) -> float:
+        """Return the keyframe angle of a joint (its patterns are disjoint)."""
+        hits = [v for k, v in (KNEES_BENT_KEYFRAME.joint_pos or {}).items() if re.fullmatch(k, name)]
+        return float(hits[0]) if hits else 0.0
+
+    assert [angle(n) for n in G1_JOINT_NAMES] == list(G1_KNEES_BENT_POSE)

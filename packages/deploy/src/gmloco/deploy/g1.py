@@ -20,6 +20,7 @@ __all__ = [
     "G1_FEET",
     "G1_FOOT_BODIES",
     "G1_JOINT_NAMES",
+    "G1_KNEES_BENT_POSE",
     "G1_LEG_JOINTS",
     "G1_NUM_JOINTS",
     "G1_NUM_MOTOR_SLOTS",
@@ -172,3 +173,18 @@ G1_STIFFNESS: tuple[float, ...] = tuple(g1_actuator(n).stiffness for n in G1_JOI
 """Nominal PD stiffness kp per joint [N m/rad] (mjlab's position actuators), canonical order, length 29."""
 G1_DAMPING: tuple[float, ...] = tuple(g1_actuator(n).damping for n in G1_JOINT_NAMES)
 """Nominal PD damping kd per joint [N m s/rad] (mjlab's position actuators), canonical order, length 29."""
+
+
+def _knees_bent_angle(joint: str) -> float:
+    """Joint angle of mjlab's ``KNEES_BENT_KEYFRAME`` [rad] (its arms held away from the body by the roll)."""
+    side, _, part = joint.partition("_")
+    if side not in ("left", "right"):
+        return 0.0
+    if part == "shoulder_roll_joint":
+        return 0.2 if side == "left" else -0.2
+    pose = {"hip_pitch_joint": -0.312, "knee_joint": 0.669, "ankle_pitch_joint": -0.363, "elbow_joint": 0.6}
+    return pose.get(part, 0.2 if part == "shoulder_pitch_joint" else 0.0)
+
+
+G1_KNEES_BENT_POSE: tuple[float, ...] = tuple(_knees_bent_angle(n) for n in G1_JOINT_NAMES)
+"""mjlab's knees-bent standing pose (``KNEES_BENT_KEYFRAME``, the G1 tasks' default pose) [rad], length 29."""
