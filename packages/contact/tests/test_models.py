@@ -349,7 +349,8 @@ def test_set_materials_keeps_eta_and_eta_log_in_step(device: str) -> None:
     for name in ("rho_c", "mu_int", "mu_surf", "eta", "eta_log"):
         np.testing.assert_array_equal(getattr(dev, name).numpy(), getattr(host, name).numpy(), err_msg=name)
     host.set_materials(mu_int=[0.3], env_ids=[4])  # rho_c of world 4 stays 500
-    np.testing.assert_allclose(host.eta.numpy()[ids], eta(rho, [1.0, 0.3, 0.6]), rtol=1e-5)
-    np.testing.assert_allclose(host.eta_log.numpy()[ids], eta(rho, [1.0, 0.3, 0.6], "log"), rtol=1e-5)
+    mu_now = np.array([1.0, 0.3, 0.6])
+    np.testing.assert_allclose(host.eta.numpy()[ids], eta(rho, mu_now), rtol=1e-5)
+    np.testing.assert_allclose(host.eta_log.numpy()[ids], eta(rho, mu_now, "log"), rtol=1e-5)
     with pytest.raises(ValueError, match="unknown parameters"):
         dev.set_materials(sigma_flat=as_t(rho), env_ids=torch.as_tensor(ids, device=as_t(rho).device))
