@@ -56,6 +56,22 @@ def _analyze_logs_problem(section: DictConfig) -> tuple[str, str] | None:
     return None
 
 
+def _calibrated_problem(section: DictConfig) -> tuple[str, str] | None:
+    """``contact_model=rft3d_calibrated`` needs the fitted extensions an accepted calibration fit writes."""
+    if str(getattr(section.contact_model, "value", section.contact_model)) != "rft3d_calibrated":
+        return None
+    from gmloco.train.config import GranularTaskCfg
+
+    path = Path(GranularTaskCfg().rft_extensions_file)
+    if path.is_file():
+        return None
+    return "train_teacher.contact_model", (
+        f"bad value for 'train_teacher.contact_model': rft3d_calibrated reads the fitted terms from '{path}', which "
+        "does not exist; make the MPM calibration dataset and fit it first (docs/sand_calibration.md: python -m "
+        "gmloco.eval.calibration.fit_cli ... --write-default), or train with contact_model=rft3d."
+    )
+
+
 def _jump_problem(section: DictConfig) -> tuple[str, str] | None:
     """The jump imitation task trains vanilla PPO only."""
     if section.get("jump") is not None and str(section.algorithm.value) != "ppo":
@@ -69,6 +85,8 @@ def _jump_problem(section: DictConfig) -> tuple[str, str] | None:
 def input_problem(cfg: DictConfig) -> tuple[str, str] | None:
     """First problem with the inputs of the selected stages, as ``(key, message)``; else None."""
     if "train_teacher" in cfg.stages and (found := _jump_problem(cfg.train_teacher)) is not None:
+        return found
+    if "train_teacher" in cfg.stages and (found := _calibrated_problem(cfg.train_teacher)) is not None:
         return found
     if "mismatch" in cfg.stages and (found := _mismatch_problem(cfg.mismatch)) is not None:
         return found

@@ -22,6 +22,7 @@ from gmloco.contact import (
     ContactHeuristicRFTCfg,
     ContactRFT3DCfg,
     ContactRigidCfg,
+    eta,
     g1_foot_box_cfg,
     make_contact_model,
     terrain_sinusoid,
@@ -329,3 +330,27 @@ def test_rigid_model_writes_zero(device: str) -> None:
     assert make_contact_model(ContactConeSingleCfg(at_rest="none"), 1, 1, device).is_stateful
     assert not make_contact_model(ContactRFT3DCfg(at_rest="none"), 1, 1, device).is_stateful
     np.testing.assert_array_equal(run(model, random_feet(1)), 0.0)
+
+
+def test_set_materials_keeps_eta_and_eta_log_in_step(device: str) -> None:
+    """Host and device (torch) inputs give the same arrays; eta and eta_log follow a change of mu_int alone.
+
+    eta = xi / xi_max and eta_log = ln(xi / xi_min) / ln(xi_max / xi_min) (materials.eta), evaluated in float32
+    on the device: rtol 1e-5 covers a few float32 roundings of xi ~ 1e4-1e7 N/m^3 and of its logarithm.
+    """
+    torch = pytest.importorskip("torch")
+    rho, mu, ms = np.array([3000.0, 500.0, 1800.0]), np.array([1.0, 0.1, 0.6]), np.array([0.5, 0.2, 0.9])
+    ids = np.array([1, 4, 2])
+    host = make_contact_model(ContactRFT3DCfg(), W, F, device)
+    host.set_materials(rho, mu, ms, env_ids=ids)
+    dev = make_contact_model(ContactRFT3DCfg(), W, F, device)
+    as_t = lambda a: torch.as_tensor(a, dtype=torch.float32, device=wp.device_to_torch(device))  # noqa: E731
+    dev.set_materials(as_t(rho), as_t(mu), as_t(ms), env_ids=torch.as_tensor(ids, device=as_t(rho).device))
+    for name in ("rho_c", "mu_int", "mu_surf", "eta", "eta_log"):
+        np.testing.assert_array_equal(getattr(dev, name).numpy(), getattr(host, name).numpy(), err_msg=name)
+    host.set_materials(mu_int=[0.3], env_ids=[4])  # rho_c of world 4 stays 500
+    mu_now = np.array([1.0, 0.3, 0.6])
+    np.testing.assert_allclose(host.eta.numpy()[ids], eta(rho, mu_now), rtol=1e-5)
+    np.testing.assert_allclose(host.eta_log.numpy()[ids], eta(rho, mu_now, "log"), rtol=1e-5)
+    with pytest.raises(ValueError, match="unknown parameters"):
+        dev.set_materials(sigma_flat=as_t(rho), env_ids=torch.as_tensor(ids, device=as_t(rho).device))

@@ -15,7 +15,7 @@ from pathlib import Path
 import mujoco
 import numpy as np
 
-from gmloco.deploy.logs.g1 import G1_FEET, G1_JOINT_NAMES, G1_LEG_JOINTS
+from gmloco.deploy.g1 import G1_FEET, G1_JOINT_NAMES, G1_LEG_JOINTS
 
 OUT = Path(__file__).resolve().parents[1] / "src/gmloco/deploy/logs/g1_model.json"
 

@@ -16,9 +16,10 @@ import pytest
 import torch
 import warp as wp
 
+from gmloco.deploy.g1 import G1_FOOT_BODIES
 from gmloco.train.contact_coupling import ContactCoupling
 
-FEET = ("left_ankle_roll_link", "right_ankle_roll_link")
+FEET = G1_FOOT_BODIES
 DT = 0.005
 """Physics step [s]."""
 

@@ -12,7 +12,7 @@ import pytest
 from onnx import TensorProto, helper
 
 from gmloco.deploy.export import METADATA_KEY, JointSpec, PolicyMetadata, read_policy_metadata
-from gmloco.deploy.logs.g1 import G1_JOINT_NAMES
+from gmloco.deploy.g1 import G1_JOINT_NAMES
 from gmloco.train.tasks.g1_granular import g1_granular_task
 from gmloco.train.tasks.g1_granular.policy_metadata import granular_policy_metadata, joint_spec
 from gmloco.train.tasks.g1_granular.upgrade_metadata import upgrade_policy_dir

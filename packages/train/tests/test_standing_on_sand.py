@@ -26,10 +26,11 @@ import warp as wp
 
 from gmloco.contact import MATERIAL_PRESETS, ContactRFT3DCfg, g1_foot_box_cfg, g1_foot_collider, make_contact_model
 from gmloco.contact.reference import rft3d_generic
+from gmloco.deploy.g1 import G1_FOOT_BODIES
 
 DT = 0.005
 """Physics step [s] (GM-Loco: 200 Hz)."""
-FEET = ("left_ankle_roll_link", "right_ankle_roll_link")
+FEET = G1_FOOT_BODIES
 # mjlab 1.6 g1_constants: (joint regex, armature [kg m^2], kp [N m/rad], kd [N m s/rad], effort limit [N m]);
 # kp = armature (2 pi 10 Hz)^2, kd = 2 * 2.0 * armature * (2 pi 10 Hz). Copied to avoid importing mjlab (~8 s).
 G1_GAINS = (

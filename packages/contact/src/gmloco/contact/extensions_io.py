@@ -35,7 +35,7 @@ def load_rft_extensions(path: str | Path) -> RftExtensionsCfg:
     path = Path(path)
     if not path.is_file():
         raise FileNotFoundError(
-            f"{path}: no fitted RFT extensions; fit them with python -m gmloco.eval.calibration.fit --write-default"
+            f"{path}: no fitted RFT extensions; fit them with python -m gmloco.eval.calibration.fit_cli --write-default"
         )
     data = json.loads(path.read_text())["extensions"]
     known = {f.name for f in fields(RftExtensionsCfg)}

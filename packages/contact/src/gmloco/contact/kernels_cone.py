@@ -9,9 +9,8 @@ import warp as wp
 
 from gmloco.contact.kernels_geometry import (
     TerrainData,
+    element_kinematics,
     foot_inputs_finite,
-    foot_point_kinematics,
-    terrain_height,
     write_element,
 )
 from gmloco.contact.kernels_rft2d import coulomb_tangential
@@ -88,10 +87,8 @@ def cone_point_force_kernel(
         wp.atomic_add(nan_count_out, 0, 1)
         write_element(wp.vec3(0.0), 0.0, wp.vec3(0.0), point_force_out, point_depth_out, point_vel_out, w, f, p)
         return
-    kin = foot_point_kinematics(pos, rot, lin_vel, ang_vel, points_b[p], wp.vec3(0.0, 0.0, -1.0))
-    x = kin[0]
+    kin, z = element_kinematics(terrain, pos, rot, lin_vel, ang_vel, points_b[p], wp.vec3(0.0, 0.0, -1.0))
     v = kin[2]
-    z = terrain_height(terrain, x[0], x[1]) - x[2]
     z_dot = -v[2]
     z_max = state_in.depth_max[w, f, p]
     r_h = radii[p]

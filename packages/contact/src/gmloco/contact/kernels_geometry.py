@@ -1,16 +1,21 @@
 # SPDX-License-Identifier: Apache-2.0
-"""Warp kernels shared by all models: foot kinematics, terrain queries, wrench reduction, material scatter."""
+"""Warp kernels shared by all models: foot kinematics, terrain queries, wrench reduction, material scatter and eta."""
 
 from __future__ import annotations
 
+import math
 from typing import Any
 
 import warp as wp
 
+from gmloco.contact.materials import DR_RANGES_PAPER, GRAVITY, xi_max, xi_n
+
 __all__ = [
     "TerrainData",
+    "element_kinematics",
     "eval_foot_wrench",
     "eval_foot_wrench_tiled",
+    "eval_material_eta",
     "eval_scatter_values",
     "foot_inputs_finite",
     "foot_partial_wrench",
@@ -107,6 +112,26 @@ def foot_point_kinematics(
     """Return rows (p_w, n_w, v_w): world position, outward normal, and velocity v + w x (R p_b) of a point."""
     r = rot * point_b
     return wp.matrix_from_rows(pos + r, rot * normal_b, lin_vel + wp.cross(ang_vel, r))
+
+
+@wp.func
+def element_kinematics(  # noqa: ANN201 (returns the tuple wp.mat33, float; Warp infers it)
+    terrain: TerrainData,
+    pos: wp.vec3,
+    rot: wp.mat33,
+    lin_vel: wp.vec3,
+    ang_vel: wp.vec3,
+    point_b: wp.vec3,
+    normal_b: wp.vec3,
+):
+    """Return a foot element's kinematics rows (x, n, v) and its depth below the local free surface [m].
+
+    The opening block of every element kernel (cone, 2D-RFT, 3D-RFT): :func:`foot_point_kinematics`, then
+    depth = z_s(x, y) - z (positive below the surface, :func:`terrain_height`).
+    """
+    kin = foot_point_kinematics(pos, rot, lin_vel, ang_vel, point_b, normal_b)
+    x = kin[0]
+    return kin, terrain_height(terrain, x[0], x[1]) - x[2]
 
 
 @wp.func
@@ -272,4 +297,43 @@ def eval_scatter_values(ids: wp.array, values: wp.array, values_out: wp.array) -
     """Launch :func:`scatter_values_kernel` (in-place update of a per-world parameter array)."""
     wp.launch(
         scatter_values_kernel, dim=ids.shape[0], inputs=[ids, values], outputs=[values_out], device=values_out.device
+    )
+
+
+@wp.kernel
+def material_eta_kernel(
+    # Model:
+    rho_c: wp.array[float],
+    mu_int: wp.array[float],
+    gravity: float,
+    xi_max: float,
+    log_xi_min: float,
+    log_xi_max: float,
+    # Data in:
+    ids_in: wp.array[int],
+    # Data out:
+    eta_out: wp.array[float],
+    eta_log_out: wp.array[float],
+) -> None:
+    """Write eta = xi / xi_max and eta_log = (ln xi - ln xi_min) / (ln xi_max - ln xi_min) of world ids[i].
+
+    xi = xi_n(rho_c, mu_int) of the world's current material (gmloco.contact.materials.eta, both scales).
+    """
+    i = wp.tid()
+    w = ids_in[i]
+    xi = media_scaling(rho_c[w], mu_int[w], gravity)
+    eta_out[w] = xi / xi_max
+    eta_log_out[w] = (wp.log(xi) - log_xi_min) / (log_xi_max - log_xi_min)
+
+
+def eval_material_eta(model: Any, ids: wp.array, eta_out: wp.array, eta_log_out: wp.array) -> None:
+    """Launch :func:`material_eta_kernel` over the worlds ``ids`` (after their rho_c / mu_int were written)."""
+    dr = DR_RANGES_PAPER  # the range that defines eta (gmloco.contact.materials.eta)
+    lo, hi = float(xi_n(dr.rho_c[0], dr.mu_int[0])), xi_max(dr)
+    wp.launch(
+        material_eta_kernel,
+        dim=ids.shape[0],
+        inputs=[model.rho_c, model.mu_int, GRAVITY, hi, math.log(lo), math.log(hi), ids],
+        outputs=[eta_out, eta_log_out],
+        device=model.device,
     )

@@ -9,11 +9,10 @@ import warp as wp
 
 from gmloco.contact.kernels_geometry import (
     TerrainData,
+    element_kinematics,
     foot_inputs_finite,
-    foot_point_kinematics,
     media_scaling,
     point_material,
-    terrain_height,
     write_element,
 )
 from gmloco.contact.kernels_rft3d import G_HAT, unit_velocity
@@ -116,11 +115,10 @@ def heuristic_point_force_kernel(
         wp.atomic_add(nan_count_out, 0, 1)
         write_element(wp.vec3(0.0), 0.0, wp.vec3(0.0), point_force_out, point_depth_out, point_vel_out, w, f, p)
         return
-    kin = foot_point_kinematics(pos, rot, lin_vel, ang_vel, points_b[p], normals_b[p])
+    kin, depth = element_kinematics(terrain, pos, rot, lin_vel, ang_vel, points_b[p], normals_b[p])
     x = kin[0]
     n = kin[1]
     v = kin[2]
-    depth = terrain_height(terrain, x[0], x[1]) - x[2]
     mat = point_material(terrain, rho_c, mu_int, mu_surf, w, x[0])
     scale = 1.0e6  # N/cm^3 -> N/m^3 for the dimensional poppy-seed sets
     if dimensional == 0:

@@ -9,12 +9,12 @@ import warp as wp
 
 from gmloco.contact.kernels_geometry import (
     TerrainData,
+    element_kinematics,
     foot_inputs_finite,
     foot_point_kinematics,
     foot_wrench_block_sum,
     media_scaling,
     point_material,
-    terrain_height,
     tile_block_dim,
     write_element,
 )
@@ -303,9 +303,8 @@ def rft3d_element(  # noqa: ANN202 (returns the tuple wp.vec3, float, wp.mat33; 
     surface, and for an :func:`element_active` element the local material and :func:`rft3d_element_force`
     (else force 0). Reads the old state only.
     """
-    kin = foot_point_kinematics(pos, rot, lin_vel, ang_vel, m.points_b[p], m.normals_b[p])
+    kin, depth = element_kinematics(m.terrain, pos, rot, lin_vel, ang_vel, m.points_b[p], m.normals_b[p])
     x = kin[0]
-    depth = terrain_height(m.terrain, x[0], x[1]) - x[2]
     force = wp.vec3(0.0)
     if element_active(depth, m.rest):
         mat = point_material(m.terrain, m.rho_c, m.mu_int, m.mu_surf, w, x[0])
@@ -327,9 +326,8 @@ def rft3d_element_ext(  # noqa: ANN202 (returns the tuple wp.vec3, float, wp.mat
     p: int,
 ):
     """Return :func:`rft3d_element` with the extension terms (:func:`rft3d_element_force_ext`)."""
-    kin = foot_point_kinematics(pos, rot, lin_vel, ang_vel, m.points_b[p], m.normals_b[p])
+    kin, depth = element_kinematics(m.terrain, pos, rot, lin_vel, ang_vel, m.points_b[p], m.normals_b[p])
     x = kin[0]
-    depth = terrain_height(m.terrain, x[0], x[1]) - x[2]
     force = wp.vec3(0.0)
     if element_active(depth, m.rest):
         mat = point_material(m.terrain, m.rho_c, m.mu_int, m.mu_surf, w, x[0])

@@ -14,6 +14,7 @@ from gmloco.contact.kernels_geometry import (
     TerrainData,
     eval_foot_wrench,
     eval_foot_wrench_tiled,
+    eval_material_eta,
     eval_scatter_values,
 )
 from gmloco.contact.kernels_state import (
@@ -67,6 +68,21 @@ def make_at_rest_params(cfg: Any) -> Any:  # an AtRestParams instance (Warp stru
     ext = getattr(cfg, "extensions", None)
     rest.footprint_radius = float(ext.footprint_radius) if ext is not None else 0.0
     return rest
+
+
+def _is_device_array(values: Any) -> bool:
+    """Whether ``values`` is a warp array or a torch tensor (written without a host round trip)."""
+    return isinstance(values, wp.array) or hasattr(values, "detach")
+
+
+def _as_warp(values: Any, dtype: type) -> wp.array:
+    """Return a warp array as is, or a torch tensor as a 1-D warp array of ``dtype`` (float32 / int32)."""
+    if isinstance(values, wp.array):
+        return values
+    import torch  # a tensor was passed, so torch is installed
+
+    tensor = values.detach().reshape(-1).to(torch.float32 if dtype is float else torch.int32).contiguous()
+    return wp.from_torch(tensor, dtype=wp.float32 if dtype is float else wp.int32)
 
 
 def _to_numpy(values: Any) -> np.ndarray:
@@ -176,14 +192,14 @@ class ContactModel:
             raise ValueError(f"env_ids must lie in [0, {self.num_worlds - 1}]")
         return wp.array(ids.astype(np.int32), dtype=int, device=self.device)
 
-    def _scatter(self, values: np.ndarray, ids: wp.array, out: wp.array) -> None:
-        """Copy ``values`` into ``out[ids]`` in place."""
-        eval_scatter_values(ids, wp.array(values, dtype=float, device=self.device), out)
-
     def set_materials(
         self, rho_c: Any = None, mu_int: Any = None, mu_surf: Any = None, env_ids: Any = None, **extra: Any
     ) -> None:
-        """Set per-world materials in place; None leaves a parameter unchanged.
+        """Set per-world materials in place and recompute eta / eta_log of those worlds; None leaves one unchanged.
+
+        The one writer of the per-world material arrays. Host values (numpy, lists, scalars) are range-checked;
+        torch tensors and warp arrays (all of them, ``env_ids`` too) stay on the device, unchecked and without a
+        host round trip (the caller draws them from checked ranges, as ``gmloco.train``'s ``MaterialWriter``).
 
         Args:
             rho_c: Critical density [kg/m^3], [num_worlds] or [len(env_ids)] (numpy, torch, warp or scalar).
@@ -197,19 +213,33 @@ class ContactModel:
         }
         if not given:
             return
+        on_device = all(_is_device_array(v) for v in given.values())
+        ids, arrays = self._device_inputs(env_ids, given) if on_device else self._host_inputs(env_ids, given)
+        for name, values in arrays.items():
+            eval_scatter_values(ids, values, getattr(self, name))
+        if "rho_c" in arrays or "mu_int" in arrays:
+            eval_material_eta(self, ids, self.eta, self.eta_log)
+
+    def _host_inputs(self, env_ids: Any, given: dict[str, Any]) -> tuple[wp.array, dict[str, wp.array]]:
+        """Range-check host values and upload them with their world ids."""
         count = len(np.atleast_1d(_to_numpy(next(iter(given.values())))))
         ids = self._world_ids(env_ids, count)
         arrays = {k: np.broadcast_to(np.atleast_1d(_to_numpy(v)), (count,)).copy() for k, v in given.items()}
         validate_material_arrays(arrays.get("rho_c"), arrays.get("mu_int"), arrays.get("mu_surf"))
         self._validate_extra(arrays)
-        for name, values in arrays.items():
-            self._scatter(values, ids, getattr(self, name))
-        if "rho_c" in arrays or "mu_int" in arrays:
-            ids_np = np.asarray(ids.numpy(), dtype=np.int64)
-            rho = arrays["rho_c"] if "rho_c" in arrays else self.rho_c.numpy()[ids_np].astype(np.float64)
-            mu = arrays["mu_int"] if "mu_int" in arrays else self.mu_int.numpy()[ids_np].astype(np.float64)
-            self._scatter(eta(rho, mu), ids, self.eta)
-            self._scatter(eta(rho, mu, "log"), ids, self.eta_log)
+        return ids, {k: wp.array(v, dtype=float, device=self.device) for k, v in arrays.items()}
+
+    def _device_inputs(self, env_ids: Any, given: dict[str, Any]) -> tuple[wp.array, dict[str, wp.array]]:
+        """Wrap device values and their world ids as warp arrays (zero-copy where already float32 / int32)."""
+        self._validate_extra({k: np.ones(1) for k in given})  # names only: the values stay on the device
+        arrays = {k: _as_warp(v, float) for k, v in given.items()}
+        count = next(iter(arrays.values())).shape[0]
+        ids = wp.array(np.arange(self.num_worlds, dtype=np.int32), device=self.device)
+        if env_ids is not None:
+            ids = _as_warp(env_ids, int)
+        if any(a.shape[0] != ids.shape[0] for a in arrays.values()) or count != ids.shape[0]:
+            raise ValueError(f"set_materials: got {count} values for {ids.shape[0]} worlds")
+        return ids, arrays
 
     def _validate_extra(self, arrays: dict[str, np.ndarray]) -> None:
         """Reject parameters this model does not have (subclasses add theirs)."""

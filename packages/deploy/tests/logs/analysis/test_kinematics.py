@@ -6,8 +6,8 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
+from gmloco.deploy.g1 import joint_index
 from gmloco.deploy.logs.analysis import G1LegKinematics, g1_model, sole_heights
-from gmloco.deploy.logs.g1 import joint_index
 
 
 def test_fk_matches_mujoco() -> None:

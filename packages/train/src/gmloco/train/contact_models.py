@@ -1,9 +1,8 @@
 # SPDX-License-Identifier: Apache-2.0
 """Adapter from :class:`GranularTaskCfg` to ``gmloco.contact`` (the only train module that imports it).
 
-Per-env materials are written straight into the model's per-world Warp arrays through zero-copy
-torch views (no host round trip on reset, which happens almost every step at 4,096 envs); eta uses
-the contact package's own ``xi_n`` / ``xi_max`` (plain arithmetic, so it runs on torch tensors).
+Per-env materials are drawn as torch tensors and handed to the model's ``set_materials``, which writes them and
+their eta / eta_log on the device (no host round trip on reset, which happens almost every step at 4,096 envs).
 """
 
 from __future__ import annotations
@@ -16,7 +15,7 @@ import torch
 import warp as wp
 
 import gmloco.contact as gc
-from gmloco.contact.materials import validate_material_arrays, xi_max, xi_n
+from gmloco.contact.materials import validate_material_arrays
 from gmloco.train.config import ContactModelName, GranularTaskCfg, MaterialRangeCfg, SandTerrainCfg
 
 __all__ = [
@@ -121,7 +120,7 @@ def extension_dr_columns(model: Any, ranges: dict[str, tuple[float, float]]) -> 
 
 
 class MaterialWriter:
-    """Draws per-env materials and writes them into a contact model's per-world arrays in place.
+    """Draws per-env materials and writes them into a contact model through its ``set_materials``.
 
     Args:
         model: A ``gmloco.contact.ContactModel``.
@@ -140,8 +139,7 @@ class MaterialWriter:
         self.extension_ranges = extension_dr_columns(model, extension_ranges or {})
         """Column of ``model.ext_values`` -> U[lo, hi] of the RFT extension terms drawn per env on reset."""
         self.device = device
-        self._xi_n: Any = xi_n  # plain arithmetic: evaluates on torch tensors too
-        self._xi_max = float(xi_max())
+        self.model = model
         self.preset = gc.MATERIAL_PRESETS[ranges.preset] if ranges.preset is not None else None
         lo_hi = lambda r: np.asarray(r, dtype=np.float64)  # noqa: E731
         validate_material_arrays(
@@ -151,7 +149,8 @@ class MaterialWriter:
         self.views = {n: wp.to_torch(getattr(model, n)) for n in names if hasattr(model, n)}
         if self.extension_ranges:
             self.views["ext_values"] = wp.to_torch(model.ext_values)  # [W, 7]
-        """Zero-copy torch views of the model's per-world parameter arrays, each [W]."""
+        """Zero-copy torch views of the model's per-world parameter arrays, each [W] (read here; written by
+        ``set_materials``, except the extension columns of ``ext_values``)."""
         self.pinned: dict[str, torch.Tensor] | None = None
         """Per-env (rho_c, mu_int, mu_surf) used instead of drawing, set by :meth:`pin`."""
         self.held_out = None
@@ -171,15 +170,19 @@ class MaterialWriter:
         }
 
     def draw(self, env_ids: torch.Tensor) -> None:
-        """Set (preset) or draw (uniform DR) the material of ``env_ids``."""
-        n, r, v = len(env_ids), self.ranges, self.views
+        """Set (pinned, preset) or draw (uniform DR) the material of ``env_ids`` and write it to the model.
+
+        Every material reaches the model through ``ContactModel.set_materials``, the one writer that keeps
+        ``eta`` and ``eta_log`` in step with ``(rho_c, mu_int)``.
+        """
+        n, r = len(env_ids), self.ranges
+        if n == 0:
+            return
         if self.pinned is not None:
-            for name, values in self.pinned.items():
-                v[name][env_ids] = values[env_ids]
+            material = {name: values[env_ids] for name, values in self.pinned.items()}
         elif self.preset is not None:
-            v["rho_c"][env_ids] = float(self.preset.rho_c)
-            v["mu_int"][env_ids] = float(self.preset.mu_int)
-            v["mu_surf"][env_ids] = float(self.preset.mu_surf)
+            names = ("rho_c", "mu_int", "mu_surf")
+            material = {k: torch.full((n,), float(getattr(self.preset, k)), device=self.device) for k in names}
         else:
             rho_c = self._uniform(r.packing, n) * self._uniform(r.bulk_density, n)
             mu_int = self._uniform(r.mu_int, n)
@@ -187,16 +190,13 @@ class MaterialWriter:
                 from gmloco.train.teacher_student.heldout import redraw_outside
 
                 mu_int = redraw_outside(self.held_out, rho_c, mu_int, r.mu_int)
-            v["rho_c"][env_ids] = rho_c
-            v["mu_int"][env_ids] = mu_int
-            v["mu_surf"][env_ids] = self._uniform(r.mu_surf, n)
+            material = {"rho_c": rho_c, "mu_int": mu_int, "mu_surf": self._uniform(r.mu_surf, n)}
         for name in ("sigma_flat", "sigma_cone"):
-            if name in v:
-                v[name][env_ids] = self._uniform(getattr(r, name), n)
+            if name in self.views:
+                material[name] = self._uniform(getattr(r, name), n)
+        self.model.set_materials(env_ids=env_ids, **material)
         for column, bounds in self.extension_ranges.items():
-            v["ext_values"][env_ids, column] = self._uniform(bounds, n)
-        # eta = xi_n(rho_c, mu_int) / xi_max, the paper's normalized stiffness (gmloco.contact.eta).
-        v["eta"][env_ids] = self._xi_n(v["rho_c"][env_ids], v["mu_int"][env_ids]) / self._xi_max
+            self.views["ext_values"][env_ids, column] = self._uniform(bounds, n)
 
     @property
     def eta(self) -> torch.Tensor:

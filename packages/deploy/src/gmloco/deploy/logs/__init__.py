@@ -1,6 +1,7 @@
 # SPDX-License-Identifier: Apache-2.0
 """G1 robot logs in MCAP: schema, writer, damage-tolerant reader, alignment and analyses (``gmloco-logs``)."""
 
+from gmloco.deploy.g1 import G1_FEET, G1_JOINT_NAMES, G1_NUM_JOINTS, joint_index
 from gmloco.deploy.logs.align import AlignCfg, AlignedLog, align, resample
 from gmloco.deploy.logs.errors import (
     JointOrderError,
@@ -10,7 +11,6 @@ from gmloco.deploy.logs.errors import (
     MissingTopicError,
     UnitsError,
 )
-from gmloco.deploy.logs.g1 import G1_FEET, G1_JOINT_NAMES, G1_NUM_JOINTS, joint_index
 from gmloco.deploy.logs.mcap_scan import DamageReport
 from gmloco.deploy.logs.metadata import RunMetadata, git_commit
 from gmloco.deploy.logs.reader import ChannelData, G1Log, ReadCfg, read_log

@@ -14,7 +14,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from gmloco.deploy.logs.g1 import G1_JOINT_NAMES, joint_index
+from gmloco.deploy.g1 import G1_JOINT_NAMES, joint_index
 from gmloco.deploy.logs.rotations import quat_normalize
 from gmloco.deploy.logs.schema import TOPIC_JOINT_STATES, signal_spec
 

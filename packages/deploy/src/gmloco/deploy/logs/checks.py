@@ -12,8 +12,8 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
+from gmloco.deploy.g1 import G1_JOINT_NAMES
 from gmloco.deploy.logs.errors import LogContractWarning
-from gmloco.deploy.logs.g1 import G1_JOINT_NAMES
 from gmloco.deploy.logs.schema import TOPIC_JOINT_STATES
 
 if TYPE_CHECKING:

@@ -9,8 +9,8 @@ from typing import Any
 
 import numpy as np
 
+from gmloco.deploy.g1 import G1_JOINT_NAMES, G1_NUM_JOINTS
 from gmloco.deploy.logs.errors import JointOrderError, LogFormatError
-from gmloco.deploy.logs.g1 import G1_JOINT_NAMES, G1_NUM_JOINTS
 from gmloco.deploy.logs.schema import JOINT_DIM, TopicSpec
 
 __all__ = ["decode_topic", "joint_permutation", "protobuf_decoder"]

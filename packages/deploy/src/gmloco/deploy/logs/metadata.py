@@ -9,8 +9,8 @@ from dataclasses import dataclass, field, fields
 from pathlib import Path
 from typing import Literal
 
+from gmloco.deploy.g1 import G1_JOINT_NAMES
 from gmloco.deploy.logs.errors import LogFormatError
-from gmloco.deploy.logs.g1 import G1_JOINT_NAMES
 from gmloco.deploy.logs.schema import SCHEMA_VERSION, UNITS
 
 __all__ = ["RunMetadata", "git_commit"]

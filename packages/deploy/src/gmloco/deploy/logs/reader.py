@@ -12,6 +12,7 @@ from typing import Any, Literal
 
 import numpy as np
 
+from gmloco.deploy.g1 import G1_JOINT_NAMES, joint_index
 from gmloco.deploy.logs.checks import check_contracts
 from gmloco.deploy.logs.decode import decode_topic, joint_permutation
 from gmloco.deploy.logs.errors import (
@@ -21,7 +22,6 @@ from gmloco.deploy.logs.errors import (
     MissingTopicError,
     UnitsError,
 )
-from gmloco.deploy.logs.g1 import G1_JOINT_NAMES, joint_index
 from gmloco.deploy.logs.mcap_scan import DamageReport, scan_mcap
 from gmloco.deploy.logs.metadata import RunMetadata
 from gmloco.deploy.logs.schema import (

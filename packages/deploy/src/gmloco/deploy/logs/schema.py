@@ -14,7 +14,7 @@ import json
 from dataclasses import dataclass
 from typing import Literal
 
-from gmloco.deploy.logs.g1 import G1_NUM_JOINTS
+from gmloco.deploy.g1 import G1_NUM_JOINTS
 
 __all__ = [
     "JOINT_DIM",

@@ -12,7 +12,7 @@ from typing import Any, Literal
 
 import numpy as np
 
-from gmloco.deploy.logs.g1 import G1_FEET, G1_NUM_JOINTS
+from gmloco.deploy.g1 import G1_FEET, G1_NUM_JOINTS
 from gmloco.deploy.logs.metadata import RunMetadata
 from gmloco.deploy.logs.schema import (
     JOINT_DIM,

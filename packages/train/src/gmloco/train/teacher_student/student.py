@@ -20,6 +20,7 @@ from rsl_rl.models import MLPModel
 from rsl_rl.modules import MLP, EmpiricalNormalization, HiddenState
 from tensordict import TensorDict
 
+from gmloco.train.teacher_student.actor_export import LatentActorExport
 from gmloco.train.teacher_student.networks import TemporalConvEncoder, history_to_time_major
 
 __all__ = ["DEFAULT_HISTORY_LENGTH", "StudentActor"]
@@ -151,22 +152,13 @@ class StudentActor(MLPModel):
         return _StudentOnnxExport(self)
 
 
-class _StudentExport(nn.Module):
+class _StudentExport(LatentActorExport):
     """Deterministic student: ``(obs [B, obs_dim], history [B, N, D]) -> actions [B, A]``."""
 
-    is_recurrent: bool = False
-
     def __init__(self, model: StudentActor) -> None:
-        """Deep-copy every module on the action path (encoder included) and the decoder copy."""
-        super().__init__()
-        self.obs_normalizer = copy.deepcopy(model.obs_normalizer)
+        """Deep-copy every module on the action path (encoder included), the history normalizer and the decoder."""
+        super().__init__(model)
         self.history_normalizer = copy.deepcopy(model.history_normalizer)
-        self.encoder = copy.deepcopy(model.encoder)
-        self.decoder = copy.deepcopy(model.decoder)
-        self.mlp = copy.deepcopy(model.mlp)
-        dist = model.distribution
-        self.deterministic_output = dist.as_deterministic_output_module() if dist is not None else nn.Identity()
-        self.obs_dim = model.obs_dim
         self.history_length = model.history_length
         self.history_frame_dim = model.history_frame_dim
 
@@ -177,12 +169,7 @@ class _StudentExport(nn.Module):
     def _act(self, obs: torch.Tensor, history: torch.Tensor) -> tuple[torch.Tensor, torch.Tensor]:
         """Return ``(actions [B, A], z_hat [B, latent_dim])``."""
         z_hat = self.encoder(self.history_normalizer(history))
-        actions = self.deterministic_output(self.mlp(torch.cat([self.obs_normalizer(obs), z_hat], dim=-1)))
-        return actions, z_hat
-
-    @torch.jit.export
-    def reset(self) -> None:
-        """No recurrent state to reset (the caller keeps the history)."""
+        return self.act(obs, z_hat), z_hat
 
     def get_dummy_inputs(self) -> tuple[torch.Tensor, torch.Tensor]:
         """Return zero inputs of batch 1 for tracing."""
@@ -192,11 +179,6 @@ class _StudentExport(nn.Module):
     def input_names(self) -> list[str]:
         """Return the ONNX input names."""
         return ["obs", "history"]
-
-    @property
-    def output_names(self) -> list[str]:
-        """Return the ONNX output names."""
-        return ["actions"]
 
 
 class _StudentOnnxExport(_StudentExport):

@@ -18,6 +18,7 @@ from rsl_rl.models import MLPModel
 from rsl_rl.modules import MLP, EmpiricalNormalization, HiddenState
 from tensordict import TensorDict
 
+from gmloco.train.teacher_student.actor_export import LatentActorExport
 from gmloco.train.teacher_student.networks import GaussianEncoder, flatten_groups
 
 __all__ = ["TeacherActor"]
@@ -131,32 +132,19 @@ class TeacherActor(MLPModel):
         return _TeacherExport(self)
 
 
-class _TeacherExport(nn.Module):
+class _TeacherExport(LatentActorExport):
     """Deterministic teacher for export: ``(obs [B, obs_dim], encoder_obs [B, enc_dim]) -> actions [B, A]``."""
 
-    is_recurrent: bool = False
-
     def __init__(self, model: TeacherActor) -> None:
-        """Deep-copy every module on the action path, the encoder included."""
-        super().__init__()
-        self.obs_normalizer = copy.deepcopy(model.obs_normalizer)
+        """Deep-copy every module on the action path, the encoder and its input normalizer included."""
+        super().__init__(model)
         self.encoder_normalizer = copy.deepcopy(model.encoder_normalizer)
-        self.encoder = copy.deepcopy(model.encoder)
-        self.decoder = copy.deepcopy(model.decoder)
-        self.mlp = copy.deepcopy(model.mlp)
-        dist = model.distribution
-        self.deterministic_output = dist.as_deterministic_output_module() if dist is not None else nn.Identity()
-        self.obs_dim = model.obs_dim
         self.encoder_obs_dim = model.encoder_obs_dim
 
     def forward(self, obs: torch.Tensor, encoder_obs: torch.Tensor) -> torch.Tensor:
         """Return the deterministic action, using the latent mean."""
         mu, _ = self.encoder(self.encoder_normalizer(encoder_obs))
-        return self.deterministic_output(self.mlp(torch.cat([self.obs_normalizer(obs), mu], dim=-1)))
-
-    @torch.jit.export
-    def reset(self) -> None:
-        """No recurrent state to reset."""
+        return self.act(obs, mu)
 
     def get_dummy_inputs(self) -> tuple[torch.Tensor, torch.Tensor]:
         """Return zero inputs of batch 1 for tracing."""
@@ -166,8 +154,3 @@ class _TeacherExport(nn.Module):
     def input_names(self) -> list[str]:
         """Return the ONNX input names."""
         return ["obs", "encoder_obs"]
-
-    @property
-    def output_names(self) -> list[str]:
-        """Return the ONNX output names."""
-        return ["actions"]

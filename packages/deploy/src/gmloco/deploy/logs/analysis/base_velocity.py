@@ -15,8 +15,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from gmloco.deploy.g1 import G1_FEET
 from gmloco.deploy.logs.analysis.kinematics import G1LegKinematics
-from gmloco.deploy.logs.g1 import G1_FEET
 from gmloco.deploy.logs.rotations import quat_rotate, quat_to_rpy
 
 __all__ = ["BaseVelocityCfg", "heading_velocity_from_odometry", "leg_odometry_velocity", "smooth"]

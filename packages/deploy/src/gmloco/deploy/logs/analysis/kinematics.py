@@ -15,7 +15,7 @@ from importlib import resources
 
 import numpy as np
 
-from gmloco.deploy.logs.g1 import G1_FEET, joint_index
+from gmloco.deploy.g1 import G1_FEET, joint_index
 from gmloco.deploy.logs.rotations import axis_angle_matrix, quat_to_matrix
 
 __all__ = ["G1LegKinematics", "g1_model", "sole_heights"]

@@ -8,8 +8,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from gmloco.deploy.g1 import G1_FEET
 from gmloco.deploy.logs.analysis.segmentation import phase_windows
-from gmloco.deploy.logs.g1 import G1_FEET
 
 __all__ = [
     "MetricsCfg",

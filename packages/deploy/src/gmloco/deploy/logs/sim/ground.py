@@ -15,7 +15,7 @@ from typing import Any, Protocol
 
 import numpy as np
 
-from gmloco.deploy.logs.g1 import G1_FEET
+from gmloco.deploy.g1 import G1_FEET
 
 __all__ = ["GroundContact", "RigidGround", "RigidGroundCfg"]
 

@@ -10,37 +10,14 @@ from typing import Any
 
 import numpy as np
 
-from gmloco.deploy.logs.g1 import G1_JOINT_NAMES
+from gmloco.deploy.g1 import G1_EFFORT_LIMIT, G1_JOINT_NAMES, g1_actuator
 
 __all__ = ["G1SceneCfg", "build_g1_model", "g1_effort_limits", "g1_xml_path"]
-
-# Reflected rotor inertia [kg*m^2] and effort limit [N*m] per actuator type, from
-# mjlab 1.6.0 asset_zoo/robots/unitree_g1/g1_constants.py (ARMATURE_*, ACTUATOR_*.effort_limit).
-_ACTUATORS: dict[str, tuple[float, float]] = {
-    "7520_14": (0.01017752004132231, 88.0),
-    "7520_22": (0.025101924999999997, 139.0),
-    "5020": (0.003609725, 25.0),
-    "5020x2": (2 * 0.003609725, 50.0),  # ankles, waist roll/pitch: 4-bar linkage driven by two 5020
-    "4010": (0.00425, 5.0),
-}
-
-
-def _actuator(name: str) -> str:
-    """Actuator type of a G1 joint (mjlab's grouping)."""
-    if any(k in name for k in ("hip_pitch", "hip_yaw", "waist_yaw")):
-        return "7520_14"
-    if any(k in name for k in ("hip_roll", "knee")):
-        return "7520_22"
-    if any(k in name for k in ("ankle", "waist_roll", "waist_pitch")):
-        return "5020x2"
-    if any(k in name for k in ("wrist_pitch", "wrist_yaw")):
-        return "4010"
-    return "5020"
 
 
 def g1_effort_limits() -> np.ndarray:
     """Joint torque limits [N*m], canonical order, shape [29]."""
-    return np.array([_ACTUATORS[_actuator(n)][1] for n in G1_JOINT_NAMES])
+    return np.array(G1_EFFORT_LIMIT)
 
 
 def g1_xml_path() -> Path:
@@ -67,7 +44,7 @@ def build_g1_model(cfg: G1SceneCfg | None = None) -> Any:
     """Compile the G1 scene and return a ``mujoco.MjModel``.
 
     Feet keep their capsules (condim 3); other collision geoms are disabled, as in mjlab's feet-only
-    collision preset. Joint armature follows mjlab's actuator constants.
+    collision preset. Joint armature follows mjlab's actuator constants (:mod:`gmloco.deploy.g1`).
     """
     import mujoco
 
@@ -86,7 +63,7 @@ def build_g1_model(cfg: G1SceneCfg | None = None) -> Any:
                 g.friction[0] = cfg.foot_friction
     for j in spec.joints:
         if j.name in G1_JOINT_NAMES:
-            j.armature = _ACTUATORS[_actuator(j.name)][0]
+            j.armature = g1_actuator(j.name).armature
     model = spec.compile()
     names = tuple(model.joint(i).name for i in range(1, model.njnt))
     if names != G1_JOINT_NAMES:

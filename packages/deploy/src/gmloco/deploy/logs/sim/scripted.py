@@ -15,7 +15,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from gmloco.deploy.logs.g1 import G1_FEET, G1_JOINT_NAMES, joint_index
+from gmloco.deploy.g1 import G1_FEET, G1_JOINT_NAMES, G1_KNEES_BENT_POSE, joint_index
 from gmloco.deploy.logs.rotations import quat_to_rpy
 
 __all__ = ["ScriptedStepping", "ScriptedSteppingCfg", "g1_knees_bent_pose"]
@@ -23,21 +23,7 @@ __all__ = ["ScriptedStepping", "ScriptedSteppingCfg", "g1_knees_bent_pose"]
 
 def g1_knees_bent_pose() -> np.ndarray:
     """Mjlab's ``KNEES_BENT_KEYFRAME`` joint pose [rad], canonical order, shape [29]."""
-    pose = {
-        "hip_pitch_joint": -0.312,
-        "knee_joint": 0.669,
-        "ankle_pitch_joint": -0.363,
-        "elbow_joint": 0.6,
-        "shoulder_pitch_joint": 0.2,
-    }
-    q = np.zeros(len(G1_JOINT_NAMES))
-    for i, n in enumerate(G1_JOINT_NAMES):
-        for k, v in pose.items():
-            if n.endswith(k) and n.startswith(("left", "right")):
-                q[i] = v
-    q[joint_index("left_shoulder_roll_joint")] = 0.2
-    q[joint_index("right_shoulder_roll_joint")] = -0.2
-    return q
+    return np.array(G1_KNEES_BENT_POSE)
 
 
 def _gains(name: str) -> tuple[float, float]:

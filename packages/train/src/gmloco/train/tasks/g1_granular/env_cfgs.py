@@ -29,7 +29,7 @@ from gmloco.train.config import (
     rough_sand_terrain,
 )
 from gmloco.train.mdp.commands import YawTargetVelocityCommandCfg
-from gmloco.train.sand import FEET_FLOOR_SENSOR, SAND_FLOOR_BODY, add_sand_floor
+from gmloco.train.sand import FEET_FLOOR_SENSOR, FOOT_BODIES, SAND_FLOOR_BODY, add_sand_floor
 from gmloco.train.tasks.g1_granular.events_cfg import make_events_cfg
 from gmloco.train.tasks.g1_granular.observations_cfg import make_observations_cfg
 from gmloco.train.tasks.g1_granular.rewards_cfg import make_curriculum_cfg, make_rewards_cfg
@@ -62,7 +62,7 @@ def _sensors() -> tuple[ContactSensorCfg, ...]:
     floor = ContactMatch(mode="body", pattern=SAND_FLOOR_BODY)
     feet = ContactSensorCfg(
         name=FEET_FLOOR_SENSOR,
-        primary=ContactMatch(mode="body", pattern=r"^(left_ankle_roll_link|right_ankle_roll_link)$", entity="robot"),
+        primary=ContactMatch(mode="body", pattern=f"^({'|'.join(FOOT_BODIES)})$", entity="robot"),
         secondary=floor,
         fields=("found", "force"),
         reduce="netforce",

@@ -6,14 +6,13 @@ that built the training env (:func:`make_g1_granular_env_cfg`, :func:`contact_mo
 scale, physics dt and decimation, command ranges, stages and heading rule, contact model and foot collider, terrain, materials
 and robot randomization. Joints (order, kp/kd, default pose, action scale) come from the live env
 (:func:`policy_metadata_from_env`) or, for a file exported before, from its own older metadata; effort limits
-from mjlab's G1 actuator configs.
+from the G1 actuator table (:mod:`gmloco.deploy.g1`, checked against mjlab's G1 actuator configs).
 """
 
 from __future__ import annotations
 
 import json
 import math
-import re
 from collections.abc import Sequence
 from dataclasses import asdict
 from typing import TYPE_CHECKING, Any
@@ -29,6 +28,7 @@ from gmloco.deploy.export.metadata import (
     PolicyMetadata,
     TimingSpec,
 )
+from gmloco.deploy.g1 import g1_actuator
 from gmloco.train.config import GranularTaskCfg, contact_force_threshold
 
 if TYPE_CHECKING:
@@ -43,21 +43,15 @@ def _plain(value: Any) -> Any:
 
 
 def g1_effort_limits(joint_names: Sequence[str]) -> list[float]:
-    """Return the actuator torque limit of each joint [N m] from mjlab's G1 actuator configs.
+    """Return the actuator torque limit of each joint [N m] from the G1 actuator table (:mod:`gmloco.deploy.g1`).
 
     Raises:
-        ValueError: If a joint matches no actuator, several, or one without a limit.
+        ValueError: If a name is not a G1 29-DoF joint.
     """
-    from mjlab.asset_zoo.robots import get_g1_robot_cfg
-
-    actuators = get_g1_robot_cfg().articulation.actuators  # type: ignore[union-attr]
-    limits = []
-    for name in joint_names:
-        hits = [a.effort_limit for a in actuators if any(re.fullmatch(e, name) for e in a.target_names_expr)]
-        if len(hits) != 1 or hits[0] is None:
-            raise ValueError(f"joint {name!r}: {len(hits)} G1 actuator configs with effort limits {hits}, need one.")
-        limits.append(float(hits[0]))
-    return limits
+    try:
+        return [g1_actuator(name).effort_limit for name in joint_names]
+    except KeyError as err:
+        raise ValueError(f"effort limits: {err.args[0]}") from None
 
 
 def joint_spec(
