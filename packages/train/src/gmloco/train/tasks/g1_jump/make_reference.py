@@ -21,7 +21,7 @@ from pathlib import Path
 
 import numpy as np
 
-from gmloco.train.tasks.g1_jump.ik import load_g1_model
+from gmloco.train.tasks.g1_jump.ik import IkCfg, load_g1_model
 from gmloco.train.tasks.g1_jump.plausibility import check_plausibility
 from gmloco.train.tasks.g1_jump.profile import JumpProfileCfg
 from gmloco.train.tasks.g1_jump.reference import (
@@ -39,14 +39,19 @@ MODULE = "gmloco.train.tasks.g1_jump.make_reference"
 
 
 def shipped_references() -> list[JumpSynthesisCfg]:
-    """The references the package ships: a vertical jump (8 cm CoM rise) and a 10 cm forward jump.
+    """The references the package ships: a vertical jump (8 cm CoM rise in flight) and a 15 cm forward jump.
 
-    The forward jump is 10 cm long: with zero angular momentum about the CoM the torso counter-rotates against the
-    legs' extension, and at 15 cm and beyond the waist pitch reaches its joint limit during the push-off.
+    Both keep every joint within the G1's effort, velocity and position limits. The zero angular momentum about
+    the CoM from push-off to landing is balanced by turning the whole trunk on the hips (waist and arms cost 100
+    and 0.3 times the leg motion in the IK); the take-off 10 cm below the standing CoM height and a 3 cm foot lift
+    spread over half the flight keep the legs' swing in flight, which the trunk must balance, small. Beyond 15 cm
+    forward the feet's swing in flight needs a trunk rotation whose waist torque passes the 50 N m limit.
     """
+    ik = IkCfg(weight_waist=100.0, weight_arms=0.3)
+    common = {"takeoff_rise": -0.10, "foot_lift": 0.03, "foot_lift_fraction": 0.5}
     return [
-        JumpSynthesisCfg(profile=JumpProfileCfg(name="vertical")),
-        JumpSynthesisCfg(profile=JumpProfileCfg(name="forward", distance=0.10, takeoff_rise=-0.05)),
+        JumpSynthesisCfg(profile=JumpProfileCfg(name="vertical", **common), ik=ik),
+        JumpSynthesisCfg(profile=JumpProfileCfg(name="forward", distance=0.15, t_push=0.30, **common), ik=ik),
     ]
 
 
@@ -92,9 +97,11 @@ def build(out: Path) -> dict[str, object]:
         "method": (
             "quintic CoM height per phase (continuous force, zero at take-off and touch-down), ballistic flight, "
             "horizontal force parallel to the vertical one; min-jerk foot lift; whole-body IK on mjlab's G1 MJCF "
-            "(CoM, soles, zero angular momentum about the CoM as primary tasks, pelvis lean and posture in the null "
-            "space); velocities by central differences; rigid-ground inverse dynamics (mj_inverse, minimum-norm "
-            "sole wrenches) for the plausibility report"
+            "(CoM and soles as primary tasks; from push-off to the end of the landing also zero angular momentum "
+            "about the CoM, solved with a weighted pseudo-inverse that makes waist and arm motion costlier so the "
+            "trunk turns on the hips, no pelvis task; pelvis lean primary during crouch and recovery; posture in "
+            "the null space); velocities by central differences; rigid-ground inverse dynamics (mj_inverse, "
+            "minimum-norm sole wrenches) for the plausibility report, every joint against its effort limit"
         ),
         "model": "mjlab asset_zoo unitree_g1 g1.xml (MuJoCo Menagerie lineage, BSD-3-Clause) + mjlab G1 armature",
         "versions": _versions(),
