@@ -39,19 +39,24 @@ MODULE = "gmloco.train.tasks.g1_jump.make_reference"
 
 
 def shipped_references() -> list[JumpSynthesisCfg]:
-    """The references the package ships: a vertical jump (8 cm CoM rise in flight) and a 15 cm forward jump.
+    """The references the package ships: a vertical jump (12 cm CoM rise in flight) and a 15 cm forward jump.
 
     Both keep every joint within the G1's effort, velocity and position limits. The zero angular momentum about
     the CoM from push-off to landing is balanced by turning the whole trunk on the hips (waist and arms cost 100
-    and 0.3 times the leg motion in the IK); the take-off 10 cm below the standing CoM height and a 3 cm foot lift
-    spread over half the flight keep the legs' swing in flight, which the trunk must balance, small. Beyond 15 cm
-    forward the feet's swing in flight needs a trunk rotation whose waist torque passes the 50 N m limit.
+    and 0.3 times the leg motion in the IK); a take-off well below the standing CoM height, a 0.30 s push-off
+    and a foot lift spread over half the flight keep the legs' swing in flight, which the trunk must balance,
+    small. The forward jump rises 8 cm from a take-off 10 cm low: with the feet's forward swing in flight, a 12 cm
+    rise or more than 15 cm forward needs a trunk rotation whose waist torque passes 50 N m.
     """
     ik = IkCfg(weight_waist=100.0, weight_arms=0.3)
-    common = {"takeoff_rise": -0.10, "foot_lift": 0.03, "foot_lift_fraction": 0.5}
+    lift = {"foot_lift_fraction": 0.5, "t_push": 0.30}
     return [
-        JumpSynthesisCfg(profile=JumpProfileCfg(name="vertical", **common), ik=ik),
-        JumpSynthesisCfg(profile=JumpProfileCfg(name="forward", distance=0.15, t_push=0.30, **common), ik=ik),
+        JumpSynthesisCfg(
+            profile=JumpProfileCfg(name="vertical", apex_rise=0.12, takeoff_rise=-0.08, foot_lift=0.07, **lift), ik=ik
+        ),
+        JumpSynthesisCfg(
+            profile=JumpProfileCfg(name="forward", distance=0.15, takeoff_rise=-0.10, foot_lift=0.03, **lift), ik=ik
+        ),
     ]
 
 
