@@ -148,6 +148,8 @@ class IkTargets:
     shape [3]; None: no momentum task, the pelvis orientation is a primary task instead."""
     dt: float = 0.01
     """Time since the previous frame [s] (momentum task only)."""
+    waist_pitch: float = 0.0
+    """Posture target of the waist pitch joint [rad] (the standing pose's is 0)."""
 
 
 class WholeBodyIk:
@@ -178,6 +180,8 @@ class WholeBodyIk:
                 self.posture_gain[dof - 6], weight[dof] = cfg.posture_gain_arms, cfg.weight_arms
         self.inv_weight = 1.0 / weight
         """Inverse joint-space weight of the momentum tasks' pseudo-inverse, shape [nv]."""
+        self.waist_pitch = model.jnt_qposadr[model.joint("waist_pitch_joint").id]
+        """qpos index of the waist pitch joint."""
         self.mass = float(model.body_subtreemass[self.pelvis])
         self.foot_quat = np.zeros((2, 4))
         self.last_error = np.inf
@@ -278,7 +282,9 @@ class WholeBodyIk:
             if worst < self.cfg.tolerance and it >= self.cfg.min_iterations:
                 break
             dq_posture = np.zeros(self.model.nv)
-            dq_posture[6:] = self.posture_gain * (self.q_nominal[7:] - self.q[7:])
+            q_nominal = self.q_nominal.copy()
+            q_nominal[self.waist_pitch] = targets.waist_pitch
+            dq_posture[6:] = self.posture_gain * (q_nominal[7:] - self.q[7:])
             if A is None:
                 J, e = np.concatenate(jacs), np.concatenate(errs)
                 J_pinv = _pinv(J, self.cfg.damping)

@@ -50,6 +50,9 @@ class JumpSynthesisCfg:
     """Forward pelvis pitch held from the end of the crouch to the end of the landing [rad]."""
     ik: IkCfg | None = None
     """IK settings; None: ``IkCfg()``."""
+    waist_lean: float = 0.0
+    """Waist pitch posture target at full lean [rad], following the pelvis lean's timing; negative keeps the
+    torso more upright than the pelvis, shortening the lever of its weight about the waist."""
     angular_momentum: Literal["zero", "jump"] = "jump"
     """Angular momentum schedule of the IK. "jump": the momentum about the CoM is held at zero from the start of
     the push-off to the end of the landing with no pelvis task, so the whole trunk turns on the hips to balance
@@ -165,6 +168,7 @@ def _solve_frames(model: mujoco.MjModel, cfg: JumpSynthesisCfg, profile: JumpPro
             pelvis_pitch=pitch,
             angmom=angmom,
             dt=dt,
+            waist_pitch=cfg.waist_lean * float(profile.lean_fraction[i]),
         )
         out[i] = ik.solve(targets)
         worst = max(worst, ik.last_error)
