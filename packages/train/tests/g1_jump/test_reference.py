@@ -77,6 +77,21 @@ def test_flight_com_is_ballistic(shipped: tuple[JumpReference, PlausibilityRepor
     assert report.flight_base_force < 0.02 * report.mass * GRAVITY
 
 
+def test_flight_angular_momentum_is_zero(model: object, shipped: tuple[JumpReference, PlausibilityReport]) -> None:
+    """Over every flight step the whole-body angular momentum about the CoM is zero (the IK's momentum task).
+
+    The IK stops when the momentum error times dt / m is below its tolerance, so |L| <= tolerance m fps.
+    """
+    from gmloco.train.tasks.g1_jump.ik import WholeBodyIk
+
+    ref, report = shipped
+    ik = WholeBodyIk(model, IkCfg())  # type: ignore[arg-type]
+    steps = np.flatnonzero(~ref.in_contact[1:] & ~ref.in_contact[:-1]) + 1
+    L = np.array([ik.step_momentum(ref.qpos[i - 1], ref.qpos[i], 1.0 / ref.fps) for i in steps])
+    assert L.shape[0] > 10
+    np.testing.assert_allclose(L, 0.0, atol=IkCfg().tolerance * report.mass * ref.fps)
+
+
 def test_feet_kinematics(shipped: tuple[JumpReference, PlausibilityReport]) -> None:
     """Stance soles stay flat on the ground and still; flight soles stay above it."""
     ref, report = shipped

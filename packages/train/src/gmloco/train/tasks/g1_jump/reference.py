@@ -47,7 +47,8 @@ class JumpSynthesisCfg:
     profile: JumpProfileCfg
     """Timing and geometry of the jump."""
     pelvis_lean: float = 0.3
-    """Forward pelvis pitch held from the end of the crouch to the end of the landing [rad]."""
+    """Forward pelvis pitch reached at the end of the crouch [rad]; held to the end of the landing with
+    ``angular_momentum="zero"``, free from push-off to landing with ``"jump"``."""
     ik: IkCfg | None = None
     """IK settings; None: ``IkCfg()``."""
     waist_lean: float = 0.0
