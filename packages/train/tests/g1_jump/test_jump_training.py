@@ -65,7 +65,9 @@ def test_ppo_losses_are_finite(tmp_path: Path) -> None:
 def test_two_iterations_then_resume_keep_the_assist_state(tmp_path: Path) -> None:
     """Two iterations write model_2.pt with the assist state; max_iterations=3 resumes for exactly one more."""
     metrics = train(_cfg(tmp_path))
-    assert metrics["iteration"] == 2 and math.isfinite(metrics["mean_reward"] or 0.0)
+    assert metrics["iteration"] == 2
+    # The reward buffer fills only when an episode ends; 2 envs x 16 steps may end none, and then both means are nan.
+    assert math.isfinite(metrics["mean_reward"]) == math.isfinite(metrics["mean_episode_length"])
     ckpt = torch.load(tmp_path / "model_2.pt", map_location="cpu", weights_only=False)
     assist = ckpt["infos"]["jump_assist"]
     assert assist["scale"] == pytest.approx(1.0)  # 2 envs x ~16 steps: far from the first judged round

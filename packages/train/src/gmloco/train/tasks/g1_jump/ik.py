@@ -3,8 +3,9 @@
 
 Each frame runs Gauss-Newton steps over the free base and the 29 joints. The whole-body CoM, both sole sites
 (position and orientation, soles flat) and, when asked, the angular momentum about the CoM over the step from
-the previous frame are primary tasks, solved by a damped pseudo-inverse; the pelvis orientation is primary
-without the momentum task and a null-space task with it; a posture step toward the standing pose (waist and
+the previous frame are primary tasks, solved by a damped pseudo-inverse (weighted with the momentum task, so
+that waist and arm motion cost more than base and leg motion); the pelvis orientation is primary without the
+momentum task and a null-space task or absent with it; a posture step toward the standing pose (waist and
 arms) acts in the remaining null space. Frames are solved in order, each warm-started from the previous one, so
 the joint trajectory is as smooth as the task trajectory.
 """
@@ -124,6 +125,11 @@ class IkCfg:
     """Stop when the largest CoM / sole position error is below this [m]."""
     limit_margin: float = 0.02
     """Joint positions are kept this far inside the joint range [rad]."""
+    weight_waist: float = 1.0
+    """Cost of waist motion relative to the base and leg motion in the weighted pseudo-inverse of the momentum
+    tasks [-]; above 1, the momentum is balanced by turning the whole trunk on the hips rather than the waist."""
+    weight_arms: float = 1.0
+    """Same for the arm joints [-]."""
 
 
 @dataclass
@@ -134,13 +140,16 @@ class IkTargets:
     """Whole-body CoM [m], shape [3]."""
     feet: np.ndarray
     """Sole-site positions, left then right [m], shape [2, 3]."""
-    pelvis_pitch: float
-    """Pelvis pitch about the world y axis [rad] (roll and yaw are zero); a null-space target."""
+    pelvis_pitch: float | None
+    """Pelvis pitch about the world y axis [rad] (roll and yaw are zero); a null-space target when ``angmom`` is
+    set; None: no pelvis task (``angmom`` must then be set), the pelvis turns as the momentum task requires."""
     angmom: np.ndarray | None = None
     """Whole-body angular momentum about the CoM to hold over the step from the previous frame [kg m^2/s],
     shape [3]; None: no momentum task, the pelvis orientation is a primary task instead."""
     dt: float = 0.01
     """Time since the previous frame [s] (momentum task only)."""
+    waist_pitch: float = 0.0
+    """Posture target of the waist pitch joint [rad] (the standing pose's is 0)."""
 
 
 class WholeBodyIk:
@@ -162,12 +171,17 @@ class WholeBodyIk:
         self.lower = np.array([model.jnt_range[j, 0] for j in hinge]) + cfg.limit_margin
         self.upper = np.array([model.jnt_range[j, 1] for j in hinge]) - cfg.limit_margin
         self.posture_gain = np.full(model.nv - 6, cfg.posture_gain_legs)
+        weight = np.ones(model.nv)
         for j in hinge:
-            name = model.joint(j).name
+            name, dof = model.joint(j).name, model.jnt_dofadr[j]
             if name.startswith("waist"):
-                self.posture_gain[model.jnt_dofadr[j] - 6] = cfg.posture_gain_waist
+                self.posture_gain[dof - 6], weight[dof] = cfg.posture_gain_waist, cfg.weight_waist
             elif not any(k in name for k in ("hip", "knee", "ankle")):
-                self.posture_gain[model.jnt_dofadr[j] - 6] = cfg.posture_gain_arms
+                self.posture_gain[dof - 6], weight[dof] = cfg.posture_gain_arms, cfg.weight_arms
+        self.inv_weight = 1.0 / weight
+        """Inverse joint-space weight of the momentum tasks' pseudo-inverse, shape [nv]."""
+        self.waist_pitch = model.jnt_qposadr[model.joint("waist_pitch_joint").id]
+        """qpos index of the waist pitch joint."""
         self.mass = float(model.body_subtreemass[self.pelvis])
         self.foot_quat = np.zeros((2, 4))
         self.last_error = np.inf
@@ -217,12 +231,28 @@ class WholeBodyIk:
             jacs += [jp, jr]
             errs += [e_pos, _rot_error(self.foot_quat[i], d.site_xmat[s])]
             worst = max(worst, float(np.abs(e_pos).max()))
+        if targets.pelvis_pitch is None:
+            return jacs, errs, worst
         jp, jr = np.zeros((3, m.nv)), np.zeros((3, m.nv))
         mujoco.mj_jacBody(m, d, jp, jr, self.pelvis)
         pelvis_quat = np.array([np.cos(targets.pelvis_pitch / 2), 0.0, np.sin(targets.pelvis_pitch / 2), 0.0])
         jacs.append(jr)
         errs.append(_rot_error(pelvis_quat, d.xmat[self.pelvis]))
         return jacs, errs, worst
+
+    def midpoint(self, q_prev: np.ndarray, q: np.ndarray) -> np.ndarray:
+        """Configuration halfway along the step from ``q_prev`` to ``q``, shape [nq]."""
+        mid = q_prev.copy()
+        step = np.zeros(self.model.nv)
+        mujoco.mj_differentiatePos(self.model, step, 1.0, q_prev, q)
+        mujoco.mj_integratePos(self.model, mid, step, 0.5)
+        return mid
+
+    def step_momentum(self, q_prev: np.ndarray, q: np.ndarray, dt: float) -> np.ndarray:
+        """Angular momentum about the CoM of the step ``q_prev -> q`` over ``dt`` (midpoint rule) [kg m^2/s]."""
+        step = np.zeros(self.model.nv)
+        mujoco.mj_differentiatePos(self.model, step, dt, q_prev, q)
+        return self.momentum_matrix(self.midpoint(q_prev, q)) @ step
 
     def _momentum_residual(self, targets: IkTargets, q_prev: np.ndarray, A: np.ndarray) -> np.ndarray:
         """Error of ``A (q - q_prev) / dt = angmom`` at the current ``q`` [kg m^2/s], shape [3]."""
@@ -243,11 +273,7 @@ class WholeBodyIk:
         for it in range(self.cfg.max_iterations):
             if targets.angmom is not None:
                 # Midpoint rule: A at the middle of the step keeps the momentum of the discrete motion second-order.
-                mid = q_prev.copy()
-                step = np.zeros(self.model.nv)
-                mujoco.mj_differentiatePos(self.model, step, 1.0, q_prev, self.q)
-                mujoco.mj_integratePos(self.model, mid, step, 0.5)
-                A = self.momentum_matrix(mid)
+                A = self.momentum_matrix(self.midpoint(q_prev, self.q))
             jacs, errs, worst = self._residuals(targets)
             if A is not None:
                 e_mom = self._momentum_residual(targets, q_prev, A)
@@ -256,21 +282,27 @@ class WholeBodyIk:
             if worst < self.cfg.tolerance and it >= self.cfg.min_iterations:
                 break
             dq_posture = np.zeros(self.model.nv)
-            dq_posture[6:] = self.posture_gain * (self.q_nominal[7:] - self.q[7:])
+            q_nominal = self.q_nominal.copy()
+            q_nominal[self.waist_pitch] = targets.waist_pitch
+            dq_posture[6:] = self.posture_gain * (q_nominal[7:] - self.q[7:])
             if A is None:
                 J, e = np.concatenate(jacs), np.concatenate(errs)
                 J_pinv = _pinv(J, self.cfg.damping)
                 dq = J_pinv @ e + dq_posture - J_pinv @ (J @ dq_posture)
             else:
                 J, e = np.concatenate([*jacs[:5], A / targets.dt]), np.concatenate([*errs[:5], e_mom])
-                J_pinv = _pinv(J, self.cfg.damping)
+                # Weighted minimum-norm step: waist and arm motion cost more than base and leg motion.
+                # W^-1 J^T (J W^-1 J^T)^-1 = D (J D)^+ with D = W^-1/2.
+                D = np.sqrt(self.inv_weight)
+                J_pinv = D[:, None] * _pinv(J * D, self.cfg.damping)
                 dq = J_pinv @ e
                 # Pelvis orientation as a secondary task, the posture as a third, each in the null space above it.
                 N = np.eye(self.model.nv) - J_pinv @ J
-                JpN_pinv = _pinv(jacs[5] @ N, self.cfg.damping)
-                dq = dq + JpN_pinv @ (errs[5] - jacs[5] @ dq)
-                N2 = N - JpN_pinv @ (jacs[5] @ N)
-                dq = dq + N2 @ dq_posture
+                if len(jacs) > 5:
+                    JpN_pinv = _pinv(jacs[5] @ N, self.cfg.damping)
+                    dq = dq + JpN_pinv @ (errs[5] - jacs[5] @ dq)
+                    N = N - JpN_pinv @ (jacs[5] @ N)
+                dq = dq + N @ dq_posture
             mujoco.mj_integratePos(self.model, self.q, dq, 1.0)
             self.q[7:] = np.clip(self.q[7:], self.lower, self.upper)
         return self.q.copy()

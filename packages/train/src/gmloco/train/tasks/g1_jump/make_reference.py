@@ -21,7 +21,7 @@ from pathlib import Path
 
 import numpy as np
 
-from gmloco.train.tasks.g1_jump.ik import load_g1_model
+from gmloco.train.tasks.g1_jump.ik import IkCfg, load_g1_model
 from gmloco.train.tasks.g1_jump.plausibility import check_plausibility
 from gmloco.train.tasks.g1_jump.profile import JumpProfileCfg
 from gmloco.train.tasks.g1_jump.reference import (
@@ -39,14 +39,30 @@ MODULE = "gmloco.train.tasks.g1_jump.make_reference"
 
 
 def shipped_references() -> list[JumpSynthesisCfg]:
-    """The references the package ships: a vertical jump (8 cm CoM rise) and a 10 cm forward jump.
+    """The references the package ships: a vertical jump (12 cm CoM rise in flight) and a 20 cm forward jump.
 
-    The forward jump is 10 cm long: with zero angular momentum about the CoM the torso counter-rotates against the
-    legs' extension, and at 15 cm and beyond the waist pitch reaches its joint limit during the push-off.
+    Both keep every joint within the G1's effort, velocity and position limits. The zero angular momentum about
+    the CoM from push-off to landing is balanced by turning the whole trunk on the hips (waist and arms cost 100
+    and 0.3 times the leg motion in the IK); a take-off well below the standing CoM height, a 0.30 s push-off
+    and a foot lift spread over half the flight keep the legs' swing in flight, which the trunk must balance,
+    small. The forward jump leans the pelvis 0.7 rad into the push with the torso 0.25 rad back on the waist
+    (a shorter lever of the torso's weight) and rises 8 cm from a take-off 10 cm low: the feet's forward swing
+    in flight turns the trunk, and a 12 cm rise or 25 cm forward needs more than the waist pitch's 50 N m.
     """
+    ik = IkCfg(weight_waist=100.0, weight_arms=0.3)
+    lift = {"foot_lift_fraction": 0.5, "t_push": 0.30}
     return [
-        JumpSynthesisCfg(profile=JumpProfileCfg(name="vertical")),
-        JumpSynthesisCfg(profile=JumpProfileCfg(name="forward", distance=0.10, takeoff_rise=-0.05)),
+        JumpSynthesisCfg(
+            profile=JumpProfileCfg(name="vertical", apex_rise=0.12, takeoff_rise=-0.08, foot_lift=0.07, **lift), ik=ik
+        ),
+        JumpSynthesisCfg(
+            profile=JumpProfileCfg(
+                name="forward", distance=0.20, takeoff_rise=-0.10, foot_lift=0.03, t_land=0.40, **lift
+            ),
+            pelvis_lean=0.7,
+            waist_lean=-0.25,
+            ik=ik,
+        ),
     ]
 
 
@@ -92,9 +108,12 @@ def build(out: Path) -> dict[str, object]:
         "method": (
             "quintic CoM height per phase (continuous force, zero at take-off and touch-down), ballistic flight, "
             "horizontal force parallel to the vertical one; min-jerk foot lift; whole-body IK on mjlab's G1 MJCF "
-            "(CoM, soles, zero angular momentum about the CoM as primary tasks, pelvis lean and posture in the null "
-            "space); velocities by central differences; rigid-ground inverse dynamics (mj_inverse, minimum-norm "
-            "sole wrenches) for the plausibility report"
+            "(CoM and soles as primary tasks; from push-off to the end of the landing also zero angular momentum "
+            "about the CoM, solved with a weighted pseudo-inverse that makes waist and arm motion costlier so the "
+            "trunk turns on the hips, no pelvis task; pelvis lean primary during crouch and recovery; posture, "
+            "with the waist pitch following the lean, in the null space); velocities by central differences; "
+            "rigid-ground inverse dynamics (mj_inverse, minimum-norm sole wrenches) for the plausibility report, "
+            "every joint against its effort limit"
         ),
         "model": "mjlab asset_zoo unitree_g1 g1.xml (MuJoCo Menagerie lineage, BSD-3-Clause) + mjlab G1 armature",
         "versions": _versions(),

@@ -78,8 +78,7 @@ class JumpProfile:
     """Whether the feet are on the ground, shape [T] (bool)."""
     lean_fraction: np.ndarray
     """Fraction of the full forward lean of the pelvis [-], shape [T]: min-jerk up over the crouch, held through
-    push-off, flight and landing (a pelvis that does not rotate needs no angular momentum), min-jerk down over
-    the recovery."""
+    push-off, flight and landing, min-jerk down over the recovery."""
     t_takeoff: float
     """Take-off time [s]."""
     t_touchdown: float

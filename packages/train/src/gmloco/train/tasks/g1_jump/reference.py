@@ -12,6 +12,7 @@ import os
 import tempfile
 from dataclasses import dataclass
 from pathlib import Path
+from typing import Literal
 
 import mujoco
 import numpy as np
@@ -46,9 +47,19 @@ class JumpSynthesisCfg:
     profile: JumpProfileCfg
     """Timing and geometry of the jump."""
     pelvis_lean: float = 0.3
-    """Forward pelvis pitch held from the end of the crouch to the end of the landing [rad]."""
+    """Forward pelvis pitch reached at the end of the crouch [rad]; held to the end of the landing with
+    ``angular_momentum="zero"``, free from push-off to landing with ``"jump"``."""
     ik: IkCfg | None = None
     """IK settings; None: ``IkCfg()``."""
+    waist_lean: float = 0.0
+    """Waist pitch posture target at full lean [rad], following the pelvis lean's timing; negative keeps the
+    torso more upright than the pelvis, shortening the lever of its weight about the waist."""
+    angular_momentum: Literal["zero", "jump"] = "jump"
+    """Angular momentum schedule of the IK. "jump": the momentum about the CoM is held at zero from the start of
+    the push-off to the end of the landing with no pelvis task, so the whole trunk turns on the hips to balance
+    the legs (the waist and arms are costlier in the weighted pseudo-inverse, ``IkCfg.weight_*``); before and
+    after, the ground's moment about the CoM is free and the pelvis orientation is primary. "zero": held at
+    zero throughout with the pelvis orientation in its null space, which turns the torso on the waist."""
 
 
 @dataclass
@@ -124,9 +135,10 @@ def _standing_state(model: mujoco.MjModel) -> tuple[np.ndarray, float]:
 def _solve_frames(model: mujoco.MjModel, cfg: JumpSynthesisCfg, profile: JumpProfile) -> tuple[np.ndarray, float]:
     """IK of every frame of ``profile``; returns qpos [T, nq] and the largest task error [m].
 
-    The angular momentum about the CoM is held at zero (a primary task, with the pelvis orientation in its null
-    space): flight then needs no rotation, and in stance the ground force passes through the CoM, so the centre
-    of pressure is where that line meets the ground.
+    Zero angular momentum about the CoM over flight is what a ballistic body without rotation needs (no external
+    moment acts about its CoM); over push-off and landing it puts the ground force through the CoM. Outside that
+    window (``angular_momentum="jump"``) the slow crouch and recovery track the pelvis lean instead, and the
+    recovery starts from the pelvis pitch the momentum task left.
     """
     q0, _ = _standing_state(model)
     ik = WholeBodyIk(model, cfg.ik or IkCfg())
@@ -135,18 +147,40 @@ def _solve_frames(model: mujoco.MjModel, cfg: JumpSynthesisCfg, profile: JumpPro
     mujoco.mj_comPos(model, data)
     com0 = data.subtree_com[ik.pelvis].copy()
     feet0 = np.stack([data.site_xpos[s].copy() for s in ik.feet])
-    out, worst = np.zeros((profile.time.size, model.nq)), 0.0
+    out, worst, dt = np.zeros((profile.time.size, model.nq)), 0.0, 1.0 / cfg.profile.fps
+    window = (profile.time >= profile.t_push_start) & (profile.time < profile.t_touchdown + cfg.profile.t_land)
+    lean = cfg.pelvis_lean * profile.lean_fraction
     for i in range(profile.time.size):
+        angmom: np.ndarray | None = np.zeros(3)
+        pitch: float | None = float(lean[i])
+        if cfg.angular_momentum == "jump":
+            if window[i]:
+                pitch = None
+            elif i > 0 and window[i - 1]:
+                # The recovery brings the pelvis from wherever the momentum task left it back upright.
+                lean = lean.copy()
+                lean[i:] = _pelvis_pitch(out[i - 1]) * profile.lean_fraction[i:]
+                pitch = float(lean[i])
+            if not window[i]:
+                angmom = None
         targets = IkTargets(
             com=com0 + profile.com[i],
             feet=feet0 + profile.foot_offset[i],
-            pelvis_pitch=cfg.pelvis_lean * float(profile.lean_fraction[i]),
-            angmom=np.zeros(3),
-            dt=1.0 / cfg.profile.fps,
+            pelvis_pitch=pitch,
+            angmom=angmom,
+            dt=dt,
+            waist_pitch=cfg.waist_lean * float(profile.lean_fraction[i]),
         )
         out[i] = ik.solve(targets)
         worst = max(worst, ik.last_error)
     return out, worst
+
+
+def _pelvis_pitch(q: np.ndarray) -> float:
+    """Pitch of the base about the world y axis [rad] (``atan2(R_02, R_22)``)."""
+    R = np.zeros(9)
+    mujoco.mju_quat2Mat(R, q[3:7])
+    return float(np.arctan2(R[2], R[8]))
 
 
 def _velocities(model: mujoco.MjModel, qpos: np.ndarray, fps: float) -> np.ndarray:
