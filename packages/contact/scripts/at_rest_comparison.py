@@ -7,7 +7,7 @@ quoted in packages/contact/README.md ("At rest").
 * Standing G1: ``simulate_standing`` of packages/train/tests/test_standing_on_sand.py (sole collider 5 x 5, lowered
   over 1 s, settled 1 s, measured 1 s): std of the total vertical foot force / weight, sinkage / static.
 * Box rebound: the box study's 35 kg 0.3 x 0.3 x 0.2 m box (six faces, 6 x 6 cells per face) released 0.1 m above
-  the surface at 1 m/s along x (``gmloco.eval.rom_box``, MuJoCo C free body, 200 Hz), 3 s. Rise = highest CoM after
+  the surface at 1 m/s along x (``gmloco.eval.box.rom``, MuJoCo C free body, 200 Hz), 3 s. Rise = highest CoM after
   the first deepest point minus the CoM settled over the last 0.5 s; e = sqrt(2 g max(rise, 0)) / v_impact.
 """
 
@@ -71,7 +71,7 @@ OPTIONS: dict[str, dict] = {  # rows before the static friction measured with th
 
 def box_rebound(options: dict, media: tuple[str, ...] = BOX_MEDIA, duration: float = 3.0) -> dict[str, tuple]:
     """Return {medium: (rise [m], e, settled sinkage [m], max sinkage [m])} of the box drop."""
-    import gmloco.eval.rom_box as rb
+    import gmloco.eval.box.rom as rb
     from gmloco.eval.box import BoxCfg
 
     box = BoxCfg(duration=duration)
