@@ -39,7 +39,7 @@ def test_dropped_basalt_share_would_have_kept_14_walks() -> None:
     assert cell_seconds(cost, 25, 2000) > 799.0
     n = fit_lanes(cost, 2000, 799.0, 25)
     assert n == 14 and cell_seconds(cost, 15, 2000) > 799.0 >= cell_seconds(cost, 14, 2000)
-    # the square-window runs to the basalt and rough-sand runs wall-clock frames: 0.0399 s + 0.1155 s per million particles, 176,720 particles a lane
+    # wall-clock frames of the square-window table rows: 0.0399 s + 0.1155 s per million particles, 176,720 particles a lane
     real_14 = 35.0 + 2000 * (0.0399 + 0.1155 * 14 * 0.17672)
     assert real_14 < cell_seconds(cost, 14, 2000) < 799.0
 
@@ -67,7 +67,7 @@ def test_model_tracks_the_frames_timed_at_fewer_lanes(lanes: int, measured_s: fl
 
 
 def test_the_prior_reads_the_measured_square_window_frame_and_errs_fast() -> None:
-    """25 lanes of the square window (176,720 particles each) price within 1 % of the basalt and rough-sand runs' 0.549 s frame.
+    """25 lanes of the square window (176,720 particles each) price within 1 % of the 0.549 s frame of the basalt and rough-sand square-window rows.
 
     Fewer rheology sweeps scale the particle term down, more leave it as at 500 (a slower solve is left to the
     probe); the build is the fastest measured.
@@ -78,5 +78,5 @@ def test_the_prior_reads_the_measured_square_window_frame_and_errs_fast() -> Non
     assert prior_cost(176_720, 25, sweeps=1000).frame_s == pytest.approx(full.frame_s)
     half = prior_cost(176_720, 25, sweeps=250).frame_s
     assert half == pytest.approx(0.040 + 0.5 * (full.frame_s - 0.040))
-    # the basalt and rough-sand runs' rough shares, 6.2 min left: the prior builds 5 lanes where the probe-and-refit kept 3
+    # a rough-sand share of the square-window rows, 6.2 min left: the prior builds 5 lanes where the probe-and-refit kept 3
     assert fit_lanes(full, 2000, 6.2 * 60, 25) == 5

@@ -153,7 +153,7 @@ def test_a_fallen_lane_takes_the_next_episode(monkeypatch: pytest.MonkeyPatch) -
     elapsed = [r["elapsed_s"] for r in rows]  # the wall clock since the first frame, in the order the ends came
     assert all(e >= 0.0 for e in elapsed) and elapsed == sorted(elapsed)
     assert [r["end_frame"] for r in rows] == [16, 40, 56, 80, 96]  # the scene's frame at each end (4 per step)
-    # every grid check waits for the frames in flight through the scene's clock first (the square-window runs' clock fix)
+    # every grid check waits for the frames in flight through the scene's clock first (the scene clock's sync)
     ev = scene.events
     assert ev.count("check") >= 5 and all(ev[i - 1] == "sync" for i, e in enumerate(ev) if e == "check")
 

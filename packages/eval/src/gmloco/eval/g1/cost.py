@@ -2,24 +2,24 @@
 """Fitting MPM cells into a time box (issue 9): start only walks that can end before it.
 
 A cell's MPM state (millions of particles) is not checkpointed, so an episode still running at the time box is
-lost with all its frames: the reach-window runs lost two basalt shares whole (25 robots each, walking 6-8 s of their 10 s
+lost with all its frames: the reach-window table rows lost two basalt shares whole (25 robots each, walking 6-8 s of their 10 s
 when the box closed; ~27 GPU-minutes). ``g1.run`` therefore measures what a cell costs in its first stretch
 (:class:`CellCost`: wall seconds per frame with all its lanes walking, and the build) and, when its running walks
 would not end before the time box if no robot fell, stops it and rebuilds it with the lanes that do fit
 (:func:`fit_lanes`); later cells of the same (terrain, scenario) get those lanes before they are built, and a lane
 whose robot fell takes the next episode only while a whole walk still fits. Before anything of a (terrain,
 scenario) is measured, its first cell is sized by :func:`prior_cost` (an H200's frame-cost line): a share started
-near the time box then builds the lanes that can end, or nothing, instead of probing a full cell first (the basalt and rough-sand runs
-spent ~70 s on each of four such probes and ~1.1 min on each of four shares in which no walk fitted). The prediction assumes no robot falls
+near the time box then builds the lanes that can end, or nothing, instead of probing a full cell first (in the basalt and rough-sand square-window
+rows, ~70 s went to each of four such probes and ~1.1 min on each of four shares in which no walk fitted). The prediction assumes no robot falls
 (the worst case): robots that fall end sooner, so a fitted cell ends early rather than late.
 
-Per-frame cost model, from the wall-clock frames of the square-window runs to the basalt and rough-sand runs (H200, 3 cm voxels, 500 sweeps, all lanes
+Per-frame cost model, from the wall-clock frames of the square-window table rows (H200, 3 cm voxels, 500 sweeps, all lanes
 walking; ``benchmarks/mpm_eval/frame_cost.py`` -> ``frame_cost.json``, ``fig_frame_cost.png``): 0.18M particles (one
 lane) 0.059 s, 0.35M 0.083 s, 0.53M 0.098 s, 2.12M 0.288 s, 3.08M 0.400 s, 4.24M 0.534 s, 4.42M 0.549 s a frame,
 i.e. 0.040 s + 0.116 s per million particles: the part that does not shrink with the sand is ~7 % of a full 25-lane
 square-window frame. Lanes of one cell have the same window, so a cell's particles follow its lanes: ``frame_s(n) =
 frame_s(N) (f + (1 - f) n / N)`` with the floor ``f`` = :data:`FRAME_COST_FLOOR`, taken a little above the fit:
-scaled from the 25-lane frame it reads the 1-3-lane cells the basalt and rough-sand runs timed (refitted rough-sand cells, a resumed
+scaled from the 25-lane frame it reads the 1-3-lane cells timed in the basalt and rough-sand square-window rows (refitted rough-sand cells, a resumed
 circle) 2-10 % high and the 12- and 24-lane cells within 1 % (:data:`FIT_MARGIN` covers that).
 """
 
@@ -30,7 +30,7 @@ from dataclasses import dataclass
 FRAME_COST_FLOOR = 0.08
 """Share of a measured frame's wall time that does not shrink with fewer lanes [-] (the fit above: 0.040 s of a
 0.549 s frame at 4.42M particles, 7 %; the rheology sweeps' launches, the robots' MuJoCo step, the coupling).
-The reach-window runs to the basalt and rough-sand runs used 0.10, set before any cell below 12 lanes was timed."""
+0.10 served until cells below 12 lanes were timed (the reach-window and square-window table rows)."""
 FIT_MARGIN = 1.1
 """Predicted stepping time is multiplied by this before it is compared with the time left [-]."""
 FIT_PROBE_S = 30.0
@@ -41,11 +41,11 @@ tables' sizes: past the capture's first slow frames, before most falls)."""
 PRIOR_FRAME_S_AT_ZERO = 0.040
 """Wall seconds of a frame that do not grow with the particles, on an H200 at 500 sweeps [s] (frame-cost fit)."""
 PRIOR_FRAME_S_PER_MILLION = 0.116
-"""Wall seconds of a frame per million particles, on an H200 at 500 sweeps [s] (frame-cost fit, the square-window runs to the basalt and rough-sand runs)."""
+"""Wall seconds of a frame per million particles, on an H200 at 500 sweeps [s] (frame-cost fit of the square-window table rows)."""
 PRIOR_SWEEPS = 500
 """Rheology sweeps the prior was measured at; fewer scale its particle term down, more leave it (optimistic)."""
 PRIOR_BUILD_S = 25.0
-"""Seconds to build and capture a cell, the fastest measured (25-41 s on H200s, the transition-course runs to the basalt and rough-sand runs) [s]."""
+"""Seconds to build and capture a cell, the fastest measured (25-41 s on H200s over the transition-course and square-window table rows) [s]."""
 
 
 @dataclass(frozen=True)
