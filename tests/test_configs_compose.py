@@ -9,7 +9,7 @@ from pathlib import Path
 import pytest
 from omegaconf import DictConfig, OmegaConf
 
-from config_errors import CONF_DIR, group_options, groups
+from config_errors import CONF_DIR, ConfigInputError, group_options, groups
 from schemas import ContactModelName, PipelineCfg, StageCfg, SweepCfg
 from stage_registry import stage_names
 
@@ -48,7 +48,16 @@ def test_every_yaml_is_composed_by_this_module() -> None:
 @pytest.mark.parametrize("scale", ["full", "smoke"])
 @pytest.mark.parametrize("exp", EXPS)
 def test_exp_composes_and_instantiates(compose: Callable[..., DictConfig], exp: str, scale: str) -> None:
-    """``+exp=<exp> +scale=<scale>`` composes, resolves and becomes typed dataclasses."""
+    """``+exp=<exp> +scale=<scale>`` composes, resolves and becomes typed dataclasses.
+
+    ``ppo_rft3d_calibrated`` is bad input until a calibration fit has written its terms: then it must be refused.
+    """
+    from gmloco.train.config import GranularTaskCfg
+
+    if exp == "ppo_rft3d_calibrated" and not Path(GranularTaskCfg().rft_extensions_file).is_file():
+        with pytest.raises(ConfigInputError, match="rft3d_calibrated reads the fitted terms"):
+            compose(f"+exp={exp}", f"+scale={scale}")
+        return
     obj = _instantiate(compose(f"+exp={exp}", f"+scale={scale}"))
     assert obj.exp_name == exp
     assert obj.scale.value == scale
