@@ -195,6 +195,10 @@ class _Hyp:
     dmass: float
     terrain: TerrainParams
     rmis_t: np.ndarray
+    has_backlash: bool
+    """Whether any backlash width is non-zero."""
+    lim: np.ndarray
+    """Static torque limit of each joint [N*m], shape [29]."""
 
 
 _BACKLASH_INDEX = np.array(
@@ -216,11 +220,12 @@ def _unpack(params: dict[str, np.ndarray]) -> _Hyp:
     p = {e.id: e.split(np.asarray(params.get(e.id, np.zeros(e.size)), float)) for e in EFFECTS}
     off = np.zeros(29)
     off[:12] = p["sensor.encoder_offset"]["offset"]
+    limit = 1.0 - float(p["actuator.torque_limit"]["limit_loss"][0])
     return _Hyp(
         delay=float(p["actuator.delay"]["delay"][0]),
         gain=1.0 + float(p["actuator.gain_scale"]["kp_scale"][0]),
         droop=float(p["actuator.torque_speed"]["droop"][0]),
-        limit=1.0 - float(p["actuator.torque_limit"]["limit_loss"][0]),
+        limit=limit,
         tau_c=float(p["joint.coulomb_friction"]["tau_c"][0]),
         b=float(p["joint.viscous_damping"]["b"][0]),
         tau_c_leg=_leg(p["joint.coulomb_friction_leg"]["tau_c"]),
@@ -239,6 +244,8 @@ def _unpack(params: dict[str, np.ndarray]) -> _Hyp:
             cohesion=float(p["terrain.cohesion"]["cohesion"][0]),
         ),
         rmis_t=quat_to_mat(quat_from_roll_pitch(*(float(a) for a in p["imu.misalignment"]["angle"]))).T,
+        has_backlash=bool(p["actuator.backlash"]["width"].any()),
+        lim=G1_EFFORT_LIMIT if limit == 1.0 else limit * G1_EFFORT_LIMIT,
     )
 
 
@@ -250,6 +257,8 @@ class _Seg:
     """Its ``mujoco.MjData``."""
     k0: int
     """Start sample."""
+    damping: np.ndarray
+    """Joint damping of each step (realised kd plus viscous friction) [N*m*s/rad], shape [H+1, 29]."""
     qc: np.ndarray
     """Delayed position commands [rad], shape [H+1, 29]."""
     dqc: np.ndarray
@@ -481,8 +490,9 @@ class Replayer:
     def simulate(self, params: dict[str, np.ndarray], starts: np.ndarray) -> np.ndarray:
         """Simulated measurements at the compare points, shape [S, P, N_CHANNELS].
 
-        All segments are stepped side by side (one MjData each), so the sand forces of every segment are
-        computed in one vectorised call per physics step; each segment's arithmetic is that of a lone replay.
+        On sand all segments are stepped side by side (one MjData each), so the sand forces of every segment are
+        computed in one vectorised call per physics step; on the plane, and for a welded pelvis, the segments run
+        one after the other in one MjData. Either way each segment's arithmetic is that of a lone replay.
 
         Args:
             params: ``{effect_id: flat parameter vector}``; missing ids are nominal.
@@ -492,9 +502,15 @@ class Replayer:
         self._set_model(h)
         base = self.base(params, starts)
         out = np.zeros((len(starts), len(self.offsets), N_CHANNELS))
+        if self.sand is None:
+            return self._simulate_serial(h, base, starts, out)
+        self._zmax0 = self.crater_memory(params)[starts].reshape(-1)
+        return self._simulate_side_by_side(h, base, starts, out)
+
+    def _simulate_side_by_side(self, h: _Hyp, base: BaseTrajectory, starts: np.ndarray, out: np.ndarray) -> np.ndarray:
+        """Step all segments together, one ``MjData`` each, so the ground forces take one call per step."""
         datas = self._datas(len(starts))
         segs = [self._seg_start(h, base, s, int(k0), datas[s]) for s, k0 in enumerate(starts)]
-        self._zmax0 = self.crater_memory(params)[starts].reshape(-1) if self.sand is not None else None
         p = 0
         for j in range(self.cfg.horizon + 1):
             for sub in range(self.cfg.substeps):
@@ -505,6 +521,27 @@ class Replayer:
                 for seg, o in zip(segs, out, strict=True):
                     self._seg_post(h, seg, j, o[p] if at_compare else None)
                 p += int(at_compare)
+        return out
+
+    def _simulate_serial(self, h: _Hyp, base: BaseTrajectory, starts: np.ndarray, out: np.ndarray) -> np.ndarray:
+        """Replay the segments one after the other in one ``MjData`` (plane or welded pelvis); fills ``out``.
+
+        Without sand no force couples the segments, so each one runs its whole horizon before the next starts.
+        The arithmetic is that of the side-by-side loop, bit for bit, but one ``MjData`` stays in the CPU cache:
+        stepping hundreds of them in turn (each touches ~1 MB) made ``mj_step1`` cost 2-4x its lone cost.
+        """
+        d = self._datas(1)[0]
+        n_cmp = len(self.offsets)
+        for s, k0 in enumerate(starts):
+            seg = self._seg_start(h, base, s, int(k0), d)
+            p = 0
+            for j in range(self.cfg.horizon + 1):
+                for sub in range(self.cfg.substeps):
+                    at_compare = sub == 0 and p < n_cmp and j == self.offsets[p]
+                    self._seg_pre(h, seg, j, at_compare)
+                    self._ground(h, [d], reset=j == 0 and sub == 0)
+                    self._seg_post(h, seg, j, out[s, p] if at_compare else None)
+                    p += int(at_compare)
         return out
 
     def _seg_start(self, h: _Hyp, base: BaseTrajectory, s: int, k0: int, d: Any) -> _Seg:
@@ -521,7 +558,8 @@ class Replayer:
         d.qpos[self._jq] = r.q[k0] - h.offset
         d.qvel[self._jv] = r.dq[k0]
         qc, dqc, tff = self._commands(k0, h.delay)
-        return _Seg(d, k0, qc, dqc, tff, pelvis_quat=base.quat[s] if self.fixed else None)
+        damping = h.gain * r.kd[k0 : k0 + self.cfg.horizon + 1] + h.b * self._w + h.b_leg
+        return _Seg(d, k0, damping, qc, dqc, tff, pelvis_quat=base.quat[s] if self.fixed else None)
 
     def _seg_pre(self, h: _Hyp, seg: _Seg, j: int, at_compare: bool) -> None:
         """First half of a physics step of one segment: kinematics, motor torques (PD on the encoders)."""
@@ -531,7 +569,7 @@ class Replayer:
         k = seg.k0 + j
         kp, kd = r.kp[k], r.kd[k]
         # Damping enters qfrc_passive in mj_step1 and the implicit Euler update in mj_step2: set it first.
-        m.dof_damping[self._jv] = h.gain * kd + h.b * self._w + h.b_leg
+        m.dof_damping[self._jv] = seg.damping[j]
         if seg.pelvis_quat is not None:  # segments share the model: put this segment's welded pelvis in place
             m.body_quat[self._pelvis] = seg.pelvis_quat
         mujoco.mj_step1(m, d)
@@ -540,12 +578,11 @@ class Replayer:
         seg.qm = d.qpos[self._jq] + h.offset
         v = d.qvel[self._jv]
         err = seg.qc[j] - seg.qm
-        if h.backlash.any():  # dead band of the position loop; at zero width the error passes unchanged
+        if h.has_backlash:  # dead band of the position loop; at zero width the error passes unchanged
             err = err - np.clip(err, -0.5 * h.backlash, 0.5 * h.backlash)
         tau = h.gain * (kp * err + kd * (seg.dqc[j] - v)) + seg.tff[j]
-        lim = G1_EFFORT_LIMIT if h.limit == 1.0 else h.limit * G1_EFFORT_LIMIT
-        lim = lim if h.droop == 0.0 else lim * np.clip(1.0 - h.droop * np.abs(v), 0.0, None)
-        seg.tau = np.clip(tau, -lim, lim)
+        lim = h.lim if h.droop == 0.0 else h.lim * np.clip(1.0 - h.droop * np.abs(v), 0.0, None)
+        seg.tau = np.minimum(np.maximum(tau, -lim), lim)  # np.clip, without its Python dispatch
         # The -kd*dq part is integrated implicitly through dof_damping (Euler integrator), so add it back.
         d.qfrc_applied[self._jv] = seg.tau + h.gain * kd * v
 
@@ -554,7 +591,7 @@ class Replayer:
         import mujoco
 
         m, d = self.model, seg.d
-        m.dof_damping[self._jv] = h.gain * self.rec.kd[seg.k0 + j] + h.b * self._w + h.b_leg
+        m.dof_damping[self._jv] = seg.damping[j]
         mujoco.mj_step2(m, d)
         if out is None:
             return
