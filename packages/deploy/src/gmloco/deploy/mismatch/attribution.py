@@ -97,9 +97,13 @@ class Hypothesis:
     spec: EffectSpec
     """The effect."""
     sens: np.ndarray
-    """Sensitivities on all segments, shape [S, P, N_CHANNELS, k]."""
+    """Sensitivities on the training segments, shape [S_train, P, N_CHANNELS, k] (screening reads no held-out
+    segment, so none is replayed)."""
     testable: bool
     """Whether a tolerance-sized change is visible above the noise."""
+    tol_energy_seg: np.ndarray | None = None
+    """Normalised residual energy a tolerance-sized change of each parameter makes on each training segment,
+    shape [S_train, k] (which recordings of a stack excite the effect)."""
     dbic_lin: float = -np.inf
     """Linearised Delta-BIC from screening."""
     energy_lin: float = 0.0
@@ -217,12 +221,16 @@ def simulate_many(
 def screen(
     pb: Problem, r0: np.ndarray, y0: np.ndarray, n_eff: float, cfg: AttributionCfg, progress: Any = None
 ) -> list[Hypothesis]:
-    """Screen every effect with finite-difference sensitivities at zero (one replay per component)."""
+    """Screen every effect with finite-difference sensitivities at zero (one replay per component).
+
+    Only the training segments are replayed: every screening statistic is a training-segment statistic, and the
+    held-out segments are first simulated by the confirmatory fits.
+    """
     out = []
-    w = pb.weight / pb.sigma
+    w = pb.scale(pb.train)
     specs = [spec for spec in EFFECTS if cfg.effects is None or spec.id in cfg.effects]
     plist, hs = [], []
-    inert = {spec.id for spec in specs if spec.ground and pb.rp.fixed}  # a held robot touches nothing
+    inert = {spec.id for spec in specs if spec.ground and pb.fixed}  # a held robot touches nothing
     for spec in specs:
         if spec.id in inert:
             continue
@@ -232,20 +240,22 @@ def screen(
             th[i] = h if hi[i] >= h else -h
             plist.append(_sim_params(spec, th))
             hs.append(th[i])
-    sims = iter(simulate_many(pb, plist, workers=cfg.workers, progress=progress))
+    sims = iter(simulate_many(pb, plist, pb.train, workers=cfg.workers, progress=progress))
+    y0_train, r0_train = y0[pb.train], r0[pb.train]
     steps_all = iter(hs)
     for spec in specs:
         if spec.id in inert:
-            sens = np.zeros((*y0.shape, spec.size))
+            sens = np.zeros((*y0_train.shape, spec.size))
             if progress:
                 for _ in range(spec.size):
                     progress()
         else:
-            sens = np.stack([(next(sims) - y0) / next(steps_all) * w for _ in range(spec.size)], axis=-1)
-        tol_energy = np.max(np.sum((sens[pb.train] * spec.flat("tolerance")) ** 2, axis=(0, 1, 2)))
+            sens = np.stack([(next(sims) - y0_train) / next(steps_all) * w for _ in range(spec.size)], axis=-1)
+        tol_energy = np.max(np.sum((sens * spec.flat("tolerance")) ** 2, axis=(0, 1, 2)))
         hyp = Hypothesis(spec, sens, testable=bool(tol_energy >= cfg.testable_energy))
-        S = sens[pb.train].reshape(-1, spec.size)
-        rt = r0[pb.train].ravel()
+        hyp.tol_energy_seg = np.sum((sens * spec.flat("tolerance")) ** 2, axis=(1, 2))
+        S = sens.reshape(-1, spec.size)
+        rt = r0_train.ravel()
         theta, *_ = np.linalg.lstsq(S, rt, rcond=None)
         lo, hi = spec.bounds()
         theta = np.clip(theta, lo, hi)
@@ -256,7 +266,7 @@ def screen(
         hyp.energy_lin = rss0 - rss1
         # n_eff of the *fitted* residual: a large systematic mismatch makes the nominal residual nearly rank one,
         # and its n_eff (a handful) would then penalise exactly the effect that explains it.
-        ne = max(n_eff, effective_samples(fit_r.reshape(r0[pb.train].shape)))
+        ne = max(n_eff, effective_samples(fit_r.reshape(r0_train.shape)))
         hyp.dbic_lin = ne * np.log(rss0 / max(rss1, 1e-300)) - spec.size * np.log(ne)
         out.append(hyp)
     return out
@@ -306,7 +316,7 @@ def _lm_iterate(
             plist.append(_sim_params(spec, th))
             hs.append(h)
         for i, y in enumerate(simulate_many(pb, plist, m, workers)):
-            J[:, i] = (((pb.y[m] - y) / pb.sigma * pb.weight).ravel() - r) / hs[i]
+            J[:, i] = (pb.normalise(y, m).ravel() - r) / hs[i]
         g, A = J.T @ r, J.T @ J
         improved = False
         for _ in range(3):
@@ -511,7 +521,7 @@ def confirm(
 def decide(pb: Problem, r0: np.ndarray, ranked: list[Hypothesis], cfg: AttributionCfg) -> dict:
     """Return the verdict and the evidence it rests on."""
     held = r0[pb.held]
-    active = float(np.mean(pb.weight > 0))
+    active = float(np.mean(np.broadcast_to(pb.weight > 0, r0.shape)[pb.held]))
     ratio = float(np.mean(held**2) / max(active, 1e-9))
     e0 = float(np.sum(held**2))
     floor_e = held.size * active

@@ -1,10 +1,14 @@
 # SPDX-License-Identifier: Apache-2.0
-"""``gmloco-mismatch --real REAL.mcap [--sim SIM.mcap] --out DIR``: find, name and fit the missing physics."""
+"""``gmloco-mismatch --real REAL.mcap [--real MORE.mcap ...] [--sim SIM.mcap] --out DIR``: name the missing physics.
+
+Several ``--real`` recordings of one robot make one diagnosis.
+"""
 
 from __future__ import annotations
 
 import argparse
 import json
+import os
 import sys
 from dataclasses import replace
 from pathlib import Path
@@ -15,7 +19,14 @@ __all__ = ["main"]
 def _parser() -> argparse.ArgumentParser:
     """Command-line interface."""
     p = argparse.ArgumentParser(prog="gmloco-mismatch", description=__doc__)
-    p.add_argument("--real", required=True, type=Path, help="real G1 recording (MCAP, project schema)")
+    p.add_argument(
+        "--real",
+        required=True,
+        type=Path,
+        action="append",
+        help="real G1 recording (MCAP, project schema); repeat it to combine several recordings of one robot "
+        "(same robot, joint order and sample rate) into one diagnosis",
+    )
     p.add_argument(
         "--sim", type=Path, default=None, help="simulated counterpart; default: replay the real commands in MuJoCo"
     )
@@ -52,19 +63,36 @@ def _parser() -> argparse.ArgumentParser:
     return p
 
 
+_BLAS_THREAD_VARS = ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS")
+
+
+def _one_blas_thread() -> None:
+    """Ask numpy's BLAS for one thread unless the caller chose otherwise.
+
+    The analysis runs its parallel work in ``--workers`` processes; a BLAS thread pool per process on top of them
+    oversubscribes the cores, and idle pool threads spin after every call. Takes effect only if numpy is not
+    imported yet (the command line), never for a caller that imported it first.
+    """
+    if "numpy" not in sys.modules:
+        for var in _BLAS_THREAD_VARS:
+            os.environ.setdefault(var, "1")
+
+
 def main(argv: list[str] | None = None) -> int:
     """Run the analysis; exit code 0 for a report on valid input, 2 for unreadable or invalid input.
 
     Every contract finding is printed; an ``invalid_input`` verdict (any contract error) still writes its report,
     which says what is wrong, and exits with 2.
     """
+    _one_blas_thread()
     from rich.console import Console
     from rich.markup import escape
     from rich.progress import Progress
 
     from gmloco.deploy.mismatch.effects import check_effect_ids
     from gmloco.deploy.mismatch.io import read_recording
-    from gmloco.deploy.mismatch.pipeline import AnalysisCfg, analyze
+    from gmloco.deploy.mismatch.multi import analyze_many
+    from gmloco.deploy.mismatch.pipeline import AnalysisCfg
     from gmloco.deploy.mismatch.replay import parse_ground, replay_cfg_for_rate
     from gmloco.deploy.mismatch.report import write_report
 
@@ -75,11 +103,13 @@ def main(argv: list[str] | None = None) -> int:
     except ValueError as exc:
         console.print(f"[red]error:[/] --effects: {escape(str(exc))} Nothing was analysed.")
         return 2
-    try:
-        rec = read_recording(args.real)
-    except (OSError, ValueError) as exc:
-        console.print(f"[red]cannot read {args.real}: {exc}")
-        return 2
+    recs = []
+    for path in args.real:
+        try:
+            recs.append(read_recording(path))
+        except (OSError, ValueError) as exc:
+            console.print(f"[red]cannot read {path}: {exc}")
+            return 2
     if args.sim is not None:
         console.print(
             "[yellow]--sim given: the simulated log is checked for its contract only; residuals come from replay at the real states (short horizons), which a free-running sim log cannot provide."
@@ -90,10 +120,10 @@ def main(argv: list[str] | None = None) -> int:
             console.print(f"[red]cannot read {args.sim}: {exc}")
             return 2
     if args.support is not None:
-        rec = replace(rec, support=args.support)
+        recs = [replace(rec, support=args.support) for rec in recs]
     try:  # the physics step and the time spans follow the recording's rate (MPM recordings are 50 Hz, a G1 500 Hz)
         ground, material = parse_ground(args.ground)
-        replay = replay_cfg_for_rate(1.0 / rec.dt, ground, material, args.horizon)
+        replay = replay_cfg_for_rate(1.0 / recs[0].dt, ground, material, args.horizon)
     except ValueError as exc:  # a misspelt --ground or a --horizon below 1 sample
         console.print(f"[red]--{exc}")
         return 2
@@ -105,7 +135,7 @@ def main(argv: list[str] | None = None) -> int:
     cfg.attribution.workers = args.workers
     with Progress(console=console) as prog:
         task = prog.add_task("mismatch", total=1.0)
-        res = analyze(rec, cfg, lambda msg, f: prog.update(task, completed=f, description=msg))
+        res = analyze_many(recs, cfg, lambda msg, f: prog.update(task, completed=f, description=msg))
     write_report(res, args.out, plots=not args.no_plots)
     r = res.report
     for issue in r.get("contract", []):

@@ -9,7 +9,7 @@ from dataclasses import dataclass, field, replace
 
 import numpy as np
 
-from gmloco.deploy.mismatch.attribution import AttributionCfg, confirm, decide, screen, second_round
+from gmloco.deploy.mismatch.attribution import AttributionCfg, Hypothesis, confirm, decide, screen, second_round
 from gmloco.deploy.mismatch.contract import ContractCfg, ContractError, ContractIssue, check_recording
 from gmloco.deploy.mismatch.effects import EFFECTS, check_effect_ids
 from gmloco.deploy.mismatch.localize import localize
@@ -23,8 +23,9 @@ from gmloco.deploy.mismatch.segmentation import (
     motion_phases,
     segment_phases,
 )
+from gmloco.deploy.mismatch.stages import recording_stage
 
-__all__ = ["AnalysisCfg", "AnalysisResult", "analyze"]
+__all__ = ["AnalysisCfg", "AnalysisResult", "Attribution", "analyze", "attribute"]
 
 
 @dataclass
@@ -110,6 +111,49 @@ def _invalid(issues: list[ContractIssue], rec: Recording | None, t0: float) -> A
     )
 
 
+@dataclass
+class Attribution:
+    """What :func:`attribute` found on one residual problem."""
+
+    y0: np.ndarray
+    """Nominal simulation, shape [S, P, N_CHANNELS]."""
+    r0: np.ndarray
+    """Nominal normalised residual, shape [S, P, N_CHANNELS]."""
+    n_eff: float
+    """Effective number of independent training residuals."""
+    hyps: list[Hypothesis]
+    """Screened effects."""
+    ranked: list[Hypothesis]
+    """Fitted effects, best first."""
+    decision: dict
+    """Verdict and its evidence (:func:`decide`)."""
+
+
+def attribute(pb: Problem, cfg: AnalysisCfg, say: Callable[[str, float], None]) -> Attribution:
+    """Nominal replay, screening, confirmatory fits (and a second round if unexplained), and the verdict."""
+    y0 = pb.simulate({})
+    r0 = pb.normalise(y0)
+    n_eff = effective_samples(r0[pb.train])
+    ids = cfg.attribution.effects
+    ncols = sum(e.size for e in EFFECTS if ids is None or e.id in ids)
+    done = [0]
+
+    def tick() -> None:
+        done[0] += 1
+        say("screening effects", 0.1 + 0.5 * done[0] / ncols)
+
+    hyps = screen(pb, r0, y0, n_eff, cfg.attribution, tick)
+    say("confirmatory fits", 0.6)
+    ranked = confirm(pb, hyps, r0, cfg.attribution, lambda: say("confirmatory fits", 0.8))
+    decision = decide(pb, r0, ranked, cfg.attribution)
+    if decision["verdict"] == "unexplained" and cfg.attribution.top_k_extra > 0:
+        say("second-round fits", 0.8)
+        extra = confirm(pb, hyps, r0, cfg.attribution, candidates=second_round(hyps, ranked, cfg.attribution))
+        ranked = sorted(ranked + extra, key=lambda h: (not h.passed, -h.heldout_gain))
+        decision = decide(pb, r0, ranked, cfg.attribution)
+    return Attribution(y0, r0, n_eff, hyps, ranked, decision)
+
+
 def analyze(
     rec: Recording, cfg: AnalysisCfg | None = None, progress: Callable[[str, float], None] | None = None
 ) -> AnalysisResult:
@@ -143,26 +187,8 @@ def analyze(
             "length", "error", f"only {len(pb.starts)} valid shooting segments: record at least ~5 s without gaps"
         )
         return _invalid([*issues, short], rec, t0)
-    y0 = pb.simulate({})
-    r0 = (pb.y - y0) / pb.sigma * pb.weight
-    n_eff = effective_samples(r0[pb.train])
-    ids = cfg.attribution.effects
-    ncols = sum(e.size for e in EFFECTS if ids is None or e.id in ids)
-    done = [0]
-
-    def tick() -> None:
-        done[0] += 1
-        say("screening effects", 0.1 + 0.5 * done[0] / ncols)
-
-    hyps = screen(pb, r0, y0, n_eff, cfg.attribution, tick)
-    say("confirmatory fits", 0.6)
-    ranked = confirm(pb, hyps, r0, cfg.attribution, lambda: say("confirmatory fits", 0.8))
-    decision = decide(pb, r0, ranked, cfg.attribution)
-    if decision["verdict"] == "unexplained" and cfg.attribution.top_k_extra > 0:
-        say("second-round fits", 0.8)
-        extra = confirm(pb, hyps, r0, cfg.attribution, candidates=second_round(hyps, ranked, cfg.attribution))
-        ranked = sorted(ranked + extra, key=lambda h: (not h.passed, -h.heldout_gain))
-        decision = decide(pb, r0, ranked, cfg.attribution)
+    att = attribute(pb, cfg, say)
+    y0, r0, n_eff, hyps, ranked, decision = att.y0, att.r0, att.n_eff, att.hyps, att.ranked, att.decision
     say("localisation", 0.9)
     phases_all, labels, columns = _phases(rec, rp, cfg.segmentation)
     idx = pb.starts[:, None] + rp.offsets[None, :]
@@ -174,7 +200,10 @@ def analyze(
     fitted = pb.simulate(params) if params else y0
     from gmloco.deploy.mismatch.report import build_report
 
-    report = build_report(rec, pb, hyps, ranked, decision, loc, issues, r0, fitted, n_eff, time.time() - t0)
+    stage = recording_stage(rec)
+    report = build_report(
+        rec, pb, hyps, ranked, decision, loc, issues, r0, fitted, n_eff, time.time() - t0, {stage} if stage else set()
+    )
     arrays = {
         "y": pb.y,
         "y0": y0,

@@ -49,9 +49,9 @@ def make_plots(result: Any, out: Path) -> list[Path]:
     h = a.get("winner")
     if h is not None:
         # 3. residual vs the winning regressor (first component), and 4. parameter intervals
-        s = h.sens[..., 0].ravel()
+        s = h.sens[..., 0].ravel()  # screening sensitivities exist on the training segments only
         fig, ax = plt.subplots(figsize=(5, 4))
-        ax.plot(s, r0.ravel(), ",", alpha=0.3)
+        ax.plot(s, r0[~a["held"]].ravel(), ",", alpha=0.3)
         ax.set_xlabel(f"sensitivity d y / d {h.spec.labels()[0]} (normalised)")
         ax.set_ylabel("nominal residual (normalised)")
         ax.set_title(h.spec.id)

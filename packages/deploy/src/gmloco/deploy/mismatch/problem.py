@@ -149,7 +149,21 @@ class Problem:
         st = self.starts if mask is None else self.starts[mask]
         return self.rp.simulate(params, st)
 
+    @property
+    def fixed(self) -> bool:
+        """Whether the pelvis is held (ground effects are inert)."""
+        return self.rp.fixed
+
+    def scale(self, mask: np.ndarray) -> np.ndarray:
+        """``weight / sigma``, broadcastable to the segments of ``mask``, shape [N_CHANNELS]."""
+        return self.weight / self.sigma
+
+    def normalise(self, y_sim: np.ndarray, mask: np.ndarray | None = None) -> np.ndarray:
+        """Normalised residual of simulated measurements ``y_sim`` on the segments of ``mask``."""
+        m = np.ones(len(self.starts), bool) if mask is None else mask
+        return (self.y[m] - y_sim) / self.sigma * self.weight
+
     def resid(self, params: dict[str, np.ndarray], mask: np.ndarray | None = None) -> np.ndarray:
         """Normalised residual on the selected segments, shape [S', P, N_CHANNELS]."""
         m = np.ones(len(self.starts), bool) if mask is None else mask
-        return (self.y[m] - self.simulate(params, m)) / self.sigma * self.weight
+        return self.normalise(self.simulate(params, m), m)

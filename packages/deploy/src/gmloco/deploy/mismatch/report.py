@@ -34,6 +34,7 @@ import numpy as np
 
 from gmloco.deploy.mismatch.effects import EffectSpec
 from gmloco.deploy.mismatch.replay import CHANNEL_GROUPS
+from gmloco.deploy.mismatch.stages import STAGES, stage_to_record
 
 __all__ = ["SCHEMA", "build_report", "write_report"]
 
@@ -71,11 +72,28 @@ def _group_nrmse(pb: Any, sim: np.ndarray) -> dict[str, float]:
     for g, w in CHANNEL_GROUPS:
         sl = slice(c, c + w)
         c += w
-        if not np.any(pb.weight[sl] > 0):
+        if not np.any(pb.weight[..., sl] > 0):
             continue
         err = np.sqrt(np.mean((y[..., sl] - sim[pb.held][..., sl]) ** 2))
         out[g] = float(err / max(np.std(y[..., sl]), 1e-12))
     return out
+
+
+def _untested(h: Any, fixed: bool, done_stages: set[str]) -> dict:
+    """Why an effect could not be tested here, and the protocol stage to record for it."""
+    stage = stage_to_record(h.spec.id, done_stages)
+    why = (
+        "the pelvis is held and touches nothing"
+        if h.spec.ground and fixed
+        else "a tolerance-sized change stays below the noise floor on this recording"
+    )
+    return {
+        "id": h.spec.id,
+        "reason": f"untestable here: record stage {stage} ({STAGES[stage]}); {why}",
+        "stage": stage,
+        "record": f"python -m gmloco.deploy.mismatch.benchmark.make_recording --stage {stage}",
+        "needs": h.spec.excitation,
+    }
 
 
 def build_report(
@@ -90,8 +108,10 @@ def build_report(
     fitted: np.ndarray,
     n_eff: float,
     runtime: float,
+    done_stages: set[str] | None = None,
 ) -> dict:
-    """Assemble the report dict."""
+    """Assemble the report dict; ``done_stages`` are the protocol stages the recordings already are."""
+    done_stages = done_stages if done_stages is not None else set()
     confirmed = {h.spec.id for h in ranked}
     order = ranked + sorted([h for h in hyps if h.spec.id not in confirmed], key=lambda h: -h.dbic_lin)
     bics = np.array([h.dbic if h.spec.id in confirmed else -np.inf for h in order] + [0.0])
@@ -133,7 +153,7 @@ def build_report(
     win = next((h for h in ranked if h.spec.id == decision["winner"]), None)
     c, floor = 0, {}
     for g, wd in CHANNEL_GROUPS:
-        floor[g] = float(np.median(pb.sigma[c : c + wd]))
+        floor[g] = float(np.median(pb.sigma[..., c : c + wd]))
         c += wd
     return {
         "schema": SCHEMA,
@@ -162,18 +182,7 @@ def build_report(
             "windows": loc["windows"],
         },
         "hypotheses": hyp_out,
-        "untested": [
-            {
-                "id": h.spec.id,
-                "reason": "untestable here: the pelvis is held and touches nothing; record a stage on the ground "
-                "(standing, stepping in place, walking)"
-                if h.spec.ground and rec.fixed_base
-                else "a tolerance-sized change stays below the noise floor on this recording",
-                "needs": h.spec.excitation,
-            }
-            for h in hyps
-            if not h.testable
-        ],
+        "untested": [_untested(h, pb.fixed, done_stages) for h in hyps if not h.testable],
         "before_after": {
             "heldout": {
                 # r0 carries the group-balance weights: divide them out to recover the nominal simulation
