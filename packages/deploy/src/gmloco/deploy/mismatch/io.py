@@ -85,6 +85,7 @@ def read_recording(path: str | Path, rate_hz: float | None = None) -> Recording:
         meta={
             "path": str(path),
             "controller": log.metadata.controller,
+            "robot": log.metadata.robot,
             "material": log.metadata.material,
             "derived_signals": _derived_signals(log.metadata),
         },

@@ -54,9 +54,11 @@ effects in isolation; standing the static ones; stepping the touchdowns and lift
 envelope and varied impacts; turning the yaw rate that a mounting rotation mixes into the other gyro axes)."""
 
 _CONTROLLER_STAGE: dict[str, Stage] = {
+    "scripted_chirp": "chirp",
     "scripted_stand": "stand",
     "scripted_step": "step",
     "scripted_walk": "walk",
+    "stage_chirp": "chirp",
     "stage_stand": "stand",
     "stage_step": "step",
     "stage_walk": "walk",

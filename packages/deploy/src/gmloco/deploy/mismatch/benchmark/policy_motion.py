@@ -15,7 +15,15 @@ import numpy as np
 
 from gmloco.deploy.logs.g1 import G1_JOINT_NAMES
 
-__all__ = ["COMPOSITE_SCHEDULE", "MOTIONS", "PolicyMotion", "PolicyMotionCfg", "motion_cfg"]
+__all__ = [
+    "COMPOSITE_SCHEDULE",
+    "MOTIONS",
+    "TURN_SCHEDULE",
+    "WALK_SPEEDS_SCHEDULE",
+    "PolicyMotion",
+    "PolicyMotionCfg",
+    "motion_cfg",
+]
 
 Segment = tuple[float, float, float, float]
 """One command-schedule segment: (start time [s], forward speed [m/s], lateral speed [m/s], yaw rate [rad/s])."""
@@ -57,7 +65,24 @@ class PolicyMotionCfg:
         return np.array(cur[1:], float)
 
 
-MOTIONS: dict[str, float] = {"walk": 8.0, "composite": 18.0}
+WALK_SPEEDS_SCHEDULE: tuple[Segment, ...] = (
+    (0.0, 0.0, 0.0, 0.0),
+    (1.0, 0.5, 0.0, 0.0),
+    (4.0, 1.0, 0.0, 0.0),
+    (7.0, 1.5, 0.0, 0.0),
+)
+"""The protocol's walking stage: stand 1 s, then 3 s each at 0.5, 1.0 and 1.5 m/s (10 s in all)."""
+
+TURN_SCHEDULE: tuple[Segment, ...] = (
+    (0.0, 0.0, 0.0, 0.0),
+    (1.0, 0.8, 0.0, 0.0),
+    (2.0, 0.8, 0.0, 0.5),
+    (5.0, 0.8, 0.0, -0.5),
+)
+"""The protocol's turning stage: stand 1 s, walk 1 s at 0.8 m/s, then turn left and right at 0.5 rad/s, 3 s each
+(8 s in all)."""
+
+MOTIONS: dict[str, float] = {"walk": 8.0, "composite": 18.0, "walk_speeds": 10.0, "turn": 8.0}
 """Named sand-suite motions and their recording lengths [s]: ``walk`` (1 m/s after 0.5 s standing, the suite's
 motion through v3) and ``composite`` (:data:`COMPOSITE_SCHEDULE`)."""
 
@@ -68,6 +93,10 @@ def motion_cfg(name: str = "walk") -> PolicyMotionCfg:
         return PolicyMotionCfg()
     if name == "composite":
         return PolicyMotionCfg(schedule=COMPOSITE_SCHEDULE)
+    if name == "walk_speeds":
+        return PolicyMotionCfg(schedule=WALK_SPEEDS_SCHEDULE)
+    if name == "turn":
+        return PolicyMotionCfg(schedule=TURN_SCHEDULE)
     raise ValueError(f"unknown motion {name!r}; known: {sorted(MOTIONS)}")
 
 
