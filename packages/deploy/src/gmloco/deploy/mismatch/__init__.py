@@ -6,7 +6,8 @@ LowCmd from the logged states in MuJoCo C (:mod:`.replay`, base state from odome
 :mod:`.baseest`) -> normalised residuals over a noise floor (:mod:`.problem`) -> stance/swing segmentation
 (:mod:`.segmentation`) and localisation (:mod:`.localize`) -> screening, confirmatory fits and model selection
 over the effect library (:mod:`.effects`, :mod:`.attribution`) -> ``report.json`` / ``report.md`` / config patch
-(:mod:`.report`). CLI: ``gmloco.deploy.mismatch.cli:main``. MuJoCo, SciPy and Matplotlib are imported lazily.
+(:mod:`.report`). Several recordings of one robot: :func:`analyze_many` (:mod:`.multi`, :mod:`.stack`); which
+protocol stage excites which effect: :mod:`.stages`. CLI: ``gmloco.deploy.mismatch.cli:main``. MuJoCo, SciPy and Matplotlib are imported lazily.
 """
 
 from gmloco.deploy.mismatch.effects import (
@@ -18,6 +19,7 @@ from gmloco.deploy.mismatch.effects import (
     check_effect_ids,
     effect,
 )
+from gmloco.deploy.mismatch.multi import analyze_many
 from gmloco.deploy.mismatch.pipeline import AnalysisCfg, AnalysisResult, analyze
 from gmloco.deploy.mismatch.recording import Recording
 
@@ -31,6 +33,7 @@ __all__ = [
     "ParamSpec",
     "Recording",
     "analyze",
+    "analyze_many",
     "check_effect_ids",
     "effect",
 ]

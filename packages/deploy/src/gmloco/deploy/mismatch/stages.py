@@ -91,4 +91,7 @@ def stage_to_record(effect_id: str, done: set[str] | frozenset[str] = frozenset(
     of it is what is missing.
     """
     stages = effect_stages(effect_id)
-    return next((s for s in stages if s not in done), stages[0])
+    for s in stages:
+        if s not in done:
+            return s
+    return stages[0]
