@@ -86,6 +86,10 @@ class _RoughBowl:
         """The replay whose residual against the zero recording is :meth:`resid` (y - sim) / sigma * weight."""
         return -self.resid(params, mask).reshape(self.y.shape)
 
+    def normalise(self, y_sim: np.ndarray, mask: np.ndarray | None = None) -> np.ndarray:
+        """Normalised residual of a replay, as :meth:`gmloco.deploy.mismatch.problem.Problem.normalise`."""
+        return (self.y - y_sim) / self.sigma * self.weight
+
     def resid(self, params: dict[str, np.ndarray], mask: np.ndarray | None = None) -> np.ndarray:
         self.calls += 1
         th = params[self.spec_id]
