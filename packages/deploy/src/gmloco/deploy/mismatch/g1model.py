@@ -17,6 +17,7 @@ from typing import Any, Literal
 
 import numpy as np
 
+from gmloco.deploy import g1
 from gmloco.deploy.logs.g1 import G1_JOINT_NAMES
 from gmloco.deploy.mismatch.sand import SandCfg
 
@@ -30,35 +31,10 @@ __all__ = [
     "g1_mjcf_path",
 ]
 
-# Reflected rotor inertia [kg*m^2] and effort limit [N*m] per motor type, from mjlab 1.6.0
-# asset_zoo/robots/unitree_g1/g1_constants.py (ARMATURE_*, ACTUATOR_*.effort_limit); ankles and waist
-# roll/pitch are 4-bar linkages driven by two 5020 motors (mjlab sums their armature).
-_MOTORS: dict[str, tuple[float, float]] = {
-    "7520_14": (0.01017752004132231, 88.0),
-    "7520_22": (0.025101924999999997, 139.0),
-    "5020": (0.003609725, 25.0),
-    "5020x2": (2 * 0.003609725, 50.0),
-    "4010": (0.00425, 5.0),
-}
-
-
-def _motor(name: str) -> str:
-    """Motor type of a G1 joint (mjlab's grouping)."""
-    if any(k in name for k in ("hip_pitch", "hip_yaw", "waist_yaw")):
-        return "7520_14"
-    if any(k in name for k in ("hip_roll", "knee")):
-        return "7520_22"
-    if any(k in name for k in ("ankle", "waist_roll", "waist_pitch")):
-        return "5020x2"
-    if any(k in name for k in ("wrist_pitch", "wrist_yaw")):
-        return "4010"
-    return "5020"
-
-
-G1_ARMATURE: np.ndarray = np.array([_MOTORS[_motor(n)][0] for n in G1_JOINT_NAMES])
-"""Nominal reflected rotor inertia per joint [kg*m^2], canonical order, shape [29]."""
-G1_EFFORT_LIMIT: np.ndarray = np.array([_MOTORS[_motor(n)][1] for n in G1_JOINT_NAMES])
-"""Nominal torque limit per joint [N*m], canonical order, shape [29]."""
+G1_ARMATURE: np.ndarray = np.array(g1.G1_ARMATURE)
+"""Nominal reflected rotor inertia per joint [kg*m^2], canonical order, shape [29] (``gmloco.deploy.g1``)."""
+G1_EFFORT_LIMIT: np.ndarray = np.array(g1.G1_EFFORT_LIMIT)
+"""Nominal torque limit per joint [N*m], canonical order, shape [29] (``gmloco.deploy.g1``)."""
 
 # Sole sample points in the ankle-roll link frame [m]: a 4 x 2 grid under the seven foot capsules of the
 # MJCF (capsules span x in [-0.054, 0.132], y in [-0.027, 0.027], centre z = -0.025, radius 0.01).
@@ -131,7 +107,7 @@ def build_model(cfg: G1SimCfg | None = None, spec_edit: Any = None) -> Any:
     floor.contype, floor.conaffinity = 0, 1
     for j in spec.joints:
         if j.name in G1_JOINT_NAMES:
-            j.armature = _MOTORS[_motor(j.name)][0]
+            j.armature = g1.g1_actuator(j.name).armature
     if cfg.fixed_base:
         spec.delete(spec.joint("floating_base_joint"))
         spec.body("pelvis").pos = [0.0, 0.0, FIXED_BASE_HEIGHT]

@@ -12,28 +12,16 @@ from typing import Literal
 
 import numpy as np
 
-from gmloco.deploy.logs.g1 import G1_JOINT_NAMES, joint_index
+from gmloco.deploy.g1 import G1_KNEES_BENT_POSE
+from gmloco.deploy.logs.g1 import G1_JOINT_NAMES
 from gmloco.deploy.mismatch.frames import quat_tilt
 
 __all__ = ["MotionCfg", "ScriptedMotion", "default_gains", "default_pose"]
 
 
 def default_pose() -> np.ndarray:
-    """Knees-bent standing pose (mjlab ``KNEES_BENT_KEYFRAME``) [rad], shape [29]."""
-    q = np.zeros(29)
-    for i, n in enumerate(G1_JOINT_NAMES):
-        for k, v in {
-            "hip_pitch": -0.312,
-            "knee": 0.669,
-            "ankle_pitch": -0.363,
-            "elbow": 0.6,
-            "shoulder_pitch": 0.2,
-        }.items():
-            if k in n:
-                q[i] = v
-    q[joint_index("left_shoulder_roll_joint")] = 0.2
-    q[joint_index("right_shoulder_roll_joint")] = -0.2
-    return q
+    """Knees-bent standing pose (mjlab ``KNEES_BENT_KEYFRAME``, ``gmloco.deploy.g1``) [rad], shape [29]."""
+    return np.array(G1_KNEES_BENT_POSE)
 
 
 def default_gains() -> tuple[np.ndarray, np.ndarray]:
