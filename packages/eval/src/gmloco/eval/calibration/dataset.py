@@ -9,14 +9,13 @@ from __future__ import annotations
 
 import hashlib
 import json
-import os
-import tempfile
 from dataclasses import asdict, dataclass, fields
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 
+from gmloco.deploy.atomic_io import atomic_write
 from gmloco.eval.calibration.protocol import SoleProtocolCfg, SoleRecord
 
 __all__ = [
@@ -104,15 +103,7 @@ def save_dataset(ds: CalibrationDataset, path: str | Path) -> Path:
     path.parent.mkdir(parents=True, exist_ok=True)
     arrays = {f"{name}/{f}": getattr(rec, f) for name, rec in ds.records.items() for f in RECORD_FIELDS}
     arrays["meta"] = np.array(json.dumps(_meta(ds)))
-    fd, tmp = tempfile.mkstemp(dir=path.parent, suffix=".npz.tmp")
-    try:
-        with os.fdopen(fd, "wb") as fh:
-            np.savez_compressed(fh, **arrays)  # pyright: ignore[reportArgumentType]
-        os.replace(tmp, path)
-    finally:
-        if os.path.exists(tmp):
-            os.unlink(tmp)
-    return path
+    return atomic_write(path, lambda fh: np.savez_compressed(fh, **arrays))  # pyright: ignore[reportArgumentType]
 
 
 def load_dataset(path: str | Path) -> CalibrationDataset:

@@ -9,9 +9,6 @@ single-stance weight. The fit is accepted only if the held-out RMS force error f
 
 from __future__ import annotations
 
-import json
-import os
-import tempfile
 from dataclasses import asdict, dataclass, replace
 from pathlib import Path
 from typing import Any, Literal
@@ -20,6 +17,7 @@ import numpy as np
 
 from gmloco.contact import MATERIAL_PRESETS, ContactRFT3DCfg, RftExtensionsCfg
 from gmloco.contact.extensions_io import save_rft_extensions
+from gmloco.deploy.atomic_io import atomic_write_json
 from gmloco.eval.calibration.dataset import CalibrationDataset, ContractError, check_contract, file_sha256
 from gmloco.eval.calibration.rft_sand import centred_sole_collider, replay_record
 
@@ -159,15 +157,7 @@ def write_report(result: SandFitResult, path: str | Path, provenance: dict[str, 
     body = {"accepted": result.accepted, "force_error_before": result.error_before,
             "force_error_after": result.error_after, "per_record": result.per_record,
             "extensions": asdict(result.extensions), "cost": result.cost, **provenance}  # fmt: skip
-    fd, tmp = tempfile.mkstemp(dir=path.parent, suffix=".json.tmp")
-    try:
-        with os.fdopen(fd, "w") as fh:
-            json.dump(body, fh, indent=1)
-        os.replace(tmp, path)
-    finally:
-        if os.path.exists(tmp):
-            os.unlink(tmp)
-    return path
+    return atomic_write_json(path, body)
 
 
 def write_default(result: SandFitResult, path: str | Path, dataset: str | Path, cfg: SandFitCfg) -> Path | None:

@@ -18,12 +18,11 @@ and ``<out>/manifest.json`` (the command and settings). Bad arguments exit with 
 from __future__ import annotations
 
 import argparse
-import json
 import math
-import os
 import sys
-import tempfile
 from pathlib import Path
+
+from gmloco.deploy.atomic_io import atomic_write_json
 
 __all__ = ["main"]
 
@@ -44,12 +43,7 @@ def _finite(obj: object) -> object:
 
 def _write_json(path: Path, payload: object) -> None:
     """Write ``payload`` as strict JSON to ``path`` atomically (NaN becomes null)."""
-    fd, tmp = tempfile.mkstemp(dir=path.parent, suffix=".json")
-    with os.fdopen(fd, "w") as f:
-        json.dump(_finite(payload), f, indent=1, allow_nan=False)
-        f.write("\n")
-    os.chmod(tmp, 0o644)
-    os.replace(tmp, path)
+    atomic_write_json(path, _finite(payload), allow_nan=False, newline=True)
 
 
 def _parse_runs(items: list[str]) -> dict[str, Path]:

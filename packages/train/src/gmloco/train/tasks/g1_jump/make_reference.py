@@ -12,15 +12,13 @@ memory and exits 1 when a shipped file differs from a fresh build by more than 1
 from __future__ import annotations
 
 import argparse
-import json
-import os
 import sys
-import tempfile
 from dataclasses import asdict
 from pathlib import Path
 
 import numpy as np
 
+from gmloco.deploy.atomic_io import atomic_write_json
 from gmloco.train.tasks.g1_jump.ik import IkCfg, load_g1_model
 from gmloco.train.tasks.g1_jump.plausibility import check_plausibility
 from gmloco.train.tasks.g1_jump.profile import JumpProfileCfg
@@ -75,12 +73,7 @@ def _versions() -> dict[str, str]:
 
 def _write_json(path: Path, payload: dict[str, object]) -> None:
     """Write ``payload`` as JSON to ``path`` atomically."""
-    fd, tmp = tempfile.mkstemp(dir=path.parent, suffix=".json")
-    with os.fdopen(fd, "w") as f:
-        json.dump(payload, f, indent=1)
-        f.write("\n")
-    os.chmod(tmp, 0o644)
-    os.replace(tmp, path)
+    atomic_write_json(path, payload, newline=True)
 
 
 def build(out: Path) -> dict[str, object]:

@@ -8,8 +8,6 @@ signals the imitation task reads, all derived from ``qpos`` with the G1 MuJoCo m
 
 from __future__ import annotations
 
-import os
-import tempfile
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Literal
@@ -17,6 +15,7 @@ from typing import Literal
 import mujoco
 import numpy as np
 
+from gmloco.deploy.atomic_io import atomic_write
 from gmloco.train.tasks.g1_jump.ik import IkCfg, IkTargets, WholeBodyIk, load_g1_model, standing_qpos
 from gmloco.train.tasks.g1_jump.profile import JumpProfile, JumpProfileCfg, make_jump_profile
 
@@ -233,28 +232,19 @@ def synthesize_reference(cfg: JumpSynthesisCfg, model: mujoco.MjModel | None = N
 
 def save_reference(ref: JumpReference, path: Path) -> None:
     """Write ``ref`` to ``path`` (compressed ``.npz``) atomically."""
-    path.parent.mkdir(parents=True, exist_ok=True)
-    fd, tmp = tempfile.mkstemp(dir=path.parent, suffix=".npz")
-    os.close(fd)
-    try:
-        np.savez_compressed(
-            tmp,
-            name=np.array(ref.name),
-            fps=np.array(ref.fps),
-            joint_names=np.array(ref.joint_names),
-            qpos=ref.qpos,
-            qvel=ref.qvel.astype(np.float32),
-            feet_pos=ref.feet_pos.astype(np.float32),
-            com=ref.com.astype(np.float32),
-            in_contact=ref.in_contact,
-            times=np.array([ref.t_push_start, ref.t_takeoff, ref.t_touchdown]),
-            sole_height=np.array(ref.sole_height),
-        )
-        os.chmod(tmp, 0o644)
-        os.replace(tmp, path)
-    except BaseException:
-        Path(tmp).unlink(missing_ok=True)
-        raise
+    arrays = {
+        "name": np.array(ref.name),
+        "fps": np.array(ref.fps),
+        "joint_names": np.array(ref.joint_names),
+        "qpos": ref.qpos,
+        "qvel": ref.qvel.astype(np.float32),
+        "feet_pos": ref.feet_pos.astype(np.float32),
+        "com": ref.com.astype(np.float32),
+        "in_contact": ref.in_contact,
+        "times": np.array([ref.t_push_start, ref.t_takeoff, ref.t_touchdown]),
+        "sole_height": np.array(ref.sole_height),
+    }
+    atomic_write(path, lambda fh: np.savez_compressed(fh, **arrays))  # pyright: ignore[reportArgumentType]
 
 
 def load_reference(path: str | Path) -> JumpReference:
