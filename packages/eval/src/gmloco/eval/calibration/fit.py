@@ -21,7 +21,15 @@ from gmloco.deploy.atomic_io import atomic_write_json
 from gmloco.eval.calibration.dataset import CalibrationDataset, ContractError, check_contract, file_sha256
 from gmloco.eval.calibration.rft_sand import centred_sole_collider, replay_record
 
-__all__ = ["FIT_BOUNDS", "SandFitCfg", "SandFitResult", "fit_extensions", "split_error"]
+__all__ = [
+    "FIT_BOUNDS",
+    "SandFitCfg",
+    "SandFitResult",
+    "dataset_material",
+    "fit_extensions",
+    "replay_forces",
+    "split_error",
+]
 
 FIT_BOUNDS: dict[str, tuple[float, float, float]] = {
     "depth_exponent": (0.3, 3.0, 1.0),
@@ -73,7 +81,7 @@ class SandFitResult:
     """Final least-squares cost on the fit split."""
 
 
-def _material(ds: CalibrationDataset) -> Any:
+def dataset_material(ds: CalibrationDataset) -> Any:
     """Return the dataset's MaterialCfg, checking it against the recorded parameters (contract)."""
     if ds.material not in MATERIAL_PRESETS:
         raise ContractError("material", f"unknown material {ds.material!r}")
@@ -95,17 +103,19 @@ def _extensions(x: np.ndarray, cfg: SandFitCfg, plastic: bool) -> RftExtensionsC
     return RftExtensionsCfg(**values)
 
 
-def _replays(ds: CalibrationDataset, ext: RftExtensionsCfg, cfg: SandFitCfg, names: list[str]) -> dict[str, np.ndarray]:
-    """Return the model force [N] [T, 3] of each named record."""
+def replay_forces(
+    ds: CalibrationDataset, ext: RftExtensionsCfg, cfg: SandFitCfg, names: list[str]
+) -> dict[str, np.ndarray]:
+    """Return the model force [N] [T, 3] of each named record (its recorded kinematics, fresh memory)."""
     model = ContactRFT3DCfg(at_rest=cfg.at_rest, extensions=ext)
     col = centred_sole_collider(ds.protocol, "box", cfg.resolution)
-    mat = _material(ds)
+    mat = dataset_material(ds)
     return {n: replay_record(ds.records[n], col, model, mat, ds.protocol.frame_dt) for n in names}
 
 
 def split_error(ds: CalibrationDataset, ext: RftExtensionsCfg, cfg: SandFitCfg) -> tuple[dict, dict]:
     """Return (RMS force error [N] per split, per record) of a model on the dataset."""
-    forces = _replays(ds, ext, cfg, list(ds.records))
+    forces = replay_forces(ds, ext, cfg, list(ds.records))
     per = {n: float(np.sqrt(np.mean(np.sum((forces[n] - ds.records[n].force) ** 2, -1)))) for n in forces}
     out = {}
     for split in ("fit", "heldout"):
@@ -124,10 +134,12 @@ def _fit_one(ds: CalibrationDataset, cfg: SandFitCfg, plastic: bool) -> tuple[Rf
 
     def residual(x: np.ndarray) -> np.ndarray:
         """Force residual of the fit records over the single-stance weight [-]."""
-        forces = _replays(ds, _extensions(x, cfg, plastic), cfg, names)
+        forces = replay_forces(ds, _extensions(x, cfg, plastic), cfg, names)
         return ((np.concatenate([forces[n] for n in names]) - data) / scale).ravel()
 
     lo, hi, x0 = (np.array([FIT_BOUNDS[p][i] for p in cfg.params]) for i in range(3))
+    if not cfg.params:  # nothing to fit (plastic unloading alone): the cost of the fixed model
+        return _extensions(x0, cfg, plastic), 0.5 * float(np.sum(residual(x0) ** 2))
     res = least_squares(residual, x0, bounds=(lo, hi), x_scale=np.maximum(hi - lo, 1e-3) / 10, diff_step=1e-4)
     return _extensions(res.x, cfg, plastic), float(res.cost)
 
