@@ -11,6 +11,7 @@ from __future__ import annotations
 import argparse
 import json
 import sys
+from dataclasses import asdict
 
 from gmloco.eval.calibration.dataset import ContractError, file_sha256, load_dataset
 from gmloco.eval.calibration.fit import FIT_BOUNDS, SandFitCfg, fit_extensions, write_default, write_report
@@ -44,7 +45,9 @@ def main(argv: list[str] | None = None) -> int:
     except (ContractError, FileNotFoundError, ValueError) as e:
         print(f"error: {e}", file=sys.stderr)
         return 2
-    write_report(result, a.out, {"dataset": a.dataset, "dataset_sha256": file_sha256(a.dataset)})
+    provenance = {"dataset": a.dataset, "dataset_sha256": file_sha256(a.dataset), "material": ds.material,
+                  "source": ds.source, "fit": asdict(cfg)}  # fmt: skip
+    write_report(result, a.out, provenance)
     written = write_default(result, a.write_default, a.dataset, cfg) if a.write_default else None
     summary = {"accepted": result.accepted, "heldout_before_N": result.error_before["heldout"],
                "heldout_after_N": result.error_after["heldout"], "default_written": str(written) if written else None}  # fmt: skip
