@@ -84,14 +84,16 @@ def test_stance_depth_of_the_published_model_is_exact(tmp_path: Path) -> None:
 
 
 def test_bad_input_exits_2(fitted: tuple[Path, Path], tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
-    """A missing report, a report that is not a fit, a dataset not given, or a bad load share: exit 2, no file."""
+    """A missing report, a report that is not a fit, a dataset not given or changed, a bad load share: exit 2."""
     _, report = fitted
     out = tmp_path / "summary.json"
     other = _build(tmp_path / "other", RftExtensionsCfg())
     not_a_fit = tmp_path / "x.json"
     not_a_fit.write_text(json.dumps({"accepted": True}))
+    stale = tmp_path / "stale.json"
+    stale.write_text(json.dumps({**json.loads(report.read_text()), "dataset_sha256": "0" * 64}))
     for args in (["--fits", str(tmp_path / "none.json")], ["--fits", str(not_a_fit)],
-                 ["--fits", str(report), "--datasets", str(other)],
+                 ["--fits", str(report), "--datasets", str(other)], ["--fits", str(stale)],
                  ["--fits", str(report), "--stance-load-fraction", "1.5"]):  # fmt: skip
         assert summary_main([*args, "--out", str(out), "--no-figures"]) == 2
         assert "error:" in capsys.readouterr().err and not out.exists()

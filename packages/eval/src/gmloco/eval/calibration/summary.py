@@ -100,7 +100,13 @@ def _extensions(report: dict[str, Any], path: str) -> RftExtensionsCfg:
 def _datasets(reports: dict[str, dict[str, Any]], paths: list[str] | None) -> dict[str, str]:
     """Return the dataset file of each fit report: the one named in it, or the given file with its SHA-256."""
     if paths is None:
-        return {f: str(r.get("dataset", "")) for f, r in reports.items()}
+        named = {f: str(r.get("dataset", "")) for f, r in reports.items()}
+        for f, d in named.items():
+            if not Path(d).is_file():
+                raise FileNotFoundError(f"dataset {d!r} of fit report {f} not found: give it with --datasets")
+            if file_sha256(d) != reports[f]["dataset_sha256"]:
+                raise ValueError(f"dataset {d} changed since fit report {f} was made (sha256 differs)")
+        return named
     by_sha = {file_sha256(p): p for p in paths}
     out = {}
     for f, r in reports.items():
