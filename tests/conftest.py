@@ -1,5 +1,5 @@
 # SPDX-License-Identifier: Apache-2.0
-"""Fixtures for the cross-package pipeline tests (``workflows/`` is on ``sys.path`` via pytest's pythonpath)."""
+"""Fixtures for the cross-package pipeline tests (the checkout root is on pytest's pythonpath, for ``workflows``)."""
 
 from __future__ import annotations
 
@@ -18,7 +18,7 @@ def _no_wandb(monkeypatch: pytest.MonkeyPatch) -> None:
 @pytest.fixture
 def compose() -> Callable[..., DictConfig]:
     """Return ``compose(*overrides)``: the checked pipeline config, as ``@hydra.main`` tasks see it."""
-    from hydra_entry import compose_checked
+    from workflows.hydra_entry import compose_checked
 
     def _compose(*overrides: str) -> DictConfig:
         return compose_checked("full_pipeline", list(overrides))

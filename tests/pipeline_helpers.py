@@ -18,9 +18,9 @@ from collections.abc import Mapping, Sequence
 from pathlib import Path
 from typing import Any
 
-import stage_registry
-from run_dir import atomic_write_json, read_json
-from stage_registry import StageFn, StageSpec, not_implemented
+from workflows import stage_registry
+from workflows.run_dir import atomic_write_json, read_json
+from workflows.stage_registry import StageFn, StageSpec, not_implemented
 
 REPO_ROOT = Path(__file__).resolve().parents[1]
 """Checkout root."""

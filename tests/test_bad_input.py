@@ -9,9 +9,9 @@ from pathlib import Path
 import pytest
 from omegaconf import DictConfig
 
-from config_errors import ConfigInputError
-from run_dir import atomic_write_json
 from tests.pipeline_helpers import plain_python_env, run_cli
+from workflows.config_errors import ConfigInputError
+from workflows.run_dir import atomic_write_json
 
 CASES = [
     # (overrides, key named in the error, words the message must contain)

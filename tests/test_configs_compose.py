@@ -9,9 +9,9 @@ from pathlib import Path
 import pytest
 from omegaconf import DictConfig, OmegaConf
 
-from config_errors import CONF_DIR, ConfigInputError, group_options, groups
-from schemas import ContactModelName, PipelineCfg, StageCfg, SweepCfg
-from stage_registry import stage_names
+from workflows.config_errors import CONF_DIR, ConfigInputError, group_options, groups
+from workflows.schemas import ContactModelName, PipelineCfg, StageCfg, SweepCfg
+from workflows.stage_registry import stage_names
 
 EXPS = group_options("exp")
 """Every experiment config."""

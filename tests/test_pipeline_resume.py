@@ -11,11 +11,11 @@ from typing import Any
 import pytest
 from omegaconf import DictConfig
 
-from pipeline_run import EXIT_FAILED, EXIT_INCOMPLETE, EXIT_OK, run_pipeline
-from run_dir import read_json
-from stage_registry import StageIncompleteError, not_implemented
-from stage_runner import PipelineConfigError
 from tests.pipeline_helpers import CALLS, toy_registry, toy_teacher
+from workflows.pipeline_run import EXIT_FAILED, EXIT_INCOMPLETE, EXIT_OK, run_pipeline
+from workflows.run_dir import read_json
+from workflows.stage_registry import StageIncompleteError, not_implemented
+from workflows.stage_runner import PipelineConfigError
 
 Compose = Callable[..., DictConfig]
 

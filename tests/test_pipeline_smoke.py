@@ -12,8 +12,8 @@ from pathlib import Path
 
 import pytest
 
-from stage_registry import stage_names
 from tests.pipeline_helpers import REPO_ROOT, run_cli
+from workflows.stage_registry import stage_names
 
 SAMPLE_LOGS = sorted((REPO_ROOT / "packages" / "deploy" / "data" / "sample_logs").glob("*.mcap"))
 """The committed sample recordings, analyze_logs' default input."""
@@ -34,7 +34,7 @@ STAGE_FILES = {
 
 def _cuda() -> bool:
     """Whether the smoke scale is not chosen automatically on this machine."""
-    from stage_runner import resolve_device
+    from workflows.stage_runner import resolve_device
 
     return resolve_device("auto") != "cpu"
 

@@ -10,10 +10,10 @@ from typing import Any
 import pytest
 from omegaconf import DictConfig
 
-from pipeline_run import EXIT_INCOMPLETE, EXIT_OK, run_pipeline
-from run_dir import read_json
-from stage_runner import PipelineConfigError
 from tests.pipeline_helpers import REPO_ROOT
+from workflows.pipeline_run import EXIT_INCOMPLETE, EXIT_OK, run_pipeline
+from workflows.run_dir import read_json
+from workflows.stage_runner import PipelineConfigError
 
 SAMPLE_LOGS = sorted((REPO_ROOT / "packages" / "deploy" / "data" / "sample_logs").glob("*.mcap"))
 """The committed sample recordings, analyze_logs' default input."""

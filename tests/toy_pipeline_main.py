@@ -3,11 +3,11 @@
 
 from __future__ import annotations
 
-import stage_registry
 from tests.pipeline_helpers import toy_registry
+from workflows import stage_registry
 
 if __name__ == "__main__":
     stage_registry.STAGES = toy_registry()
-    import full_pipeline
+    from workflows import full_pipeline
 
     full_pipeline.main()

@@ -35,11 +35,21 @@ from typing import Any
 
 from omegaconf import DictConfig, OmegaConf
 
-from pipeline_report import console
-from pipeline_run import EXIT_FAILED, EXIT_INCOMPLETE, EXIT_OK, run_pipeline
-from run_dir import atomic_write_json, atomic_write_text, atomic_write_yaml, read_json, seed_everything, write_git_state
-from schemas import REPO_ROOT
-from stage_runner import PipelineConfigError, resolve_device
+if not __package__:  # run as ``python workflows/<name>.py``: the checkout root makes ``workflows`` importable
+    sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
+
+from workflows.pipeline_report import console
+from workflows.pipeline_run import EXIT_FAILED, EXIT_INCOMPLETE, EXIT_OK, run_pipeline
+from workflows.run_dir import (
+    atomic_write_json,
+    atomic_write_text,
+    atomic_write_yaml,
+    read_json,
+    seed_everything,
+    write_git_state,
+)
+from workflows.schemas import REPO_ROOT
+from workflows.stage_runner import PipelineConfigError, resolve_device
 
 __all__ = ["Arm", "main", "markdown_table", "run_ablation", "table_rows"]
 
@@ -113,7 +123,7 @@ def _compose_arm(exp: str, overrides: Sequence[str]) -> DictConfig:
         from hydra import compose
 
         return compose("full_pipeline", overrides=args)
-    from hydra_entry import compose_checked
+    from workflows.hydra_entry import compose_checked
 
     return compose_checked("full_pipeline", args)
 
@@ -156,7 +166,7 @@ def eval_settings(cfg: DictConfig) -> dict[str, Any]:
 
 def evaluate_arm(cfg: DictConfig, arm: Arm, root: Path) -> Arm:
     """Evaluate the arm's policy, or reuse ``eval/<exp>.json`` written for the same policy and settings."""
-    from policy_training import torch_device
+    from workflows.policy_training import torch_device
 
     settings = eval_settings(cfg)
     out = root / "eval" / f"{arm.exp}.json"
@@ -320,11 +330,11 @@ def _passed_overrides() -> list[str]:
 def _prepare(cfg: DictConfig) -> DictConfig:
     """Copy ``cfg``, pin run dir and device, check the ablation's input."""
     if cfg.get("ablation") is None:
-        from config_errors import group_options
+        from workflows.config_errors import group_options
 
         choices = ", ".join(group_options("ablation"))
         raise PipelineConfigError("ablation", f"ablation: no ablation chosen: add +ablation=<name>. Valid: {choices}.")
-    from config_errors import group_options
+    from workflows.config_errors import group_options
 
     unknown = [e for e in cfg.ablation.exps if e not in group_options("exp")]
     if unknown:
@@ -391,8 +401,8 @@ def _defaults(argv: Sequence[str]) -> list[str]:
     """Add ``+exp=<first of ablation.exps>`` and ``run_dir=<runs>/ablation/<time>`` when the command line has none."""
     args = list(argv)
     if not any(a.lstrip("+").startswith("exp=") for a in args):
-        from config_errors import CONF_DIR
-        from schemas import AblationCfg
+        from workflows.config_errors import CONF_DIR
+        from workflows.schemas import AblationCfg
 
         names = [a.split("=", 1)[1] for a in args if a.lstrip("+").startswith("ablation=")]
         path = CONF_DIR / "ablation" / f"{names[0]}.yaml" if names else None
@@ -411,7 +421,7 @@ def _task(cfg: DictConfig) -> int:
 
 def main() -> None:
     """Command-line entry (Hydra)."""
-    from hydra_entry import hydra_entry
+    from workflows.hydra_entry import hydra_entry
 
     sys.argv = [sys.argv[0], *_defaults(sys.argv[1:])]
     hydra_entry(_task, only_stage="train_teacher")

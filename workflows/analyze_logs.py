@@ -17,12 +17,16 @@ counts and the mean velocity-tracking error; it takes seconds per recording, so 
 from __future__ import annotations
 
 import math
+import sys
 from pathlib import Path
 from typing import Any
 
 from omegaconf import DictConfig
 
-from run_dir import atomic_write_json
+if not __package__:  # run as ``python workflows/<name>.py``: the checkout root makes ``workflows`` importable
+    sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
+
+from workflows.run_dir import atomic_write_json
 
 __all__ = ["main", "recordings", "run"]
 
@@ -67,8 +71,8 @@ def run(cfg: DictConfig) -> dict[str, float]:
 
 def main() -> None:
     """Command-line entry: run this stage alone in a run directory (Hydra)."""
-    from hydra_entry import hydra_entry
-    from pipeline_run import run_from_hydra
+    from workflows.hydra_entry import hydra_entry
+    from workflows.pipeline_run import run_from_hydra
 
     hydra_entry(run_from_hydra, only_stage="analyze_logs")
 

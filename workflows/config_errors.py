@@ -13,7 +13,7 @@ from hydra.errors import ConfigCompositionException, MissingConfigException, Ove
 from omegaconf import DictConfig, OmegaConf
 from omegaconf.errors import OmegaConfBaseException
 
-from schemas import REPO_ROOT, PipelineCfg
+from workflows.schemas import REPO_ROOT, PipelineCfg
 
 __all__ = ["CONF_DIR", "ConfigInputError", "explain", "group_options", "groups", "unknown_key_error"]
 

@@ -18,9 +18,15 @@ atomically), stops by ``cfg.distill.max_minutes`` with a checkpoint and raises `
 
 from __future__ import annotations
 
+import sys
+from pathlib import Path
+
 from omegaconf import DictConfig
 
-from policy_training import distill_overrides, newest_checkpoint, run_training, task_cfg
+if not __package__:  # run as ``python workflows/<name>.py``: the checkout root makes ``workflows`` importable
+    sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
+
+from workflows.policy_training import distill_overrides, newest_checkpoint, run_training, task_cfg
 
 __all__ = ["main", "run"]
 
@@ -46,8 +52,8 @@ def run(cfg: DictConfig) -> dict[str, float | None]:
 
 def main() -> None:
     """Command-line entry: run this stage alone in a run directory (Hydra)."""
-    from hydra_entry import hydra_entry
-    from pipeline_run import run_from_hydra
+    from workflows.hydra_entry import hydra_entry
+    from workflows.pipeline_run import run_from_hydra
 
     hydra_entry(run_from_hydra, only_stage="distill")
 

@@ -20,6 +20,7 @@ walks as the accepted one does: ``python -m gmloco.eval.studies.convergence`` (`
 
 from __future__ import annotations
 
+import sys
 import threading
 from collections.abc import Callable, Iterator
 from contextlib import contextmanager
@@ -29,8 +30,11 @@ from typing import TYPE_CHECKING
 
 from omegaconf import DictConfig
 
-from pipeline_report import say, stage_bar
-from stage_registry import StageIncompleteError
+if not __package__:  # run as ``python workflows/<name>.py``: the checkout root makes ``workflows`` importable
+    sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
+
+from workflows.pipeline_report import say, stage_bar
+from workflows.stage_registry import StageIncompleteError
 
 if TYPE_CHECKING:
     from gmloco.eval.g1.config import G1EvalCfg
@@ -150,8 +154,8 @@ def run(cfg: DictConfig) -> dict[str, float]:
 
 def main() -> None:
     """Command-line entry: run this stage alone in a run directory (Hydra)."""
-    from hydra_entry import hydra_entry
-    from pipeline_run import run_from_hydra
+    from workflows.hydra_entry import hydra_entry
+    from workflows.pipeline_run import run_from_hydra
 
     hydra_entry(run_from_hydra, only_stage="eval_mpm")
 

@@ -27,15 +27,19 @@ metrics; it takes seconds, so it has no time box of its own.
 from __future__ import annotations
 
 import os
+import sys
 from dataclasses import replace
 from pathlib import Path
 from typing import Any
 
 from omegaconf import DictConfig
 
-from policy_training import distill_overrides, newest_checkpoint, task_cfg, torch_device
-from run_dir import atomic_write_json
-from schemas import REPO_ROOT
+if not __package__:  # run as ``python workflows/<name>.py``: the checkout root makes ``workflows`` importable
+    sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
+
+from workflows.policy_training import distill_overrides, newest_checkpoint, task_cfg, torch_device
+from workflows.run_dir import atomic_write_json
+from workflows.schemas import REPO_ROOT
 
 __all__ = ["main", "run"]
 
@@ -94,8 +98,8 @@ def run(cfg: DictConfig) -> dict[str, float]:
 
 def main() -> None:
     """Command-line entry: run this stage alone in a run directory (Hydra)."""
-    from hydra_entry import hydra_entry
-    from pipeline_run import run_from_hydra
+    from workflows.hydra_entry import hydra_entry
+    from workflows.pipeline_run import run_from_hydra
 
     hydra_entry(run_from_hydra, only_stage="export")
 

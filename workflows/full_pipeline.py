@@ -15,9 +15,14 @@ Exit codes: 0 every stage done, skipped, blocked or not implemented yet; 1 a sta
 
 from __future__ import annotations
 
+import sys
+from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
-from project_python import ensure_project_python
+if not __package__:  # run as ``python workflows/<name>.py``: the checkout root makes ``workflows`` importable
+    sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
+
+from workflows.project_python import ensure_project_python
 
 if TYPE_CHECKING:
     from omegaconf import DictConfig
@@ -27,7 +32,7 @@ __all__ = ["main", "run"]
 
 def run(cfg: DictConfig) -> dict[str, Any]:
     """Run every stage selected by ``cfg.stages`` and return the summary (also in ``summary.json``)."""
-    from pipeline_run import run_pipeline
+    from workflows.pipeline_run import run_pipeline
 
     return run_pipeline(cfg)
 
@@ -35,8 +40,8 @@ def run(cfg: DictConfig) -> dict[str, Any]:
 def main() -> None:
     """Command-line entry (Hydra)."""
     ensure_project_python(__file__)
-    from hydra_entry import hydra_entry
-    from pipeline_run import run_from_hydra
+    from workflows.hydra_entry import hydra_entry
+    from workflows.pipeline_run import run_from_hydra
 
     hydra_entry(run_from_hydra)
 

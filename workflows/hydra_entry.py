@@ -21,15 +21,17 @@ from omegaconf import DictConfig, OmegaConf, open_dict
 from omegaconf.errors import OmegaConfBaseException
 from rich.markup import escape
 
-import schemas  # noqa: F401  (registers the schemas and resolvers)
-import stage_registry
-from config_errors import CONF_DIR, ConfigInputError, explain, group_options, groups, unknown_key_error
-from config_ranges import range_problem
-from input_checks import input_problem
-from pipeline_report import console
-from run_guard import run_dir_problem
-from schemas import PipelineCfg
-from stage_runner import PipelineConfigError, validate_selection
+from workflows import (
+    schemas,  # noqa: F401  (registers the schemas and resolvers)
+    stage_registry,
+)
+from workflows.config_errors import CONF_DIR, ConfigInputError, explain, group_options, groups, unknown_key_error
+from workflows.config_ranges import range_problem
+from workflows.input_checks import input_problem
+from workflows.pipeline_report import console
+from workflows.run_guard import run_dir_problem
+from workflows.schemas import PipelineCfg
+from workflows.stage_runner import PipelineConfigError, validate_selection
 
 __all__ = ["EXIT_BAD_INPUT", "check_config", "compose_checked", "hydra_entry"]
 

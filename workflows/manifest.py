@@ -9,7 +9,7 @@ from enum import Enum
 from pathlib import Path
 from typing import Any
 
-from run_dir import atomic_write_json, list_outputs, read_json
+from workflows.run_dir import atomic_write_json, list_outputs, read_json
 
 __all__ = ["MANIFEST_VERSION", "Manifest", "StageRecord", "StageStatus"]
 

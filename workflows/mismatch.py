@@ -19,12 +19,16 @@ line to the report is in ``docs/mismatch.md``.
 
 from __future__ import annotations
 
+import sys
 from pathlib import Path
 from typing import Any
 
 from omegaconf import DictConfig
 
-from pipeline_report import stage_bar
+if not __package__:  # run as ``python workflows/<name>.py``: the checkout root makes ``workflows`` importable
+    sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
+
+from workflows.pipeline_report import stage_bar
 
 __all__ = ["main", "run"]
 
@@ -77,8 +81,8 @@ def run(cfg: DictConfig) -> dict[str, Any]:
 
 def main() -> None:
     """Command-line entry: run this stage alone in a run directory (Hydra)."""
-    from hydra_entry import hydra_entry
-    from pipeline_run import run_from_hydra
+    from workflows.hydra_entry import hydra_entry
+    from workflows.pipeline_run import run_from_hydra
 
     hydra_entry(run_from_hydra, only_stage="mismatch")
 

@@ -16,7 +16,7 @@ from rich.console import Console
 from rich.markup import escape
 from rich.progress import BarColumn, Progress, SpinnerColumn, TextColumn, TimeElapsedColumn
 
-from manifest import StageStatus
+from workflows.manifest import StageStatus
 
 __all__ = [
     "STATUS_STYLE",

@@ -17,10 +17,10 @@ from typing import Any
 
 from omegaconf import DictConfig, OmegaConf
 
-import stage_registry
-from manifest import Manifest, StageStatus
-from pipeline_report import console, print_ending, print_header, say, stage_line, stage_progress
-from run_dir import (
+from workflows import stage_registry
+from workflows.manifest import Manifest, StageStatus
+from workflows.pipeline_report import console, print_ending, print_header, say, stage_line, stage_progress
+from workflows.run_dir import (
     RunDir,
     atomic_write_json,
     atomic_write_text,
@@ -29,14 +29,14 @@ from run_dir import (
     seed_everything,
     write_git_state,
 )
-from run_guard import run_dir_problem
-from run_log import job_log_path, library_output_to
-from run_summary import SMOKE_CONSOLE_NOTE, headline, summary_markdown
-from schemas import REPO_ROOT
-from stage_hashing import hashable_config, stage_hashes
-from stage_registry import StageSpec
-from stage_runner import PipelineConfigError, StageOutcome, StageRunner, resolve_device, validate_selection
-from tracking import Tracker
+from workflows.run_guard import run_dir_problem
+from workflows.run_log import job_log_path, library_output_to
+from workflows.run_summary import SMOKE_CONSOLE_NOTE, headline, summary_markdown
+from workflows.schemas import REPO_ROOT
+from workflows.stage_hashing import hashable_config, stage_hashes
+from workflows.stage_registry import StageSpec
+from workflows.stage_runner import PipelineConfigError, StageOutcome, StageRunner, resolve_device, validate_selection
+from workflows.tracking import Tracker
 
 __all__ = ["EXIT_FAILED", "EXIT_INCOMPLETE", "EXIT_OK", "exit_code", "run_from_hydra", "run_pipeline"]
 

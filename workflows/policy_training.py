@@ -17,8 +17,8 @@ from typing import Any
 
 from omegaconf import DictConfig, OmegaConf
 
-from pipeline_report import say, stage_bar
-from stage_registry import StageIncompleteError
+from workflows.pipeline_report import say, stage_bar
+from workflows.stage_registry import StageIncompleteError
 
 __all__ = [
     "distill_overrides",

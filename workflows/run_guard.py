@@ -14,11 +14,11 @@ from pathlib import Path
 
 from omegaconf import DictConfig, OmegaConf
 
-from manifest import Manifest
-from run_dir import RunDir, list_outputs
-from stage_hashing import stage_hashes
-from stage_registry import StageSpec
-from stage_runner import forced_stages
+from workflows.manifest import Manifest
+from workflows.run_dir import RunDir, list_outputs
+from workflows.stage_hashing import stage_hashes
+from workflows.stage_registry import StageSpec
+from workflows.stage_runner import forced_stages
 
 __all__ = ["recorded_experiment", "run_dir_problem"]
 

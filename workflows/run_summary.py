@@ -12,8 +12,8 @@ import math
 from collections.abc import Callable, Mapping, Sequence
 from typing import Any
 
-from manifest import Manifest, StageStatus
-from stage_registry import StageSpec
+from workflows.manifest import Manifest, StageStatus
+from workflows.stage_registry import StageSpec
 
 __all__ = ["HEADLINES", "SMOKE_CONSOLE_NOTE", "SMOKE_NOTE", "headline", "summary_markdown"]
 

@@ -17,8 +17,8 @@ from typing import Any
 from hydra.core.config_store import ConfigStore
 from omegaconf import MISSING, OmegaConf
 
-from config_ranges import each, ranged
-from stage_registry import stage_names
+from workflows.config_ranges import each, ranged
+from workflows.stage_registry import stage_names
 
 __all__ = [
     "AblationCfg",

@@ -15,8 +15,8 @@ from typing import Any
 
 from omegaconf import DictConfig, OmegaConf
 
-from run_dir import config_hash
-from stage_registry import StageSpec
+from workflows.run_dir import config_hash
+from workflows.stage_registry import StageSpec
 
 __all__ = ["VOLATILE_KEYS", "VOLATILE_STAGE_KEYS", "hashable_config", "stage_hashes"]
 

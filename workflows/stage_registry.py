@@ -43,7 +43,7 @@ class StageSpec:
     summary: str = ""
     """One line for the summary table."""
     module: str = ""
-    """Module that defines ``run(cfg)``; defaults to ``name`` (i.e. ``workflows/<name>.py``)."""
+    """Module that defines ``run(cfg)``; defaults to ``workflows.<name>`` (i.e. ``workflows/<name>.py``)."""
     fn: StageFn | None = None
     """Direct callable (tests register toy stages this way); overrides ``module``."""
 
@@ -100,5 +100,5 @@ def load_stage_fn(spec: StageSpec) -> StageFn:
     """Import the stage's module lazily (heavy dependencies load only when the stage runs) and return ``run``."""
     if spec.fn is not None:
         return spec.fn
-    module = importlib.import_module(spec.module or spec.name)
+    module = importlib.import_module(spec.module or f"workflows.{spec.name}")
     return module.run

@@ -19,9 +19,9 @@ from typing import Any
 
 from omegaconf import DictConfig, OmegaConf
 
-from manifest import Manifest, StageRecord, StageStatus
-from run_dir import atomic_write_json, list_outputs
-from stage_registry import (
+from workflows.manifest import Manifest, StageRecord, StageStatus
+from workflows.run_dir import atomic_write_json, list_outputs
+from workflows.stage_registry import (
     StageIncompleteError,
     StageNotImplementedError,
     StageSpec,

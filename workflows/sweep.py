@@ -31,10 +31,13 @@ from typing import Any
 
 from omegaconf import DictConfig, OmegaConf
 
-from manifest import StageStatus
-from pipeline_report import console
-from pipeline_run import EXIT_FAILED, EXIT_INCOMPLETE, EXIT_OK, run_pipeline
-from run_dir import (
+if not __package__:  # run as ``python workflows/<name>.py``: the checkout root makes ``workflows`` importable
+    sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
+
+from workflows.manifest import StageStatus
+from workflows.pipeline_report import console
+from workflows.pipeline_run import EXIT_FAILED, EXIT_INCOMPLETE, EXIT_OK, run_pipeline
+from workflows.run_dir import (
     atomic_write_json,
     atomic_write_text,
     atomic_write_yaml,
@@ -42,9 +45,9 @@ from run_dir import (
     seed_everything,
     write_git_state,
 )
-from schemas import REPO_ROOT
-from stage_registry import StageSpec
-from stage_runner import PipelineConfigError, resolve_device
+from workflows.schemas import REPO_ROOT
+from workflows.stage_registry import StageSpec
+from workflows.stage_runner import PipelineConfigError, resolve_device
 
 __all__ = ["Objective", "SearchParam", "apply_task_overrides", "main", "parse_space", "run_sweep"]
 
@@ -184,7 +187,7 @@ def check_space(cfg: DictConfig, space: Sequence[SearchParam], fixed: Mapping[st
     task_params = [p for p in space if p.key.startswith(TASK_PREFIX)]
     if not task_params and not fixed:
         return
-    from policy_training import task_cfg
+    from workflows.policy_training import task_cfg
 
     base = task_cfg(cfg.train_teacher)
     # Worst case for a range: its low end at its largest value and its high end at its smallest.
@@ -225,7 +228,7 @@ class Objective:
     def _evaluate(self, cfg: DictConfig, iteration: int) -> dict[str, float]:
         """Roll out the chunk's exported ``policy.onnx`` on the fixed materials of ``sweep.eval``."""
         from gmloco.train import EvalCfg, evaluate_policy
-        from policy_training import torch_device
+        from workflows.policy_training import torch_device
 
         section, ev = cfg.train_teacher, cfg.sweep.eval
         out = Path(section.out_dir)
@@ -249,7 +252,7 @@ class Objective:
 
 def _train_kwargs(section: DictConfig, task: Any) -> dict[str, Any]:
     """``TrainRunCfg`` fields of the train stage, as ``train_teacher.run`` builds them, with the trial's task."""
-    from policy_training import teacher_cfg, vanilla_ppo_overrides
+    from workflows.policy_training import teacher_cfg, vanilla_ppo_overrides
 
     kwargs: dict[str, Any] = {"task": task, "hidden_dims": tuple(int(d) for d in section.hidden_dims)}
     if section.algorithm.value == "ppo":
@@ -278,7 +281,7 @@ class TrialStage:
 
     def __call__(self, cfg: DictConfig) -> dict[str, Any]:
         """Train chunk by chunk (``StageRunner`` passes ``resume`` and ``max_minutes``); return the metrics."""
-        from policy_training import newest_checkpoint, run_training, task_cfg
+        from workflows.policy_training import newest_checkpoint, run_training, task_cfg
 
         section = cfg.train_teacher
         task = apply_task_overrides(task_cfg(section), self.task_overrides)
@@ -370,7 +373,7 @@ def run_trial(cfg: DictConfig, trial: Any, objective: Objective, root: Path, dea
 def _prepare(cfg: DictConfig) -> DictConfig:
     """Copy ``cfg``, pin run dir / device, apply the smoke limits; check the sweep's input."""
     if cfg.get("sweep") is None:
-        from config_errors import group_options
+        from workflows.config_errors import group_options
 
         raise _bad("sweep", f"no sweep chosen: add +sweep=<name>. Valid choices: {', '.join(group_options('sweep'))}.")
     cfg = copy.deepcopy(cfg)
@@ -661,8 +664,8 @@ def _defaults(argv: Sequence[str]) -> list[str]:
         args.insert(0, "run_dir=${paths.runs_dir}/${exp_name}/sweep-${run_name}")
     if any(a.lstrip("+").startswith("exp=") for a in argv):
         return args
-    from config_errors import CONF_DIR
-    from schemas import SweepCfg
+    from workflows.config_errors import CONF_DIR
+    from workflows.schemas import SweepCfg
 
     names = [a.split("=", 1)[1] for a in argv if a.lstrip("+").startswith("sweep=")]
     path = CONF_DIR / "sweep" / f"{names[0]}.yaml" if names else None
@@ -680,7 +683,7 @@ def _task(cfg: DictConfig) -> int:
 
 def main() -> None:
     """Command-line entry (Hydra)."""
-    from hydra_entry import hydra_entry
+    from workflows.hydra_entry import hydra_entry
 
     sys.argv = [sys.argv[0], *_defaults(sys.argv[1:])]
     hydra_entry(_task, only_stage="train_teacher")

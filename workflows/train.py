@@ -12,15 +12,21 @@ box and exit codes are the pipeline's (``full_pipeline.py``); the stage itself i
 
 from __future__ import annotations
 
-from train_teacher import run
+import sys
+from pathlib import Path
+
+if not __package__:  # run as ``python workflows/<name>.py``: the checkout root makes ``workflows`` importable
+    sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
+
+from workflows.train_teacher import run
 
 __all__ = ["main", "run"]
 
 
 def main() -> None:
     """Command-line entry: run the train stage alone in a run directory (Hydra)."""
-    from hydra_entry import hydra_entry
-    from pipeline_run import run_from_hydra
+    from workflows.hydra_entry import hydra_entry
+    from workflows.pipeline_run import run_from_hydra
 
     hydra_entry(run_from_hydra, only_stage="train_teacher")
 

@@ -24,11 +24,16 @@ with a checkpoint and raises ``StageIncompleteError`` (rerun to continue from it
 
 from __future__ import annotations
 
+import sys
+from pathlib import Path
 from typing import Any
 
 from omegaconf import DictConfig
 
-from policy_training import jump_task_cfg, run_training, task_cfg, teacher_cfg, vanilla_ppo_overrides
+if not __package__:  # run as ``python workflows/<name>.py``: the checkout root makes ``workflows`` importable
+    sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
+
+from workflows.policy_training import jump_task_cfg, run_training, task_cfg, teacher_cfg, vanilla_ppo_overrides
 
 __all__ = ["main", "run"]
 
@@ -61,8 +66,8 @@ def run(cfg: DictConfig) -> dict[str, float | None]:
 
 def main() -> None:
     """Command-line entry: run this stage alone in a run directory (Hydra)."""
-    from hydra_entry import hydra_entry
-    from pipeline_run import run_from_hydra
+    from workflows.hydra_entry import hydra_entry
+    from workflows.pipeline_run import run_from_hydra
 
     hydra_entry(run_from_hydra, only_stage="train_teacher")
 

@@ -18,9 +18,9 @@ from typing import Any
 import pytest
 from omegaconf import DictConfig
 
-import ablation
-from stage_runner import PipelineConfigError
 from tests.pipeline_helpers import REPO_ROOT, run_cli
+from workflows import ablation
+from workflows.stage_runner import PipelineConfigError
 
 COMMITTED = REPO_ROOT / "artifacts" / "ppo_rft3d"
 """A committed vanilla-PPO artifact (policy.onnx + metrics.json)."""

@@ -10,8 +10,8 @@ from dataclasses import dataclass, field
 import pytest
 from omegaconf import OmegaConf
 
-import schemas
-from config_ranges import RANGE_KEY, Range, each, range_problem, ranged
+from workflows import schemas
+from workflows.config_ranges import RANGE_KEY, Range, each, range_problem, ranged
 
 
 @pytest.mark.parametrize(

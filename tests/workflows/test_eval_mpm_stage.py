@@ -8,7 +8,7 @@ from collections.abc import Callable
 import pytest
 from omegaconf import DictConfig
 
-import eval_mpm
+from workflows import eval_mpm
 
 
 def test_section_settings_reach_the_eval_cfg(compose: Callable[..., DictConfig]) -> None:

@@ -8,7 +8,7 @@ from pathlib import Path
 import pytest
 from omegaconf import DictConfig, OmegaConf
 
-from input_checks import input_problem
+from workflows.input_checks import input_problem
 
 
 def _cfg(contact_model: str) -> DictConfig:

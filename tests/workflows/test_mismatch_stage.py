@@ -6,7 +6,7 @@ from __future__ import annotations
 import pytest
 from omegaconf import OmegaConf
 
-import mismatch
+from workflows import mismatch
 
 
 def _section(ground: str) -> object:

@@ -10,8 +10,8 @@ from pathlib import Path
 
 import pytest
 
-from project_python import VENV_DIR, ensure_project_python
 from tests.pipeline_helpers import REPO_ROOT
+from workflows.project_python import VENV_DIR, ensure_project_python
 
 
 def test_missing_dependencies_without_a_venv_exit_2_with_the_command(

@@ -12,10 +12,10 @@ from typing import Any
 import pytest
 from omegaconf import DictConfig
 
-from pipeline_report import say, stage_bar
-from pipeline_run import run_pipeline
-from run_summary import SMOKE_NOTE, headline
 from tests.pipeline_helpers import CALLS, toy_registry, toy_teacher
+from workflows.pipeline_report import say, stage_bar
+from workflows.pipeline_run import run_pipeline
+from workflows.run_summary import SMOKE_NOTE, headline
 
 Compose = Callable[..., DictConfig]
 
@@ -104,7 +104,7 @@ def test_training_stage_announces_the_checkpoint_it_resumes_from(
     tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:
     """The newest model_<it>.pt is named with its iteration (10 > 3: numeric, not lexical, order); none: silence."""
-    from policy_training import _announce_resume
+    from workflows.policy_training import _announce_resume
 
     _announce_resume("distill", tmp_path)
     assert capsys.readouterr().err == ""

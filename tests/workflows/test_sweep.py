@@ -15,11 +15,10 @@ from typing import Any
 import pytest
 from omegaconf import DictConfig, OmegaConf
 
-import policy_training
-import sweep
-from stage_registry import StageIncompleteError
-from stage_runner import PipelineConfigError
 from tests.pipeline_helpers import run_cli
+from workflows import policy_training, sweep
+from workflows.stage_registry import StageIncompleteError
+from workflows.stage_runner import PipelineConfigError
 
 MU_KEY = "task.material.mu_int.0"
 """The searched DR range end in the fake-training tests."""

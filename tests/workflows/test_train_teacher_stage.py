@@ -9,7 +9,7 @@ from typing import Any
 import pytest
 from omegaconf import DictConfig
 
-import train_teacher
+from workflows import train_teacher
 
 
 def _captured(monkeypatch: pytest.MonkeyPatch) -> dict[str, Any]:
@@ -73,7 +73,7 @@ def test_jump_exps_differ_only_in_the_contact_model(compose: Callable[..., DictC
 
 def test_jump_with_the_vae_teacher_is_refused(compose: Callable[..., DictConfig]) -> None:
     """train_teacher.jump with algorithm=vae_teacher is a composition error naming the key and the fix."""
-    from config_errors import ConfigInputError
+    from workflows.config_errors import ConfigInputError
 
     with pytest.raises(ConfigInputError, match="needs algorithm=ppo") as info:
         compose("+exp=jump_rft3d", "train_teacher.algorithm=vae_teacher")

@@ -14,8 +14,11 @@ from gmloco.deploy.g1 import (
     G1_DAMPING,
     G1_EFFORT_LIMIT,
     G1_FOOT_BODIES,
+    G1_FOOT_SITES,
     G1_JOINT_NAMES,
     G1_KNEES_BENT_POSE,
+    G1_SOLE_BOX_CENTER,
+    G1_SOLE_BOX_HALF_EXTENTS,
     G1_STIFFNESS,
     G1_VELOCITY_LIMIT,
     g1_actuator,
@@ -83,6 +86,40 @@ def test_joint_order_and_feet_match_the_mjcf() -> None:
     assert tuple(model.joint(i).name for i in range(1, model.njnt)) == G1_JOINT_NAMES
     for body in G1_FOOT_BODIES:
         assert mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_BODY, body) >= 0, body
+
+
+def test_sole_sites_and_box_match_the_foot_capsules() -> None:
+    """Each sole site sits on its foot body; the sole box holds the axes of that foot's collision capsules.
+
+    A capsule's axis runs from ``pos - R e_z h`` to ``pos + R e_z h`` in the body frame (R from ``geom_quat``, h the
+    half length ``geom_size[1]``); both ends must lie within ``center +- half_extents`` (exact: the box is the
+    capsules' x span [-0.054, 0.132] m widened by 2 mm).
+    """
+    mujoco = pytest.importorskip("mujoco")
+    from gmloco.deploy.logs.sim.scene import g1_xml_path
+
+    try:
+        path = g1_xml_path()
+    except ImportError:
+        pytest.skip("mjlab is not installed")
+    model = mujoco.MjModel.from_xml_path(str(path))
+    lo = np.subtract(G1_SOLE_BOX_CENTER, G1_SOLE_BOX_HALF_EXTENTS)
+    hi = np.add(G1_SOLE_BOX_CENTER, G1_SOLE_BOX_HALF_EXTENTS)
+    for body, site in zip(G1_FOOT_BODIES, G1_FOOT_SITES, strict=True):
+        b = model.body(body).id
+        assert model.site_bodyid[model.site(site).id] == b, site
+        capsules = [
+            g
+            for g in range(model.ngeom)
+            if model.geom_bodyid[g] == b and model.geom_type[g] == mujoco.mjtGeom.mjGEOM_CAPSULE
+        ]
+        assert capsules, body
+        for g in capsules:
+            rot = np.zeros(9)
+            mujoco.mju_quat2Mat(rot, model.geom_quat[g])
+            axis = rot.reshape(3, 3)[:, 2] * model.geom_size[g, 1]
+            for end in (model.geom_pos[g] + axis, model.geom_pos[g] - axis):
+                assert np.all(end >= lo) and np.all(end <= hi), (body, g, end)
 
 
 def test_knees_bent_pose_matches_mjlab() -> None:

@@ -1,5 +1,5 @@
 # SPDX-License-Identifier: Apache-2.0
-"""The Unitree G1 (29-DoF) in one place: joints, feet, and the actuator table (armature, limits, PD gains).
+"""The Unitree G1 (29-DoF) in one place: joints, feet (bodies, sole sites, sole box), and the actuator table.
 
 Pure Python, no dependency: every package (deploy's light core, contact, train, eval) may import it without
 pulling mujoco, Warp, torch or mjlab. The joint order is the Unitree SDK motor index order of the 29-DoF G1
@@ -19,11 +19,14 @@ __all__ = [
     "G1_EFFORT_LIMIT",
     "G1_FEET",
     "G1_FOOT_BODIES",
+    "G1_FOOT_SITES",
     "G1_JOINT_NAMES",
     "G1_KNEES_BENT_POSE",
     "G1_LEG_JOINTS",
     "G1_NUM_JOINTS",
     "G1_NUM_MOTOR_SLOTS",
+    "G1_SOLE_BOX_CENTER",
+    "G1_SOLE_BOX_HALF_EXTENTS",
     "G1_STIFFNESS",
     "G1_VELOCITY_LIMIT",
     "G1Actuator",
@@ -81,6 +84,18 @@ G1_FEET: tuple[str, ...] = ("left", "right")
 
 G1_FOOT_BODIES: tuple[str, str] = ("left_ankle_roll_link", "right_ankle_roll_link")
 """MJCF bodies of the feet, in :data:`G1_FEET` order; they carry the sole and receive the granular wrench."""
+
+G1_FOOT_SITES: tuple[str, str] = ("left_foot", "right_foot")
+"""MJCF sole sites, in :data:`G1_FEET` order: on the foot bodies, 3.7 cm below the ankle-roll origin."""
+
+G1_SOLE_BOX_CENTER: tuple[float, float, float] = (0.039, 0.0, -0.03)
+"""Centre of a box covering each foot's MJCF collision capsules, in the foot body (ankle-roll-link) frame [m].
+
+The capsules (radius 1 cm) run along x over [-0.054, 0.132] m at z = -0.025 m; the box spans x in
+[-0.056, 0.134] m and z in [-0.04, -0.02] m (:data:`G1_SOLE_BOX_HALF_EXTENTS`).
+"""
+G1_SOLE_BOX_HALF_EXTENTS: tuple[float, float, float] = (0.095, 0.035, 0.01)
+"""Half sizes of the sole box of :data:`G1_SOLE_BOX_CENTER` along x, y, z [m]."""
 
 G1_LEG_JOINTS: dict[str, tuple[str, ...]] = {
     foot: tuple(n for n in G1_JOINT_NAMES[:12] if n.startswith(foot)) for foot in G1_FEET

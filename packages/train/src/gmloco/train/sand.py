@@ -18,7 +18,7 @@ from typing import TYPE_CHECKING, Any
 import mujoco
 import torch
 
-from gmloco.deploy.g1 import G1_FOOT_BODIES
+from gmloco.deploy.g1 import G1_FOOT_BODIES, G1_FOOT_SITES
 from gmloco.train.config import GranularTaskCfg, SandTerrainCfg, contact_force_threshold
 from gmloco.train.foot_contact import FootContactTracker, SurfaceHeightFn
 
@@ -44,7 +44,7 @@ SAND_FLOOR_BODY = "sand_floor"
 """Mocap body carrying the hard-floor plane; its per-env height is the terrain curriculum."""
 FOOT_BODIES = G1_FOOT_BODIES
 """Robot bodies that receive the granular wrench (spec section 4)."""
-FOOT_SITES = ("left_foot", "right_foot")
+FOOT_SITES = G1_FOOT_SITES
 """Sole sites of the G1 (3.7 cm below the ankle-roll origin)."""
 FEET_FLOOR_SENSOR = "feet_floor_contact"
 """mjlab contact sensor between the foot bodies and the hard floor."""

@@ -37,10 +37,10 @@ from typing import Any
 
 import numpy as np
 
+from gmloco.deploy.g1 import G1_FOOT_BODIES
 from gmloco.eval.g1.policy import MjlabOnnxPolicy, PolicySpec, StudentOnnxPolicy
 from gmloco.eval.g1.scene_cfg import G1MpmSceneCfg
 from gmloco.eval.g1.soles import (
-    FOOT_BODIES,
     NJMAX_PER_ROBOT,
     g1_mjcf_path,
     needs_sand,
@@ -131,7 +131,7 @@ class G1MpmScene:
         hidden = int(newton.ShapeFlags.COLLIDE_PARTICLES) | int(newton.ShapeFlags.COLLIDE_SHAPES)
         b.shape_flags = [int(f) & ~hidden for f in b.shape_flags]
         labels = [label.rsplit("/", 1)[-1] for label in b.body_label]
-        self.foot_local = [labels.index(name) for name in FOOT_BODIES]
+        self.foot_local = [labels.index(name) for name in G1_FOOT_BODIES]
         sole = self.cfg.sole
         mu = float(np.median([m.collider_friction for m in self.mats]))
         sole_cfg = newton.ModelBuilder.ShapeConfig(density=0.0, mu=mu, has_shape_collision=self.cfg.floor_contact)

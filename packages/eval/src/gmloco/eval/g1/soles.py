@@ -1,8 +1,8 @@
 # SPDX-License-Identifier: Apache-2.0
 """The G1's soles on the sand: sole boxes, which corners need sand, where they lie against the window and pelvis.
 
-Also the G1 facts the scene builds from: mjlab's MJCF, its foot bodies, MuJoCo Warp's constraint rows per robot,
-and the quaternion helpers of the pelvis frame.
+Also what the scene builds from besides the G1 facts of :mod:`gmloco.deploy.g1` (foot bodies, sole box): mjlab's
+MJCF, MuJoCo Warp's constraint rows per robot, and the quaternion helpers of the pelvis frame.
 """
 
 from __future__ import annotations
@@ -12,10 +12,10 @@ from pathlib import Path
 
 import numpy as np
 
+from gmloco.deploy.g1 import G1_SOLE_BOX_CENTER, G1_SOLE_BOX_HALF_EXTENTS
 from gmloco.eval.metrics.locomotion import quat_wxyz_to_roll_pitch_yaw
 
 __all__ = [
-    "FOOT_BODIES",
     "NJMAX_PER_ROBOT",
     "SOLE_NEAR_M",
     "SoleCfg",
@@ -91,7 +91,6 @@ def sole_reach(corners: np.ndarray, low: np.ndarray, base_q: np.ndarray) -> np.n
     return out
 
 
-FOOT_BODIES = ("left_ankle_roll_link", "right_ankle_roll_link")
 # MuJoCo Warp constraint rows per robot: both soles on the rigid floor (8 corners x 2 soles x 4 pyramidal rows) plus
 # joint limits of a fallen robot reached 93 on the H100 (the voxel-size probes: "nefc overflow" at 64, rows dropped).
 NJMAX_PER_ROBOT = 160
@@ -115,9 +114,9 @@ def quat_rotate_inv(q_xyzw: np.ndarray, v: np.ndarray) -> np.ndarray:
 class SoleCfg:
     """Sole box of each foot, in the ankle-roll-link frame (covers the MJCF foot capsules)."""
 
-    center: tuple[float, float, float] = (0.039, 0.0, -0.03)
+    center: tuple[float, float, float] = G1_SOLE_BOX_CENTER
     """Box centre in the ankle-roll frame [m] (capsules span x in [-0.054, 0.132], sit at z = -0.025)."""
-    half_extents: tuple[float, float, float] = (0.095, 0.035, 0.01)
+    half_extents: tuple[float, float, float] = G1_SOLE_BOX_HALF_EXTENTS
     """Half sizes [m]."""
     effective_mass: float | None = None
     """Mass MPM solves each foot's contact against [kg]; None = half the robot's mass (double stance)."""

@@ -17,6 +17,7 @@ import numpy as np
 import torch
 from mjlab.managers import CommandTerm, CommandTermCfg
 
+from gmloco.deploy.g1 import G1_FOOT_SITES
 from gmloco.train.tasks.g1_jump.reference import JumpReference, load_reference, reference_path
 
 if TYPE_CHECKING:
@@ -199,5 +200,5 @@ class JumpReferenceCommand(CommandTerm):
     def feet_site_ids(self) -> list[int]:
         """Robot-local ids of the two sole sites (left, right)."""
         if not hasattr(self, "_feet_site_ids"):
-            self._feet_site_ids = self.robot.find_sites(("left_foot", "right_foot"), preserve_order=True)[0]
+            self._feet_site_ids = self.robot.find_sites(G1_FOOT_SITES, preserve_order=True)[0]
         return self._feet_site_ids

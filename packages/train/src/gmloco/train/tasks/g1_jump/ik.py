@@ -17,6 +17,8 @@ from dataclasses import dataclass
 import mujoco
 import numpy as np
 
+from gmloco.deploy.g1 import G1_FOOT_SITES
+
 __all__ = [
     "G1_STANDING_JOINT_POS",
     "IkCfg",
@@ -163,7 +165,7 @@ class WholeBodyIk:
     def __init__(self, model: mujoco.MjModel, cfg: IkCfg) -> None:
         self.model, self.cfg = model, cfg
         self.data = mujoco.MjData(model)
-        self.feet = [model.site(n).id for n in ("left_foot", "right_foot")]
+        self.feet = [model.site(n).id for n in G1_FOOT_SITES]
         self.pelvis = model.body("pelvis").id
         self.q_nominal = standing_qpos(model)
         self.q = self.q_nominal.copy()

@@ -15,6 +15,7 @@ from dataclasses import asdict, dataclass
 import mujoco
 import numpy as np
 
+from gmloco.deploy.g1 import G1_FOOT_BODIES, G1_FOOT_SITES
 from gmloco.train.tasks.g1_jump.ik import g1_joint_limits
 from gmloco.train.tasks.g1_jump.profile import GRAVITY
 from gmloco.train.tasks.g1_jump.reference import JumpReference, kinematic_signals
@@ -86,7 +87,7 @@ def inverse_dynamics(model: mujoco.MjModel, ref: JumpReference) -> tuple[np.ndar
     """
     data = mujoco.MjData(model)
     qacc = _accelerations(model, ref)
-    sites = [model.site(n).id for n in ("left_foot", "right_foot")]
+    sites = [model.site(n).id for n in G1_FOOT_SITES]
     T = ref.qpos.shape[0]
     wrench, tau, residual = np.zeros((T, 2, 6)), np.zeros((T, model.nv - 6)), np.zeros((T, 6))
     for i in range(T):
@@ -109,8 +110,8 @@ def sole_extent(model: mujoco.MjModel) -> tuple[np.ndarray, np.ndarray]:
     data = mujoco.MjData(model)
     data.qpos[3] = 1.0
     mujoco.mj_kinematics(model, data)
-    site = model.site("left_foot").id
-    foot = model.body("left_ankle_roll_link").id
+    site = model.site(G1_FOOT_SITES[0]).id
+    foot = model.body(G1_FOOT_BODIES[0]).id
     origin, rot = data.site_xpos[site], data.site_xmat[site].reshape(3, 3)
     points = []
     for g in range(model.ngeom):

@@ -16,6 +16,7 @@ import mujoco
 import numpy as np
 
 from gmloco.deploy.atomic_io import atomic_write
+from gmloco.deploy.g1 import G1_FOOT_BODIES, G1_FOOT_SITES
 from gmloco.train.tasks.g1_jump.ik import IkCfg, IkTargets, WholeBodyIk, load_g1_model, standing_qpos
 from gmloco.train.tasks.g1_jump.profile import JumpProfile, JumpProfileCfg, make_jump_profile
 
@@ -109,15 +110,15 @@ def _sole_height(model: mujoco.MjModel, q: np.ndarray) -> float:
     data = mujoco.MjData(model)
     data.qpos[:] = q
     mujoco.mj_kinematics(model, data)
-    foot = model.body("left_ankle_roll_link").id
+    foot = model.body(G1_FOOT_BODIES[0]).id
     lows = [
         data.geom_xpos[g, 2] - model.geom_size[g, 0]
         for g in range(model.ngeom)
         if model.geom_bodyid[g] == foot and model.geom_type[g] == mujoco.mjtGeom.mjGEOM_CAPSULE
     ]
     if not lows:
-        raise ValueError("the G1 model has no foot collision capsules on left_ankle_roll_link")
-    return float(data.site("left_foot").xpos[2] - min(lows))
+        raise ValueError(f"the G1 model has no foot collision capsules on {G1_FOOT_BODIES[0]}")
+    return float(data.site(G1_FOOT_SITES[0]).xpos[2] - min(lows))
 
 
 def _standing_state(model: mujoco.MjModel) -> tuple[np.ndarray, float]:
@@ -127,7 +128,7 @@ def _standing_state(model: mujoco.MjModel) -> tuple[np.ndarray, float]:
     data.qpos[:] = q
     mujoco.mj_kinematics(model, data)
     sole = _sole_height(model, q)
-    q[2] -= data.site("left_foot").xpos[2] - sole
+    q[2] -= data.site(G1_FOOT_SITES[0]).xpos[2] - sole
     return q, sole
 
 
@@ -201,7 +202,7 @@ def kinematic_signals(model: mujoco.MjModel, qpos: np.ndarray) -> tuple[np.ndarr
         data.qpos[:] = q
         mujoco.mj_kinematics(model, data)
         mujoco.mj_comPos(model, data)
-        feet[i] = [data.site("left_foot").xpos, data.site("right_foot").xpos]
+        feet[i] = [data.site(n).xpos for n in G1_FOOT_SITES]
         com[i] = data.subtree_com[pelvis]
     return feet, com
 
