@@ -3,8 +3,9 @@
 
 Each ``conf/<group>/*.yaml`` extends its schema through its defaults list (``- base_<group>``), so a typo in
 an override or a YAML file fails at composition with the key's name. The stage sections mirror the packages'
-``FooCfg`` dataclasses (OmegaConf cannot hold their ``Literal`` fields); each ``workflows/<stage>.py`` converts
-its section into the package's dataclass. ``eval_mpm``'s section mirrors ``gmloco.eval.g1.config.G1EvalCfg`` (issue 9).
+``FooCfg`` dataclasses where those still hold ``Literal`` fields (OmegaConf cannot); each ``workflows/<stage>.py``
+converts its section into the package's dataclass. The PPO settings are the package's own
+``gmloco.train.teacher_student.PpoCfg``. ``eval_mpm``'s section mirrors ``gmloco.eval.g1.config.G1EvalCfg`` (issue 9).
 """
 
 from __future__ import annotations
@@ -18,6 +19,8 @@ from hydra.core.config_store import ConfigStore
 from omegaconf import MISSING, OmegaConf
 
 from config_ranges import each, ranged
+from gmloco.train.teacher_student.config import DistillCfg as DistillAlgorithmCfg
+from gmloco.train.teacher_student.config import PpoCfg
 from stage_registry import stage_names
 
 __all__ = [
@@ -34,8 +37,6 @@ __all__ = [
     "PathsCfg",
     "PipelineCfg",
     "PolicyTrainingCfg",
-    "PpoSchedule",
-    "PpoSettingsCfg",
     "ScaleName",
     "StageCfg",
     "SweepCfg",
@@ -177,39 +178,6 @@ class JumpSectionCfg:
     """Moving fraction of episodes ending without a failure above which the assist scale drops."""
 
 
-class PpoSchedule(str, Enum):
-    """Learning-rate schedule of rsl-rl's PPO."""
-
-    adaptive = "adaptive"
-    fixed = "fixed"
-
-
-@dataclass
-class PpoSettingsCfg:
-    """PPO hyper-parameters (mirror of ``gmloco.train.teacher_student.PpoCfg``; GM-Loco values by default)."""
-
-    learning_rate: float = ranged(1.0e-3, gt=0)
-    """Adam learning rate (initial value under the adaptive schedule)."""
-    schedule: PpoSchedule = PpoSchedule.adaptive
-    """Learning-rate schedule; adaptive keeps the policy KL near ``desired_kl``."""
-    desired_kl: float = ranged(0.01, gt=0)
-    """Target KL per update [nats] of the adaptive schedule."""
-    entropy_coef: float = ranged(0.005, ge=0)
-    """Entropy bonus weight."""
-    gamma: float = ranged(0.99, ge=0, le=1)
-    """Discount factor per policy step."""
-    lam: float = ranged(0.95, ge=0, le=1)
-    """GAE lambda."""
-    clip_param: float = ranged(0.2, gt=0)
-    """PPO ratio clip."""
-    num_learning_epochs: int = ranged(5, ge=1)
-    """Passes over the rollout per update."""
-    num_mini_batches: int = ranged(4, ge=1)
-    """Mini-batches per pass."""
-    max_grad_norm: float = ranged(1.0, gt=0)
-    """Gradient-norm clip."""
-
-
 @dataclass
 class PolicyTrainingCfg(StageCfg):
     """Fields shared by the two training stages (``gmloco.train.TrainRunCfg``)."""
@@ -222,8 +190,8 @@ class PolicyTrainingCfg(StageCfg):
     """Env steps per env and iteration."""
     save_interval: int = ranged(50, ge=1)
     """Iterations between checkpoints (one is always written when a call ends)."""
-    ppo: PpoSettingsCfg = field(default_factory=PpoSettingsCfg)
-    """PPO hyper-parameters."""
+    ppo: PpoCfg = field(default_factory=PpoCfg)
+    """PPO hyper-parameters (``gmloco.train.teacher_student.PpoCfg``; GM-Loco values by default)."""
 
 
 @dataclass
@@ -265,22 +233,19 @@ class TrainTeacherCfg(PolicyTrainingCfg):
 
 
 @dataclass
-class DistillCfg(PolicyTrainingCfg):
-    """TCN student distilled from the teacher with DAgger + PPO (issue 6)."""
+class DistillCfg(DistillAlgorithmCfg, PolicyTrainingCfg):
+    """TCN student distilled from the teacher with DAgger + PPO (issue 6).
+
+    The stage's training fields plus the package's ``gmloco.train.teacher_student.DistillCfg`` (loss weights, their
+    curriculum, the teacher checkpoint and the PPO settings), all at ``distill.<field>``.
+    """
 
     out_dir: str = _interp("${run_dir}/distill")
     teacher_dir: str = _interp("${train_teacher.out_dir}")
-    """Folder holding the teacher checkpoint (newest ``model_<it>.pt``)."""
+    """Folder holding the teacher checkpoint (newest ``model_<it>.pt``), unless ``teacher_checkpoint`` names one."""
     max_iterations: int = ranged(2000, ge=1)
-    curriculum_finish: int = ranged(1000, ge=1)
-    """Iteration at which w_PPO and w_dist reach their end values (ours)."""
     tcn_channels: list[int] = field(default_factory=lambda: [32, 32, 32], metadata=each(integer=True, ge=1))
-    """Output channels of the student's three 1-D convolutions (ours)."""
-    decoder_loss_weight: float = ranged(1.0, ge=0)
-    """Weight of (psi(z) - psi(z_hat))^2 (paper: 1)."""
-    ppo: PpoSettingsCfg = field(
-        default_factory=lambda: PpoSettingsCfg(learning_rate=5.0e-4, schedule=PpoSchedule.fixed, entropy_coef=0.001)
-    )
+    """Output channels of the student's three 1-D convolutions (``StudentCfg.tcn_channels``, ours)."""
 
 
 @dataclass
