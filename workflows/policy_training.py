@@ -23,6 +23,7 @@ from stage_registry import StageIncompleteError
 __all__ = [
     "distill_overrides",
     "jump_task_cfg",
+    "material_cfg",
     "newest_checkpoint",
     "ppo_cfg",
     "run_training",
@@ -57,10 +58,12 @@ def newest_checkpoint(folder: str | Path) -> Path:
 
 
 def task_cfg(section: DictConfig) -> Any:
-    """Return the ``GranularTaskCfg`` of a train section: contact model x terrain, stacked actor frames."""
+    """Return the ``GranularTaskCfg`` of a train section: contact model x terrain (x material), stacked actor frames."""
     from gmloco.train import g1_granular_task
 
     task = g1_granular_task(str(section.contact_model.value), str(section.terrain.value))  # type: ignore[arg-type]
+    if section.get("material") is not None:
+        task = replace(task, material=material_cfg(section.material, task.material))
     clearance = section.get("foot_clearance", "penalty")
     if str(getattr(section.get("algorithm", ""), "value", "")) == "vae_teacher":
         from gmloco.train.teacher_student.heldout import with_held_out
@@ -72,6 +75,20 @@ def task_cfg(section: DictConfig) -> Any:
         curriculum_scale=float(section.get("curriculum_scale", 1.0)),
         foot_clearance=str(getattr(clearance, "value", clearance)),  # type: ignore[arg-type]
     )
+
+
+def material_cfg(node: DictConfig, terrain_material: Any) -> Any:
+    """Return ``terrain_material`` (a ``MaterialRangeCfg``) with the fields a ``train_teacher.material`` node sets.
+
+    A field the node leaves at ``MaterialRangeCfg``'s default keeps the terrain's value (the deep bed's mu_int).
+    """
+    from gmloco.train.config import MaterialRangeCfg
+
+    values = OmegaConf.to_container(node, resolve=True)
+    assert isinstance(values, dict)
+    default = MaterialRangeCfg()
+    as_set = {str(k): tuple(v) if isinstance(v, list) else v for k, v in values.items()}
+    return replace(terrain_material, **{k: v for k, v in as_set.items() if v != getattr(default, k)})
 
 
 def jump_task_cfg(section: DictConfig) -> Any:

@@ -19,6 +19,7 @@ from hydra.core.config_store import ConfigStore
 from omegaconf import MISSING, OmegaConf
 
 from config_ranges import each, ranged
+from gmloco.train.config import MaterialRangeCfg
 from gmloco.train.teacher_student.config import DistillCfg as DistillAlgorithmCfg
 from gmloco.train.teacher_student.config import PpoCfg
 from stage_registry import stage_names
@@ -230,6 +231,11 @@ class TrainTeacherCfg(PolicyTrainingCfg):
     jump: JumpSectionCfg | None = None
     """Train the jump imitation task (``+exp=jump_rft3d|jump_rigid``, needs ``algorithm: ppo``) instead of the
     velocity task; ``terrain`` and ``foot_clearance`` are then unused. null: the velocity task."""
+    material: MaterialRangeCfg = field(default_factory=MaterialRangeCfg)
+    """Per-env granular material of the velocity task (``gmloco.train.MaterialRangeCfg``): the ranges of mu_int,
+    packing, bulk_density, ... drawn on every reset, or one ``preset`` (``train_teacher.material.mu_int=[0.3,0.6]``,
+    ``train_teacher.material.preset=dry_sand``). A field left at its default keeps the terrain's value (the deep
+    bed's mu_int 0.1-0.4); the VAE teacher's held-out rectangle is then cut out of the ranges."""
 
 
 @dataclass
