@@ -115,4 +115,4 @@ def test_every_schema_default_lies_in_its_range() -> None:
             continue
         rng = range_of(f)
         assert rng is not None
-        assert all(rng.fits(v) for v in (default if isinstance(default, list) else [default])), name
+        assert all(rng.fits(v) for v in (default if isinstance(default, list | tuple) else [default])), name
