@@ -39,6 +39,7 @@ CASES = [
     (["+exp=gm_loco", "mismatch.effects=[actuator.dleay]"], "mismatch.effects", ["did you mean 'actuator.delay'"]),
     (["+exp=gm_loco", "mismatch.real=README.md"], "mismatch.real", ["not an MCAP recording"]),
     (["+exp=gm_loco", "analyze_logs.inputs=[/nonexistent/logs]"], "analyze_logs.inputs", ["does not exist"]),
+    (["+exp=ppo_rigid", "train_teacher.material.mu_int=[0.6,0.3]"], "train_teacher.material.mu_int", ["not a range"]),
 ]
 
 

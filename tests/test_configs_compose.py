@@ -3,6 +3,7 @@
 
 from __future__ import annotations
 
+import dataclasses
 from collections.abc import Callable
 from pathlib import Path
 
@@ -65,7 +66,7 @@ def test_exp_composes_and_instantiates(compose: Callable[..., DictConfig], exp: 
     assert isinstance(obj.train_teacher.contact_model, ContactModelName)
     for name in stage_names():
         stage = getattr(obj, name)
-        assert isinstance(stage, StageCfg)
+        assert all(hasattr(stage, f.name) for f in dataclasses.fields(StageCfg))  # eval_mpm: a G1EvalCfg
         assert Path(stage.out_dir).is_absolute() and Path(stage.out_dir).name == name
         assert Path(stage.out_dir).parent == Path(obj.run_dir)
 
@@ -92,9 +93,11 @@ def test_full_scale_scores_mpm_at_the_accepted_setting(compose: Callable[..., Di
     """Full scale: the accepted setting (3 cm / 500 it / 5 ms x 1 step, 30 cm, 1.4 x 0.6 m); smoke: fast numerics."""
     full = _instantiate(compose("+exp=gm_loco", "+scale=full")).eval_mpm
     smoke = _instantiate(compose("+exp=gm_loco", "+scale=smoke")).eval_mpm
-    assert (full.voxel_size, full.max_iterations, full.frame_dt, full.rigid_substeps) == (0.03, 500, 0.005, 1)
-    assert (full.bed_depth, full.window_length, full.window_width) == (0.30, 1.4, 0.6)
-    assert (smoke.voxel_size, smoke.max_iterations, smoke.frame_dt, smoke.rigid_substeps) == (0.05, 50, 0.01, 2)
+    solver, smoke_solver = full.solver, smoke.solver
+    assert (solver.voxel_size, solver.max_iterations, solver.frame_dt, solver.rigid_substeps) == (0.03, 500, 0.005, 1)
+    assert (full.bed_depth, full.window.length, full.window.width) == (0.30, 1.4, 0.6)
+    assert (smoke_solver.voxel_size, smoke_solver.max_iterations) == (0.05, 50)
+    assert (smoke_solver.frame_dt, smoke_solver.rigid_substeps) == (0.01, 2)
 
 
 def test_ablation_exps_select_their_contact_model(compose: Callable[..., DictConfig]) -> None:

@@ -2,7 +2,9 @@
 """Valid ranges of the numeric config fields, declared next to each field and checked when a config is composed.
 
 A schema field declares its range through :func:`ranged` (a scalar: ``num_envs: int = ranged(4096, ge=1)``) or
-:func:`each` (every element of a list: ``field(default_factory=..., metadata=each(gt=0))``). :func:`range_problem` walks a composed config along its schema
+:func:`each` (every element of a list: ``field(default_factory=..., metadata=each(gt=0))``). A package dataclass
+used as a schema, which cannot import this module, writes the bounds themselves in its ``metadata``
+(``field(default=0.99, metadata={"ge": 0, "le": 1})``); :func:`range_of` reads both forms. :func:`range_problem` walks a composed config along its schema
 dataclass and returns the first value outside its range as ``(dotted key, message)``; the entry point turns it
 into one exit-2 paragraph before anything runs.
 """
@@ -18,10 +20,12 @@ from typing import Any
 
 from omegaconf import DictConfig, ListConfig, OmegaConf
 
-__all__ = ["RANGE_KEY", "Range", "each", "range_problem", "ranged"]
+__all__ = ["BOUND_KEYS", "RANGE_KEY", "Range", "each", "range_of", "range_problem", "ranged"]
 
 RANGE_KEY = "gmloco_range"
 """Key of a field's :class:`Range` in its dataclass ``metadata``."""
+BOUND_KEYS = ("ge", "gt", "le", "lt", "also")
+"""Plain ``metadata`` keys of a package dataclass field's bounds (same meaning as :class:`Range`'s fields)."""
 
 
 def _num(value: float) -> str:
@@ -88,6 +92,18 @@ def each(*, integer: bool = False, **bounds: Any) -> dict[str, Range]:
     return {RANGE_KEY: Range(integer=integer, **bounds)}
 
 
+def range_of(f: dataclasses.Field[Any]) -> Range | None:
+    """The :class:`Range` a field declares: its :data:`RANGE_KEY` entry or its plain bounds; None without one."""
+    if RANGE_KEY in f.metadata:
+        return f.metadata[RANGE_KEY]
+    bounds = {k: f.metadata[k] for k in BOUND_KEYS if k in f.metadata}
+    if not bounds:
+        return None
+    default = _default(f)
+    whole = f.metadata.get("integer", isinstance(default, int) and not isinstance(default, bool))
+    return Range(integer=bool(whole), **bounds)
+
+
 def _schema_of(hint: Any) -> type | None:
     """The dataclass inside a field's type hint (``FooCfg`` or ``FooCfg | None``), else None."""
     for t in (hint, *typing.get_args(hint)) if isinstance(hint, types.UnionType) else (hint,):
@@ -134,7 +150,7 @@ def range_problem(cfg: DictConfig, schema: type, prefix: str = "") -> tuple[str,
             if found:
                 return found
             continue
-        rng = f.metadata.get(RANGE_KEY)
+        rng = range_of(f)
         if rng is None or value is None:
             continue
         message = _value_problem(key, value, rng, _default(f))

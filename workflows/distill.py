@@ -1,10 +1,11 @@
 # SPDX-License-Identifier: Apache-2.0
 """Stage ``distill``: TCN student distilled from the frozen VAE teacher with DAgger + PPO (issue 6).
 
-Reads the newest ``model_<it>.pt`` of ``distill.teacher_dir`` (the ``train_teacher`` stage), builds the same task
-with the ``history`` observation group, and runs ``StudentPPO`` (student acts, frozen teacher labels; w_PPO / w_dist
-curriculum) through the time-boxed, resumable ``gmloco.train.train``. The teacher is loaded through
-``StudentPPO.load``; later checkpoints carry it (``teacher_state_dict``), so a resumed run needs no teacher path.
+Reads ``distill.teacher_checkpoint`` or else the newest ``model_<it>.pt`` of ``distill.teacher_dir`` (the
+``train_teacher`` stage), builds the same task with the ``history`` observation group, and runs ``StudentPPO``
+(student acts, frozen teacher labels; w_PPO / w_dist curriculum) through the time-boxed, resumable
+``gmloco.train.train``. The teacher is loaded through ``StudentPPO.load``; later checkpoints carry it
+(``teacher_state_dict``), so a resumed run needs no teacher path.
 
 Run alone (time-boxed and resumable; works with plain ``python`` and ``PYTHONPATH=packages/*/src:workflows``)::
 
@@ -26,7 +27,7 @@ from omegaconf import DictConfig
 if not __package__:  # run as ``python workflows/<name>.py``: the checkout root makes ``workflows`` importable
     sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
-from workflows.policy_training import distill_overrides, newest_checkpoint, run_training, task_cfg
+from workflows.policy_training import distill_overrides, run_training, task_cfg, teacher_checkpoint
 
 __all__ = ["main", "run"]
 
@@ -45,7 +46,7 @@ def run(cfg: DictConfig) -> dict[str, float | None]:
         hidden_dims=tuple(int(d) for d in teacher.hidden_dims),
         rsl_rl_overrides=distill_overrides(cfg),
         history_length=int(teacher.history_length),
-        init_checkpoint=str(newest_checkpoint(cfg.distill.teacher_dir)),
+        init_checkpoint=str(teacher_checkpoint(cfg.distill)),
         export_onnx=False,
     )
 

@@ -24,11 +24,11 @@ import sys
 import threading
 from collections.abc import Callable, Iterator
 from contextlib import contextmanager
-from dataclasses import replace
+from dataclasses import fields
 from pathlib import Path
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Any
 
-from omegaconf import DictConfig
+from omegaconf import DictConfig, OmegaConf
 
 if not __package__:  # run as ``python workflows/<name>.py``: the checkout root makes ``workflows`` importable
     sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
@@ -42,57 +42,20 @@ if TYPE_CHECKING:
 __all__ = ["eval_cfg", "main", "run"]
 
 
-def _device(device: str) -> str | None:
-    """Warp device of the pipeline's ``device`` (``auto``: Warp's default, CUDA when present)."""
-    return None if device == "auto" else device
-
-
 def eval_cfg(cfg: DictConfig) -> G1EvalCfg:
-    """The ``G1EvalCfg`` of the pipeline's ``eval_mpm`` section (every field the section sets carried over)."""
-    from gmloco.eval.g1.config import G1EvalCfg
-    from gmloco.eval.mpm.box_scene import MpmSolverCfg
-    from gmloco.eval.mpm.window import SandWindowCfg
+    """The ``G1EvalCfg`` the pipeline's ``eval_mpm`` section holds (the section is one, plus the stage's fields).
 
-    s = cfg.eval_mpm
-    base = G1EvalCfg()
-    out = replace(
-        base,
-        policy_path=str(Path(str(s.policy_dir)) / str(s.policy_file)),
-        out_dir=str(s.out_dir),
-        policy_name=str(s.policy_name),
-        terrains=tuple(str(t) for t in s.terrains),
-        scenarios=tuple(str(x) for x in s.scenarios),  # type: ignore[arg-type]
-        speeds=tuple(float(v) for v in s.speeds),
-        num_episodes=int(s.num_episodes),
-        episode_s=float(s.episode_s),
-        circle_radius=float(s.circle_radius),
-        course_slack=float(s.course_slack),
-        bed_depth=float(s.bed_depth),
-        window=SandWindowCfg(
-            moving=bool(s.moving_window),
-            length=float(s.window_length),
-            width=float(s.window_width),
-            lead=float(s.window_lead),
-        ),
-        robots_per_batch=int(s.robots_per_batch),
-        retire_idle_lanes=bool(s.retire_idle_lanes),
-        fit_time_box=bool(s.fit_time_box),
-        cell_capacity_factor=float(s.cell_capacity_factor),
-        record_mcap=bool(s.record_mcap),
-        solver=replace(
-            base.solver,
-            voxel_size=float(s.voxel_size),
-            max_iterations=int(s.max_iterations),
-            frame_dt=float(s.frame_dt),
-            rigid_substeps=int(s.rigid_substeps),
-        ),
-        seed=int(cfg.seed),
-        device=_device(str(cfg.device)),
-        max_minutes=None if s.max_minutes is None else float(s.max_minutes),
-        resume=bool(s.resume),
-    )
-    assert isinstance(out.solver, MpmSolverCfg)
-    return out
+    Its lists become the dataclass's tuples, and the device ``auto`` becomes Warp's default (CUDA when present).
+    """
+    from gmloco.eval.g1.config import G1EvalCfg
+
+    section = OmegaConf.to_object(cfg.eval_mpm)
+    assert isinstance(section, G1EvalCfg)
+    values: dict[str, Any] = {f.name: getattr(section, f.name) for f in fields(G1EvalCfg)}
+    values = {k: tuple(v) if isinstance(v, list) else v for k, v in values.items()}
+    if values["device"] == "auto":
+        values["device"] = None
+    return G1EvalCfg(**values)
 
 
 def _episodes_logged(log: Path) -> int:

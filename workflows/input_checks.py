@@ -1,5 +1,5 @@
 # SPDX-License-Identifier: Apache-2.0
-"""Checks of the selected stages' inputs that need no stage to run: recordings exist, effect ids are known.
+"""Checks of the selected stages' inputs that need no stage to run: recordings exist, effect ids are known, ranges.
 
 Each check returns ``(dotted key, message)`` for the first problem, or None; the entry point turns it into one
 exit-2 paragraph before anything runs, so a typo never becomes a failed stage or a silent ``unexplained``.
@@ -9,7 +9,7 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from omegaconf import DictConfig
+from omegaconf import DictConfig, ListConfig
 
 __all__ = ["MCAP_MAGIC", "input_problem", "mcap_problem"]
 
@@ -82,11 +82,36 @@ def _jump_problem(section: DictConfig) -> tuple[str, str] | None:
     return None
 
 
+def _material_problem(section: DictConfig) -> tuple[str, str] | None:
+    """Each range of ``train_teacher.material`` is ``[low, high]`` with low <= high; a preset is a known medium."""
+    material = section.get("material")
+    if material is None:
+        return None
+    for name, value in material.items():
+        key = f"train_teacher.material.{name}"
+        if not isinstance(value, ListConfig):
+            continue
+        if len(value) != 2 or value[0] > value[1]:
+            return key, f"bad value for '{key}': {list(value)} is not a range; give [low, high] with low <= high."
+    if material.preset is None:
+        return None
+    from gmloco.contact import MATERIAL_PRESETS  # imports Warp: only when a preset is named
+
+    if str(material.preset) not in MATERIAL_PRESETS:
+        return "train_teacher.material.preset", (
+            f"bad value for 'train_teacher.material.preset': '{material.preset}' is not a material preset; "
+            f"choose one of {', '.join(sorted(MATERIAL_PRESETS))}."
+        )
+    return None
+
+
 def input_problem(cfg: DictConfig) -> tuple[str, str] | None:
     """First problem with the inputs of the selected stages, as ``(key, message)``; else None."""
     if "train_teacher" in cfg.stages and (found := _jump_problem(cfg.train_teacher)) is not None:
         return found
     if "train_teacher" in cfg.stages and (found := _calibrated_problem(cfg.train_teacher)) is not None:
+        return found
+    if "train_teacher" in cfg.stages and (found := _material_problem(cfg.train_teacher)) is not None:
         return found
     if "mismatch" in cfg.stages and (found := _mismatch_problem(cfg.mismatch)) is not None:
         return found

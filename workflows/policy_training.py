@@ -23,11 +23,13 @@ from workflows.stage_registry import StageIncompleteError
 __all__ = [
     "distill_overrides",
     "jump_task_cfg",
+    "material_cfg",
     "newest_checkpoint",
     "ppo_cfg",
     "run_training",
     "task_cfg",
     "teacher_cfg",
+    "teacher_checkpoint",
     "torch_device",
     "vanilla_ppo_overrides",
 ]
@@ -56,10 +58,12 @@ def newest_checkpoint(folder: str | Path) -> Path:
 
 
 def task_cfg(section: DictConfig) -> Any:
-    """Return the ``GranularTaskCfg`` of a train section: contact model x terrain, stacked actor frames."""
+    """Return the ``GranularTaskCfg`` of a train section: contact model x terrain (x material), stacked actor frames."""
     from gmloco.train import g1_granular_task
 
     task = g1_granular_task(str(section.contact_model.value), str(section.terrain.value))  # type: ignore[arg-type]
+    if section.get("material") is not None:
+        task = replace(task, material=material_cfg(section.material, task.material))
     clearance = section.get("foot_clearance", "penalty")
     if str(getattr(section.get("algorithm", ""), "value", "")) == "vae_teacher":
         from gmloco.train.teacher_student.heldout import with_held_out
@@ -71,6 +75,20 @@ def task_cfg(section: DictConfig) -> Any:
         curriculum_scale=float(section.get("curriculum_scale", 1.0)),
         foot_clearance=str(getattr(clearance, "value", clearance)),  # type: ignore[arg-type]
     )
+
+
+def material_cfg(node: DictConfig, terrain_material: Any) -> Any:
+    """Return ``terrain_material`` (a ``MaterialRangeCfg``) with the fields a ``train_teacher.material`` node sets.
+
+    A field the node leaves at ``MaterialRangeCfg``'s default keeps the terrain's value (the deep bed's mu_int).
+    """
+    from gmloco.train.config import MaterialRangeCfg
+
+    values = OmegaConf.to_container(node, resolve=True)
+    assert isinstance(values, dict)
+    default = MaterialRangeCfg()
+    as_set = {str(k): tuple(v) if isinstance(v, list) else v for k, v in values.items()}
+    return replace(terrain_material, **{k: v for k, v in as_set.items() if v != getattr(default, k)})
 
 
 def jump_task_cfg(section: DictConfig) -> Any:
@@ -97,12 +115,12 @@ def jump_task_cfg(section: DictConfig) -> Any:
 
 
 def ppo_cfg(section: DictConfig) -> Any:
-    """Return ``teacher_student.PpoCfg`` from a section's ``ppo`` node."""
+    """Return the ``teacher_student.PpoCfg`` a section's ``ppo`` node holds (its structured config)."""
     from gmloco.train.teacher_student import PpoCfg
 
-    values = OmegaConf.to_container(section.ppo, resolve=True, enum_to_str=True)
-    assert isinstance(values, dict)
-    return PpoCfg(**{str(k): v for k, v in values.items()})
+    ppo = OmegaConf.to_object(section.ppo)
+    assert isinstance(ppo, PpoCfg)
+    return ppo
 
 
 def vanilla_ppo_overrides(section: DictConfig) -> dict[str, Any]:
@@ -112,9 +130,7 @@ def vanilla_ppo_overrides(section: DictConfig) -> dict[str, Any]:
     from gmloco.train import make_g1_granular_ppo_cfg
 
     algorithm = asdict(make_g1_granular_ppo_cfg().algorithm)
-    settings = OmegaConf.to_container(section.ppo, resolve=True, enum_to_str=True)
-    assert isinstance(settings, dict)
-    return {"algorithm": algorithm | {str(k): v for k, v in settings.items()}}
+    return {"algorithm": algorithm | ppo_cfg(section).to_rsl_rl()}
 
 
 def teacher_cfg(section: DictConfig) -> Any:
@@ -136,28 +152,27 @@ def teacher_cfg(section: DictConfig) -> Any:
 def distill_overrides(cfg: DictConfig) -> dict[str, Any]:
     """Return the student's rsl-rl entries (actor, critic, frozen teacher, StudentPPO, obs groups).
 
-    ``DistillCfg.to_rsl_rl`` also names ``StudentRunner`` and a teacher path; both are dropped: the time-boxed runner
-    of ``gmloco.train.train`` runs StudentPPO, and ``TrainRunCfg.init_checkpoint`` loads the teacher through
-    ``StudentPPO.load`` (which calls ``load_teacher``), as ``StudentRunner`` would.
+    The ``distill`` section is a ``teacher_student.DistillCfg`` (its schema extends the package's dataclass), so
+    its loss weights, curriculum and PPO settings reach ``student_train_entries`` as composed.
     """
-    from gmloco.train.teacher_student import DistillCfg, ObsGroupsCfg, StudentCfg
+    from gmloco.train.teacher_student import DistillCfg, StudentCfg, student_train_entries
 
-    teacher_section, section = cfg.train_teacher, cfg.distill
-    teacher = teacher_cfg(teacher_section)
+    teacher = teacher_cfg(cfg.train_teacher)
     student = StudentCfg(
         actor_hidden_dims=teacher.actor_hidden_dims,
-        history_length=int(teacher_section.history_length),
-        tcn_channels=tuple(int(c) for c in section.tcn_channels),  # type: ignore[arg-type]
+        history_length=int(cfg.train_teacher.history_length),
+        tcn_channels=tuple(int(c) for c in cfg.distill.tcn_channels),  # type: ignore[arg-type]
     )
-    distill = DistillCfg(
-        curriculum_finish=int(section.curriculum_finish),
-        decoder_loss_weight=float(section.decoder_loss_weight),
-        ppo=ppo_cfg(section),
-    )
-    entries = distill.to_rsl_rl(teacher, student, ObsGroupsCfg())
-    for key in ("class_name", "teacher_checkpoint"):
-        entries.pop(key)
-    return entries
+    distill = OmegaConf.to_object(cfg.distill)
+    assert isinstance(distill, DistillCfg)
+    return student_train_entries(teacher, student, distill)
+
+
+def teacher_checkpoint(section: DictConfig) -> Path:
+    """Return the teacher checkpoint a ``distill`` section names, else the newest one of its ``teacher_dir``."""
+    if section.teacher_checkpoint is not None:
+        return Path(section.teacher_checkpoint)
+    return newest_checkpoint(section.teacher_dir)
 
 
 def _start_fresh(run_dir: Path) -> None:

@@ -2,9 +2,12 @@
 """Structured-config schemas of the pipeline, registered in Hydra's ConfigStore.
 
 Each ``conf/<group>/*.yaml`` extends its schema through its defaults list (``- base_<group>``), so a typo in
-an override or a YAML file fails at composition with the key's name. The stage sections mirror the packages'
-``FooCfg`` dataclasses (OmegaConf cannot hold their ``Literal`` fields); each ``workflows/<stage>.py`` converts
-its section into the package's dataclass. ``eval_mpm``'s section mirrors ``gmloco.eval.g1.config.G1EvalCfg`` (issue 9).
+an override or a YAML file fails at composition with the key's name. Where a package dataclass is the config it is
+used as it is: the PPO settings (``gmloco.train.teacher_student.PpoCfg``), the distillation
+(``teacher_student.DistillCfg``), the training material (``gmloco.train.MaterialRangeCfg``) and the MPM evaluation
+(``gmloco.eval.g1.config.G1EvalCfg``) are extended with the stage's fields and defaults, not copied. The train
+stage's task and network fields are still read one by one into ``GranularTaskCfg`` / ``TeacherCfg``
+(``policy_training.py``), whose ``Literal`` fields OmegaConf cannot hold.
 """
 
 from __future__ import annotations
@@ -15,8 +18,12 @@ from pathlib import Path
 from typing import Any
 
 from hydra.core.config_store import ConfigStore
-from omegaconf import MISSING, OmegaConf
+from omegaconf import MISSING, DictConfig, OmegaConf
 
+from gmloco.eval.g1.config import G1EvalCfg, Scenario
+from gmloco.train.config import MaterialRangeCfg
+from gmloco.train.teacher_student.config import DistillCfg as DistillAlgorithmCfg
+from gmloco.train.teacher_student.config import PpoCfg
 from workflows.config_ranges import each, ranged
 from workflows.stage_registry import stage_names
 
@@ -34,8 +41,6 @@ __all__ = [
     "PathsCfg",
     "PipelineCfg",
     "PolicyTrainingCfg",
-    "PpoSchedule",
-    "PpoSettingsCfg",
     "ScaleName",
     "StageCfg",
     "SweepCfg",
@@ -177,39 +182,6 @@ class JumpSectionCfg:
     """Moving fraction of episodes ending without a failure above which the assist scale drops."""
 
 
-class PpoSchedule(str, Enum):
-    """Learning-rate schedule of rsl-rl's PPO."""
-
-    adaptive = "adaptive"
-    fixed = "fixed"
-
-
-@dataclass
-class PpoSettingsCfg:
-    """PPO hyper-parameters (mirror of ``gmloco.train.teacher_student.PpoCfg``; GM-Loco values by default)."""
-
-    learning_rate: float = ranged(1.0e-3, gt=0)
-    """Adam learning rate (initial value under the adaptive schedule)."""
-    schedule: PpoSchedule = PpoSchedule.adaptive
-    """Learning-rate schedule; adaptive keeps the policy KL near ``desired_kl``."""
-    desired_kl: float = ranged(0.01, gt=0)
-    """Target KL per update [nats] of the adaptive schedule."""
-    entropy_coef: float = ranged(0.005, ge=0)
-    """Entropy bonus weight."""
-    gamma: float = ranged(0.99, ge=0, le=1)
-    """Discount factor per policy step."""
-    lam: float = ranged(0.95, ge=0, le=1)
-    """GAE lambda."""
-    clip_param: float = ranged(0.2, gt=0)
-    """PPO ratio clip."""
-    num_learning_epochs: int = ranged(5, ge=1)
-    """Passes over the rollout per update."""
-    num_mini_batches: int = ranged(4, ge=1)
-    """Mini-batches per pass."""
-    max_grad_norm: float = ranged(1.0, gt=0)
-    """Gradient-norm clip."""
-
-
 @dataclass
 class PolicyTrainingCfg(StageCfg):
     """Fields shared by the two training stages (``gmloco.train.TrainRunCfg``)."""
@@ -222,8 +194,8 @@ class PolicyTrainingCfg(StageCfg):
     """Env steps per env and iteration."""
     save_interval: int = ranged(50, ge=1)
     """Iterations between checkpoints (one is always written when a call ends)."""
-    ppo: PpoSettingsCfg = field(default_factory=PpoSettingsCfg)
-    """PPO hyper-parameters."""
+    ppo: PpoCfg = field(default_factory=PpoCfg)
+    """PPO hyper-parameters (``gmloco.train.teacher_student.PpoCfg``; GM-Loco values by default)."""
 
 
 @dataclass
@@ -262,25 +234,27 @@ class TrainTeacherCfg(PolicyTrainingCfg):
     jump: JumpSectionCfg | None = None
     """Train the jump imitation task (``+exp=jump_rft3d|jump_rigid``, needs ``algorithm: ppo``) instead of the
     velocity task; ``terrain`` and ``foot_clearance`` are then unused. null: the velocity task."""
+    material: MaterialRangeCfg = field(default_factory=MaterialRangeCfg)
+    """Per-env granular material of the velocity task (``gmloco.train.MaterialRangeCfg``): the ranges of mu_int,
+    packing, bulk_density, ... drawn on every reset, or one ``preset`` (``train_teacher.material.mu_int=[0.3,0.6]``,
+    ``train_teacher.material.preset=dry_sand``). A field left at its default keeps the terrain's value (the deep
+    bed's mu_int 0.1-0.4); the VAE teacher's held-out rectangle is then cut out of the ranges."""
 
 
 @dataclass
-class DistillCfg(PolicyTrainingCfg):
-    """TCN student distilled from the teacher with DAgger + PPO (issue 6)."""
+class DistillCfg(DistillAlgorithmCfg, PolicyTrainingCfg):
+    """TCN student distilled from the teacher with DAgger + PPO (issue 6).
+
+    The stage's training fields plus the package's ``gmloco.train.teacher_student.DistillCfg`` (loss weights, their
+    curriculum, the teacher checkpoint and the PPO settings), all at ``distill.<field>``.
+    """
 
     out_dir: str = _interp("${run_dir}/distill")
     teacher_dir: str = _interp("${train_teacher.out_dir}")
-    """Folder holding the teacher checkpoint (newest ``model_<it>.pt``)."""
+    """Folder holding the teacher checkpoint (newest ``model_<it>.pt``), unless ``teacher_checkpoint`` names one."""
     max_iterations: int = ranged(2000, ge=1)
-    curriculum_finish: int = ranged(1000, ge=1)
-    """Iteration at which w_PPO and w_dist reach their end values (ours)."""
     tcn_channels: list[int] = field(default_factory=lambda: [32, 32, 32], metadata=each(integer=True, ge=1))
-    """Output channels of the student's three 1-D convolutions (ours)."""
-    decoder_loss_weight: float = ranged(1.0, ge=0)
-    """Weight of (psi(z) - psi(z_hat))^2 (paper: 1)."""
-    ppo: PpoSettingsCfg = field(
-        default_factory=lambda: PpoSettingsCfg(learning_rate=5.0e-4, schedule=PpoSchedule.fixed, entropy_coef=0.001)
-    )
+    """Output channels of the student's three 1-D convolutions (``StudentCfg.tcn_channels``, ours)."""
 
 
 @dataclass
@@ -296,71 +270,32 @@ class ExportCfg(StageCfg):
     """Env steps rolled out with the ONNX runner, compared with the torch student and the teacher."""
 
 
-@dataclass
-class EvalMpmCfg(StageCfg):
-    """Evaluation on Newton implicit-MPM sand (issue 9)."""
+@dataclass(frozen=True)
+class EvalMpmCfg(G1EvalCfg):
+    """Evaluation on Newton implicit-MPM sand (issue 9): ``gmloco.eval.g1.config.G1EvalCfg`` with the stage's defaults.
+
+    Every ``G1EvalCfg`` field sits at ``eval_mpm.<field>``, its nested numerics and window too
+    (``eval_mpm.solver.voxel_size``, ``eval_mpm.window.length``). The numerics and window defaults are the setting
+    the convergence check accepted (``docs/mpm_eval.md``); ``seed`` and ``device`` follow the pipeline's.
+    """
 
     out_dir: str = _interp("${run_dir}/eval_mpm")
+    max_minutes: float | None = ranged(_interp("${max_minutes}"), gt=0)
+    """Time box of the stage [min]; it saves resumable state and stops when reached. None: no limit."""
     policy_dir: str = _interp("${export.out_dir}")
     """Folder holding ``policy.onnx``."""
     policy_file: str = "policy.onnx"
     """File in ``policy_dir`` (gmloco student export or mjlab actor export)."""
+    policy_path: str = _interp("${.policy_dir}/${.policy_file}")
     policy_name: str = _interp("${exp_name}")
     """The policy's name in the tables and figures (the experiment that trained it, by default)."""
-    num_episodes: int = ranged(100, ge=1)
-    """Episodes per (policy, terrain, scenario); the paper uses 100."""
-    episode_s: float = ranged(10.0, gt=0)
-    """Episode length = course time limit [s]."""
-    voxel_size: float = ranged(0.03, gt=0)
-    """MPM voxel size [m]. The numerics defaults are the setting the convergence check accepted in the accepted-setting runs
-    (``docs/mpm_eval.md``, ``results/mpm_eval/convergence/accepted_setting/README.md``): 3 cm, 500 rheology iterations, 5 ms frames x 1
-    rigid step, a 30 cm bed and 1.4 x 0.6 m windows. 4 and 5 cm voxels change the tracking errors (rejected)."""
-    max_iterations: int = ranged(500, ge=1)
-    """Rheology solver iterations per MPM frame at most. A 3 cm frame of a G1 walk does not reach the solver's
-    tolerance within 1000, so this cap is what each frame costs; 500 walks as 1000 does, 350 sinks 27 % deeper."""
-    frame_dt: float = ranged(0.005, gt=0, le=0.02)
-    """MPM frame = coupling period [s]; must divide the 0.02 s policy step."""
-    rigid_substeps: int = ranged(1, ge=1)
-    """Rigid-solver steps per MPM frame (physics step = frame_dt / rigid_substeps)."""
-    terrains: list[str] = field(
-        default_factory=lambda: ["basalt", "dry_sand", "poppy_seed", "dry_sand_rough", "dry_sand_deep", "transition"]
-    )
+    terrains: tuple[str, ...] = ("basalt", "dry_sand", "poppy_seed", "dry_sand_rough", "dry_sand_deep", "transition")
     """Terrains (``gmloco.eval.mpm.window_terrain.terrain_cfg`` names: a medium, ``<medium>_rough``,
     ``<medium>_deep``, ``transition``)."""
-    scenarios: list[str] = field(default_factory=lambda: ["straight", "circle"])
-    """``straight`` and/or ``circle`` (``gmloco.eval.g1.run``)."""
-    speeds: list[float] = field(default_factory=lambda: [1.0, 1.5, 2.0, 2.5], metadata=each(gt=0))
-    """Forward-speed commands [m/s]; episode k uses ``speeds[k % len(speeds)]``."""
-    circle_radius: float = ranged(2.0, gt=0)
-    """Radius of the circular walk [m]."""
-    course_slack: float = ranged(0.2, ge=0, lt=1)
-    """Fraction of the commanded path that may be left at the time limit and still count as finished."""
-    bed_depth: float = ranged(0.30, gt=0)
-    """Sand depth of the flat and rough terrains [m]; a loaded sole of a walking G1 reaches 20-30 cm on MPM sand."""
-    moving_window: bool = True
-    """Sand window moving with each robot (False: a static bed covering the course, the naive baseline)."""
-    window_length: float = ranged(1.4, gt=0)
-    """Moving window size along x [m] (centred 0.2 m ahead of the pelvis; 1.4 m walks as 1.8 m does: the accepted-setting runs)."""
-    window_width: float = ranged(0.6, gt=0)
-    """Moving window size along y [m] (0.6 m walks as 1.0 m does and costs 40 % less: the batched-cuts runs)."""
-    window_lead: float = ranged(0.2, ge=-5, le=5)
-    """Window centre ahead of the pelvis [m] (negative: behind it). The soles lead the pelvis by <= 0.2 m and trail
-    it by ~0.3 m walking, 0.5-0.75 m in falls (``results/mpm_eval/convergence/voxel_reference_foot_reach/foot_reach.json``)."""
-    robots_per_batch: int = ranged(32, ge=1)
-    """Robots sharing one MPM solver (one lane each)."""
-    retire_idle_lanes: bool = True
-    """Take a lane's sand out of the MPM solve once its robot has no episode left (a cell's tail then carries only
-    the sand of the robots still walking); False keeps it in (the runs up to the ablation-circle runs)."""
-    fit_time_box: bool = True
-    """With ``max_minutes``: start only walks that can end before the time box (a cell too big for the time left is
-    rebuilt with the lanes that fit, a freed lane takes a new walk only while one can end); False: cells run until
-    the box drops their running episodes (the runs up to the reach-window runs)."""
-    cell_capacity_factor: float = ranged(1.5, ge=1, also=(0.0,))
-    """Grid capacity = factor x particles / particles-per-cell (fixed capacity: CUDA graph); 0 = unbounded.
-    The rheology solver sweeps the whole capacity, so its cost grows with the factor: 1.5 gave 1.46x the
-    robot-frames/s of 3.0 (H200, 32 robots, results/mpm_eval/convergence/grid_capacity_solvers); an overflow stops the cell with an error."""
-    record_mcap: bool = True
-    """Write the first episode of every (terrain, scenario, speed) as an MCAP recording."""
+    scenarios: tuple[Scenario, ...] = (Scenario.straight, Scenario.circle)
+    seed: int = ranged(_interp("${seed}"), integer=True, ge=0, le=2**32 - 1)
+    device: str | None = _interp("${device}")
+    """The pipeline's device (``auto``: Warp's default, CUDA when present)."""
     gpus: list[int] = field(default_factory=list, metadata=each(integer=True, ge=0))
     """CUDA devices to spread the evaluation over: one process per GPU, each (terrain, scenario) cell split into one
     share per GPU, pooled into this stage's outputs (``gmloco.eval.g1.gpus``; the shares' folders under
@@ -542,12 +477,27 @@ class PipelineCfg:
     """Contact-model ablation settings, set by ``+ablation=<name>``; None outside ablations."""
 
 
+def _writable(node: DictConfig) -> DictConfig:
+    """Return ``node`` with the read-only flag cleared on every section.
+
+    OmegaConf makes the node of a frozen dataclass (the eval package's configs are frozen values) read-only, which
+    would refuse every YAML and command-line value; the section becomes the frozen dataclass again when a stage
+    converts it (``OmegaConf.to_object``).
+    """
+    OmegaConf.set_readonly(node, False)
+    for key in node:
+        child = node._get_node(key)
+        if isinstance(child, DictConfig) and not child._is_none():
+            _writable(child)
+    return node
+
+
 def register_configs() -> None:
     """Register the schemas and the ``gmloco.repo_root`` resolver (idempotent)."""
     if not OmegaConf.has_resolver("gmloco.repo_root"):
         OmegaConf.register_new_resolver("gmloco.repo_root", lambda: str(REPO_ROOT))
     cs = ConfigStore.instance()
-    cs.store(name="base_pipeline", node=PipelineCfg)
+    cs.store(name="base_pipeline", node=_writable(OmegaConf.structured(PipelineCfg)))
     cs.store(group="paths", name="base_paths", node=PathsCfg)
     cs.store(group="tracking", name="base_tracking", node=TrackingCfg)
     cs.store(group="sweep", name="base_sweep", node=SweepCfg, package="sweep")

@@ -37,8 +37,9 @@ VOLATILE_KEYS = frozenset(
 )
 """Top-level keys that never change a stage's result (where it runs, how long, how it is tracked)."""
 
-VOLATILE_STAGE_KEYS = frozenset({"out_dir", "max_minutes", "resume", "fit_time_box"})
-"""Keys of a stage section that never change its result (``fit_time_box``: which walks one time box starts)."""
+VOLATILE_STAGE_KEYS = frozenset({"out_dir", "max_minutes", "resume", "fit_time_box", "device"})
+"""Keys of a stage section that never change its result (``fit_time_box``: which walks one time box starts;
+``device``: ``eval_mpm``'s copy of the pipeline's)."""
 
 
 def _relocate(obj: Any, roots: Sequence[tuple[str, str]]) -> Any:

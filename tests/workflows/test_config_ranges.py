@@ -5,13 +5,14 @@ from __future__ import annotations
 
 import dataclasses
 import math
+import typing
 from dataclasses import dataclass, field
 
 import pytest
 from omegaconf import OmegaConf
 
 from workflows import schemas
-from workflows.config_ranges import RANGE_KEY, Range, each, range_problem, ranged
+from workflows.config_ranges import Range, each, range_of, range_problem, ranged
 
 
 @pytest.mark.parametrize(
@@ -83,13 +84,25 @@ def test_range_problem_names_the_dotted_key(values: dict, key: str | None, words
         assert found is not None and found[0] == key and words in found[1]
 
 
+def _schema_classes(cls: type, seen: set[type]) -> None:
+    """Add ``cls`` and every dataclass its fields hold (``FooCfg`` or ``FooCfg | None``) to ``seen``."""
+    if cls in seen:
+        return
+    seen.add(cls)
+    for hint in typing.get_type_hints(cls).values():
+        for t in (hint, *typing.get_args(hint)):
+            if isinstance(t, type) and dataclasses.is_dataclass(t):
+                _schema_classes(t, seen)
+
+
 def _ranged_fields() -> list[tuple[str, dataclasses.Field]]:
-    """Every field of the pipeline's schemas (``workflows/schemas.py``) that declares a range."""
-    out = []
+    """Every field that declares a range: the pipeline's schemas and the package dataclasses they hold."""
+    classes: set[type] = set()
     for cls in vars(schemas).values():
         if isinstance(cls, type) and dataclasses.is_dataclass(cls) and cls.__module__ == schemas.__name__:
-            out += [(f"{cls.__name__}.{f.name}", f) for f in dataclasses.fields(cls) if RANGE_KEY in f.metadata]
-    return out
+            _schema_classes(cls, classes)
+    fields = [(f"{cls.__name__}.{f.name}", f) for cls in classes for f in dataclasses.fields(cls)]
+    return [(name, f) for name, f in fields if range_of(f) is not None]
 
 
 def test_every_schema_default_lies_in_its_range() -> None:
@@ -100,5 +113,6 @@ def test_every_schema_default_lies_in_its_range() -> None:
         default = f.default_factory() if f.default_factory is not dataclasses.MISSING else f.default
         if default is None or isinstance(default, str):
             continue
-        rng: Range = f.metadata[RANGE_KEY]
-        assert all(rng.fits(v) for v in (default if isinstance(default, list) else [default])), name
+        rng = range_of(f)
+        assert rng is not None
+        assert all(rng.fits(v) for v in (default if isinstance(default, list | tuple) else [default])), name

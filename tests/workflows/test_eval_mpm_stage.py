@@ -1,5 +1,5 @@
 # SPDX-License-Identifier: Apache-2.0
-"""The ``eval_mpm`` stage hands every setting of its config section to ``G1EvalCfg``."""
+"""The ``eval_mpm`` section is a ``G1EvalCfg``: every setting, nested ones too, reaches the evaluation."""
 
 from __future__ import annotations
 
@@ -8,6 +8,7 @@ from collections.abc import Callable
 import pytest
 from omegaconf import DictConfig
 
+from gmloco.eval.g1.config import G1EvalCfg
 from workflows import eval_mpm
 
 
@@ -16,32 +17,50 @@ def test_section_settings_reach_the_eval_cfg(compose: Callable[..., DictConfig])
     cfg = compose(
         "+exp=gm_loco",
         "+scale=full",
-        "eval_mpm.window_length=0.8",
-        "eval_mpm.window_width=0.5",
-        "eval_mpm.window_lead=-0.1",
+        "eval_mpm.window.length=0.8",
+        "eval_mpm.window.width=0.5",
+        "eval_mpm.window.lead=-0.1",
         "eval_mpm.bed_depth=0.25",
         "eval_mpm.robots_per_batch=50",
-        "eval_mpm.max_iterations=400",
+        "eval_mpm.solver.max_iterations=400",
+        "eval_mpm.solver.velocity_handover=rewind",
+        "eval_mpm.failure.max_tilt=0.5",
         "eval_mpm.retire_idle_lanes=false",
         "eval_mpm.fit_time_box=false",
+        "eval_mpm.speeds=[1.0,2.0]",
+        "device=cpu",
     )
     out = eval_mpm.eval_cfg(cfg)
+    assert type(out) is G1EvalCfg
     assert (out.window.length, out.window.width, out.window.lead, out.window.moving) == (0.8, 0.5, -0.1, True)
     assert (out.bed_depth, out.robots_per_batch, out.solver.max_iterations) == (0.25, 50, 400)
+    assert out.solver.velocity_handover == "rewind" and out.failure.max_tilt == 0.5
     assert out.retire_idle_lanes is False and out.fit_time_box is False
-    assert out.policy_path.endswith("policy.onnx")
+    assert out.speeds == (1.0, 2.0) and out.scenarios == ("straight", "circle") and out.terrains[0] == "basalt"
+    assert (out.seed, out.device) == (42, "cpu") and out.policy_name == "gm_loco"
+    assert out.policy_path.endswith("export/policy.onnx")
 
 
 def test_default_section_matches_the_eval_defaults(compose: Callable[..., DictConfig]) -> None:
     """Without overrides the pipeline scores at ``G1EvalCfg``'s defaults (one accepted setting, not two)."""
-    from gmloco.eval.g1.config import G1EvalCfg
-
     out = eval_mpm.eval_cfg(compose("+exp=gm_loco", "+scale=full"))
     base = G1EvalCfg()
     assert out.window == base.window
     assert (out.bed_depth, out.cell_capacity_factor) == (base.bed_depth, base.cell_capacity_factor)
     assert (out.retire_idle_lanes, out.fit_time_box) == (base.retire_idle_lanes, base.fit_time_box)
-    assert out.solver == base.solver
+    assert out.solver == base.solver and out.failure == base.failure
+    assert out.device is None  # device=auto: Warp's default
+
+
+def test_a_frozen_package_section_takes_yaml_and_command_line_values(compose: Callable[..., DictConfig]) -> None:
+    """The frozen ``G1EvalCfg`` section accepts the smoke scale's nested values and refuses an unknown key by name."""
+    from workflows.config_errors import ConfigInputError
+
+    cfg = compose("+exp=gm_loco", "+scale=smoke", "eval_mpm.window.width=0.7")
+    out = eval_mpm.eval_cfg(cfg)
+    assert (out.solver.voxel_size, out.window.length, out.window.width) == (0.05, 1.0, 0.7)
+    with pytest.raises(ConfigInputError, match="voxel_size"):
+        compose("+exp=gm_loco", "eval_mpm.voxel_size=0.04")
 
 
 def test_gpus_send_the_stage_to_the_several_gpu_runner(

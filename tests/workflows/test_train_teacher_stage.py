@@ -88,3 +88,24 @@ def test_jump_stage_trains_at_smoke_scale(compose: Callable[..., DictConfig], tm
     metrics = train_teacher.run(cfg)
     assert metrics["iteration"] == 2.0
     assert (tmp_path / "train_teacher" / "model_2.pt").exists()
+
+
+def test_material_from_the_command_line_reaches_the_task(
+    compose: Callable[..., DictConfig], monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """``train_teacher.material.<field>`` sets the task's material DR; the VAE teacher still cuts its held-out hole."""
+    seen = _captured(monkeypatch)
+    train_teacher.run(compose("+exp=ppo_rft3d", "train_teacher.material.mu_int=[0.3,0.6]"))
+    assert seen["task"].material.mu_int == (0.3, 0.6) and seen["task"].material.packing == (0.5, 1.0)
+    train_teacher.run(compose("+exp=gm_loco", "train_teacher.material.packing=[0.6,1.0]"))
+    material = seen["task"].material
+    assert material.packing == (0.6, 1.0) and material.held_out_mu_int is not None
+
+
+def test_material_fields_left_at_default_keep_the_terrains(compose: Callable[..., DictConfig]) -> None:
+    """On the deep bed, setting the packing keeps the terrain's own mu_int range (0.1-0.4)."""
+    from workflows.policy_training import task_cfg
+
+    section = compose("+exp=ppo_rft3d", "train_teacher.terrain=deep", "train_teacher.material.packing=[0.6,1.0]")
+    material = task_cfg(section.train_teacher).material
+    assert material.mu_int == (0.1, 0.4) and material.packing == (0.6, 1.0)

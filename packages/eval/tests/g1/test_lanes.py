@@ -8,7 +8,7 @@ from dataclasses import replace
 
 import pytest
 
-from gmloco.eval.g1.config import EpisodeSpec, G1EvalCfg
+from gmloco.eval.g1.config import EpisodeSpec, G1EvalCfg, Scenario
 
 
 def test_one_turning_window_serves_straight_and_circle() -> None:
@@ -19,8 +19,8 @@ def test_one_turning_window_serves_straight_and_circle() -> None:
     from gmloco.eval.g1.lanes import window_and_lanes
 
     cfg = G1EvalCfg()
-    straight, lane_s = window_and_lanes([EpisodeSpec("dry_sand", "straight", 1.0, 0)], cfg)
-    circle, lane_c = window_and_lanes([EpisodeSpec("dry_sand", "circle", 1.0, 0)], cfg)
+    straight, lane_s = window_and_lanes([EpisodeSpec("dry_sand", Scenario.straight, 1.0, 0)], cfg)
+    circle, lane_c = window_and_lanes([EpisodeSpec("dry_sand", Scenario.circle, 1.0, 0)], cfg)
     assert straight == circle == cfg.window and cfg.window.turn_with_robot
     span = math.hypot(1.4, 0.6) + 0.4
     assert lane_s == pytest.approx(span + cfg.lane_gap)
@@ -32,8 +32,8 @@ def test_a_window_on_the_grid_axes_becomes_a_square_on_a_circle() -> None:
     from gmloco.eval.g1.lanes import window_and_lanes
 
     cfg = replace(G1EvalCfg(), window=replace(G1EvalCfg().window, turn_with_robot=False))
-    straight, lane_s = window_and_lanes([EpisodeSpec("dry_sand", "straight", 1.0, 0)], cfg)
-    circle, lane_c = window_and_lanes([EpisodeSpec("dry_sand", "circle", 1.0, 0)], cfg)
+    straight, lane_s = window_and_lanes([EpisodeSpec("dry_sand", Scenario.straight, 1.0, 0)], cfg)
+    circle, lane_c = window_and_lanes([EpisodeSpec("dry_sand", Scenario.circle, 1.0, 0)], cfg)
     assert (straight.length, straight.width) == (cfg.window.length, cfg.window.width)
     side = max(cfg.window.length, cfg.window.width)
     assert (circle.length, circle.width, circle.lead) == (side, side, cfg.window.lead)

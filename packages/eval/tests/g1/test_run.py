@@ -9,7 +9,7 @@ import time
 from dataclasses import replace
 from pathlib import Path
 from types import SimpleNamespace
-from typing import ClassVar, Literal
+from typing import ClassVar
 
 import numpy as np
 import pytest
@@ -19,6 +19,7 @@ from gmloco.eval.g1.config import EpisodeSpec, G1EvalCfg, episode_batches, episo
 from gmloco.eval.g1.scene_cfg import LOG_FIELDS
 from gmloco.eval.g1.score import score_episode
 from gmloco.eval.metrics.episodes import summarize
+from gmloco.eval.mpm.box_scene import GridType
 from gmloco.eval.report.tables_mpm import table_speeds, table_terrains
 
 
@@ -304,15 +305,15 @@ def test_grid_overflow_invalidates_the_cell() -> None:
 
     calls: list[int] = []
     with pytest.raises(RuntimeError, match="--cell-capacity-factor") as info:
-        check_grid_capacity(_grid_scene(True, calls), MpmSolverCfg(grid_type="sparse", max_active_cell_count=100))
+        check_grid_capacity(
+            _grid_scene(True, calls), MpmSolverCfg(grid_type=GridType.sparse, max_active_cell_count=100)
+        )
     assert "100" in str(info.value) and "overflow" in str(info.value)
     assert isinstance(info.value.__cause__, RuntimeError) and calls == [1]
 
 
-@pytest.mark.parametrize(("grid_type", "capacity"), [("sparse", -1), ("dense", 100)])
-def test_grid_capacity_is_not_checked_without_a_reserved_sparse_grid(
-    grid_type: Literal["sparse", "dense"], capacity: int
-) -> None:
+@pytest.mark.parametrize(("grid_type", "capacity"), [(GridType.sparse, -1), (GridType.dense, 100)])
+def test_grid_capacity_is_not_checked_without_a_reserved_sparse_grid(grid_type: GridType, capacity: int) -> None:
     """Newton's per-step allocation (capacity -1) or a dense grid: the overflow check is never asked."""
     from gmloco.eval.g1.cell import check_grid_capacity
     from gmloco.eval.mpm.box_scene import MpmSolverCfg
@@ -328,7 +329,7 @@ def test_grid_within_capacity_passes() -> None:
     from gmloco.eval.mpm.box_scene import MpmSolverCfg
 
     calls: list[int] = []
-    check_grid_capacity(_grid_scene(False, calls), MpmSolverCfg(grid_type="sparse", max_active_cell_count=100))
+    check_grid_capacity(_grid_scene(False, calls), MpmSolverCfg(grid_type=GridType.sparse, max_active_cell_count=100))
     assert calls == [1]
 
 

@@ -9,7 +9,7 @@ from pathlib import Path
 
 import numpy as np
 
-from gmloco.eval.g1.config import EpisodeSpec, G1EvalCfg
+from gmloco.eval.g1.config import EpisodeSpec, G1EvalCfg, Scenario
 from gmloco.eval.g1.score import score_episode
 
 
@@ -33,7 +33,7 @@ def test_perfect_straight_walk_succeeds() -> None:
     dt, n = 0.02, 100
     t = (np.arange(n) + 1) * dt
     log = _log(np.stack([t, 0 * t], 1), np.tile([1.0, 0.0], (n, 1)), np.full(n, 0.7), dt)
-    row = score_episode(EpisodeSpec("dry_sand", "straight", 1.0, 0), cfg, log)
+    row = score_episode(EpisodeSpec("dry_sand", Scenario.straight, 1.0, 0), cfg, log)
     assert row["success"] and row["reason"] == "success"
     assert row["finished_at_s"] is not None and row["finished_at_s"] <= 2.0 * (1 - cfg.course_slack) + 1e-9
     assert math.isclose(row["vel_error"], 0.0, abs_tol=1e-12) and math.isclose(row["yaw_error"], 0.0)
@@ -53,7 +53,7 @@ def test_swing_clearance_of_a_stepping_foot() -> None:
     swing = (np.arange(n) % 20) >= 10
     log["foot_force"][swing, 0, 2] = 0.0
     log["foot_sinkage"][swing, 0] = -0.04
-    row = score_episode(EpisodeSpec("dry_sand", "straight", 1.0, 0), cfg, log)
+    row = score_episode(EpisodeSpec("dry_sand", Scenario.straight, 1.0, 0), cfg, log)
     assert row["swings"] == 4  # the fifth swing is still open when the log ends
     assert math.isclose(row["swing_apex"], 0.04) and math.isclose(row["swing_lift"], 0.06)
 
@@ -67,18 +67,18 @@ def test_a_sole_outside_the_sand_window_flags_the_episode() -> None:
     dt, n = 0.02, 100
     t = (np.arange(n) + 1) * dt
     log = _log(np.stack([t, 0 * t], 1), np.tile([1.0, 0.0], (n, 1)), np.full(n, 0.7), dt)
-    row = score_episode(EpisodeSpec("dry_sand", "straight", 1.0, 0), cfg, log)
+    row = score_episode(EpisodeSpec("dry_sand", Scenario.straight, 1.0, 0), cfg, log)
     assert row["window_exit_s"] is None and not row["window_exit_early"]  # a log without the field: no exit
     log["sole_out"] = np.zeros(n)
     log["sole_out"][30:33] = 4
-    row = score_episode(EpisodeSpec("dry_sand", "straight", 1.0, 0), cfg, log)
+    row = score_episode(EpisodeSpec("dry_sand", Scenario.straight, 1.0, 0), cfg, log)
     assert math.isclose(row["window_exit_s"], 0.6) and row["window_exit_early"]
     log["sole_out"][:] = 0
     log["sole_out"][n - 10 :] = 2  # during the last 0.2 s of the episode: the fall's last moments, not flagged
     log["sole_reach"] = np.tile([0.3, 0.15, 0.2], (n, 1))
     log["sole_reach"][40] = [0.45, 0.1, 0.25]
     log["sole_reach"][50] = np.nan  # both soles in the air
-    row = score_episode(EpisodeSpec("dry_sand", "straight", 1.0, 0), cfg, log)
+    row = score_episode(EpisodeSpec("dry_sand", Scenario.straight, 1.0, 0), cfg, log)
     assert math.isclose(row["window_exit_s"], (n - 10) * dt) and not row["window_exit_early"]
     assert (row["sole_behind_m"], row["sole_ahead_m"], row["sole_side_m"]) == (0.45, 0.15, 0.25)
 
@@ -88,11 +88,11 @@ def test_standing_still_times_out_and_fall_fails() -> None:
     cfg = replace(G1EvalCfg(), episode_s=2.0)
     dt, n = 0.02, 100
     xy, v = np.zeros((n, 2)), np.zeros((n, 2))
-    row = score_episode(EpisodeSpec("dry_sand", "straight", 1.0, 0), cfg, _log(xy, v, np.full(n, 0.7), dt))
+    row = score_episode(EpisodeSpec("dry_sand", Scenario.straight, 1.0, 0), cfg, _log(xy, v, np.full(n, 0.7), dt))
     assert (row["success"], row["reason"]) == (False, "timeout") and math.isclose(row["vel_error"], 1.0)
     z = np.full(n, 0.7)
     z[10:] = 0.1
-    row = score_episode(EpisodeSpec("dry_sand", "straight", 1.0, 0), cfg, _log(xy, v, z, dt))
+    row = score_episode(EpisodeSpec("dry_sand", Scenario.straight, 1.0, 0), cfg, _log(xy, v, z, dt))
     assert (row["reason"], row["alive_s"]) == ("base_height", 10 * dt)
 
 
@@ -154,7 +154,7 @@ def test_transition_course_per_medium(tmp_path: Path) -> None:
     log["foot_force"][swing, 0, 2] = 0.0
     log["foot_sinkage"][:, 0] = -np.where(swing, apex[layer], stance[layer])
     log |= {"terrain_cfg": terrain, "eta": eta[layer]}
-    row = score_episode(EpisodeSpec("transition", "straight", 1.2, 0), cfg, log)
+    row = score_episode(EpisodeSpec("transition", Scenario.straight, 1.2, 0), cfg, log)
     layers = {entry["medium"]: entry for entry in row["layers"]}
     assert list(layers) == list(terrain.materials) and sum(e["steps"] for e in layers.values()) == n
     for k, medium in enumerate(terrain.materials):
@@ -169,7 +169,7 @@ def test_transition_course_per_medium(tmp_path: Path) -> None:
     # a single-medium terrain has no per-medium stats and writes no transition outputs
     flat_log = _log(np.stack([1.2 * t, 0 * t], 1), np.tile([1.2, 0.0], (n, 1)), np.full(n, 0.7), dt)
     flat = score_episode(
-        EpisodeSpec("dry_sand", "straight", 1.2, 0), cfg, flat_log | {"terrain_cfg": terrain_cfg("dry_sand")}
+        EpisodeSpec("dry_sand", Scenario.straight, 1.2, 0), cfg, flat_log | {"terrain_cfg": terrain_cfg("dry_sand")}
     )
     assert flat["layers"] is None and table_transition([flat]) == []
 
@@ -190,7 +190,7 @@ def test_a_window_exit_is_blamed_on_a_turn_or_on_the_reach() -> None:
     log["sole_out"] = np.zeros(n)
     log["sole_out"][30:] = 1
     log["sole_reach"] = np.tile([0.4, 0.2, 0.2], (n, 1))
-    spec = EpisodeSpec("dry_sand", "straight", 1.0, 0)
+    spec = EpisodeSpec("dry_sand", Scenario.straight, 1.0, 0)
     row = score_episode(spec, cfg, log)
     assert math.isclose(row["heading_turn_deg"], 60.0, rel_tol=1e-6)
     assert row["window_exit_cause"] == "turn" and row["window_exit_turn"] and row["window_exit_early"]

@@ -8,7 +8,6 @@ from __future__ import annotations
 
 import math
 from collections.abc import Callable
-from typing import Literal
 
 import numpy as np
 import pytest
@@ -127,13 +126,13 @@ def test_dense_grid_plate_is_stiffer_and_rate_independent() -> None:
     """
     from gmloco.contact.materials import xi_n
     from gmloco.eval.mpm.bed import SandBedCfg
-    from gmloco.eval.mpm.box_scene import MpmSolverCfg
+    from gmloco.eval.mpm.box_scene import GridType, MpmSolverCfg
     from gmloco.eval.rft_fit.plate import PlateIntrusionCfg, run_plate_intrusion
     from gmloco.eval.rft_fit.steady import steady_alpha
 
     m = MATERIAL_PRESETS["dry_sand"]
 
-    def gz(grid_type: Literal["sparse", "dense"], speed: float) -> float:
+    def gz(grid_type: GridType, speed: float) -> float:
         cfg = PlateIntrusionCfg(
             plate_size=0.1, plate_thickness=0.02, speed=speed, depth_range=(0.06, 0.12), travel_before_sampling=0.05,
             bed=SandBedCfg(size_x=0.4, size_y=0.4, depth=0.24, center_x=0.0),
@@ -142,6 +141,6 @@ def test_dense_grid_plate_is_stiffer_and_rate_independent() -> None:
         r = run_plate_intrusion(cfg, m, np.array([0.0, 0.0, -1.0]), np.array([0.0, 0.0, -1.0]))
         return float(steady_alpha(r, cfg.plate_size**2)[0][2] / xi_n(m.rho_c, m.mu_int))
 
-    sparse, dense, dense_slow = gz("sparse", 0.5), gz("dense", 0.5), gz("dense", 0.25)
+    sparse, dense, dense_slow = gz(GridType.sparse, 0.5), gz(GridType.dense, 0.5), gz(GridType.dense, 0.25)
     assert dense > 1.3 * sparse, (sparse, dense)
     assert abs(dense_slow - dense) < 0.1 * dense, (dense, dense_slow)

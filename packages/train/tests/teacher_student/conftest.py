@@ -15,6 +15,7 @@ from gmloco.train.teacher_student import (
     DistillCfg,
     ObsGroupsCfg,
     PpoCfg,
+    PpoSchedule,
     StudentCfg,
     StudentPPO,
     TeacherCfg,
@@ -134,7 +135,9 @@ def student_cfg() -> StudentCfg:
 @pytest.fixture
 def distill_cfg() -> DistillCfg:
     """Imitation-only distillation (w_PPO = 0) with a fast fixed learning rate."""
-    ppo = PpoCfg(num_learning_epochs=2, num_mini_batches=2, learning_rate=3e-3, schedule="fixed", entropy_coef=0.0)
+    ppo = PpoCfg(
+        num_learning_epochs=2, num_mini_batches=2, learning_rate=3e-3, schedule=PpoSchedule.fixed, entropy_coef=0.0
+    )
     return DistillCfg(w_ppo_start=0.0, w_ppo_end=0.0, w_dist_start=1.0, w_dist_end=1.0, ppo=ppo)
 
 

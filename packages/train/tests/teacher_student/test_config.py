@@ -8,6 +8,8 @@ from rsl_rl.utils import resolve_callable
 from gmloco.train.teacher_student import (
     DistillCfg,
     ObsGroupsCfg,
+    PpoCfg,
+    PpoSchedule,
     StudentActor,
     StudentCfg,
     StudentPPO,
@@ -53,3 +55,12 @@ def test_distill_dict_shares_latent_and_decoder_sizes_with_the_teacher() -> None
     assert d["actor"]["latent_dim"] == d["teacher"]["latent_dim"] == 8
     assert d["actor"]["decoder_hidden_dims"] == d["teacher"]["decoder_hidden_dims"]
     assert d["actor"]["history_length"] == 50 and d["teacher_checkpoint"] == "t.pt"
+
+
+def test_ppo_kwargs_carry_plain_strings() -> None:
+    """The enum fields reach rsl-rl as the plain strings it compares against (and that YAML can write)."""
+    kwargs = PpoCfg(schedule=PpoSchedule.fixed).to_rsl_rl()
+    assert type(kwargs["schedule"]) is str and kwargs["schedule"] == "fixed"
+    assert type(kwargs["optimizer"]) is str and kwargs["optimizer"] == "adam"
+    algorithm = DistillCfg().to_rsl_rl(TeacherCfg(), StudentCfg(), ObsGroupsCfg())["algorithm"]
+    assert type(algorithm["schedule"]) is str and algorithm["schedule"] == "fixed"

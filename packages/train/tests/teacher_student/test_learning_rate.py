@@ -15,7 +15,7 @@ from dataclasses import replace
 import torch
 from rsl_rl.env import VecEnv
 
-from gmloco.train.teacher_student import ObsGroupsCfg, TeacherCfg, TeacherPPO
+from gmloco.train.teacher_student import ObsGroupsCfg, PpoSchedule, TeacherCfg, TeacherPPO
 
 ITERATIONS = 40
 
@@ -55,7 +55,7 @@ def _teacher(
     """A 256-env toy env and a teacher with the adaptive schedule (desired KL 0.01, start 1e-3)."""
     torch.manual_seed(0)
     env = make_env(num_envs=256, seed=0)
-    ppo = replace(cfg.ppo, schedule="adaptive", desired_kl=0.01, learning_rate=1e-3, num_learning_epochs=5)
+    ppo = replace(cfg.ppo, schedule=PpoSchedule.adaptive, desired_kl=0.01, learning_rate=1e-3, num_learning_epochs=5)
     teacher = replace(cfg, ppo=ppo, init_std=1.0)
     alg = TeacherPPO.construct_algorithm(
         env.get_observations(), env, runner_cfg(teacher.to_rsl_rl(ObsGroupsCfg())), "cpu"
@@ -120,7 +120,7 @@ def test_only_the_adaptive_rate_moves_the_actions(
     """
     torch.manual_seed(0)
     env = make_env(num_envs=64, seed=0)
-    ppo = replace(teacher_cfg.ppo, schedule="fixed", learning_rate=0.0)
+    ppo = replace(teacher_cfg.ppo, schedule=PpoSchedule.fixed, learning_rate=0.0)
     cfg = runner_cfg(replace(teacher_cfg, ppo=ppo, decoder_learning_rate=1e-2).to_rsl_rl(ObsGroupsCfg()))
     alg: TeacherPPO = TeacherPPO.construct_algorithm(env.get_observations(), env, cfg, "cpu")  # type: ignore[assignment]
     probe = env.get_observations().clone()

@@ -12,7 +12,7 @@ import torch
 from rsl_rl.env import VecEnv
 from rsl_rl.models import MLPModel
 
-from gmloco.train.teacher_student import ObsGroupsCfg, TeacherActor, TeacherCfg, TeacherPPO
+from gmloco.train.teacher_student import ObsGroupsCfg, PpoSchedule, TeacherActor, TeacherCfg, TeacherPPO
 from gmloco.train.teacher_student.teacher_ppo import eta_target
 
 
@@ -95,7 +95,7 @@ def test_teacher_vae_loss_decreases_on_a_fixed_batch(
     """
     torch.manual_seed(0)
     teacher_cfg.kl_weight = 1e-4
-    teacher_cfg.ppo.schedule = "fixed"
+    teacher_cfg.ppo.schedule = PpoSchedule.fixed
     alg = _build(toy_env, teacher_cfg, groups, runner_cfg)
     alg.train_mode()
     _rollout(alg, toy_env, steps=4)

@@ -1,10 +1,15 @@
 # SPDX-License-Identifier: Apache-2.0
-"""The MPM evaluation of one policy (:class:`G1EvalCfg`) and its episodes: terrain, scenario, speed and command."""
+"""The MPM evaluation of one policy (:class:`G1EvalCfg`) and its episodes: terrain, scenario, speed and command.
+
+:class:`G1EvalCfg` is also the pipeline's ``eval_mpm`` section (``workflows/schemas.py``): closed choices are
+``str`` enums, and a numeric field's valid range sits in its ``metadata`` (``ge`` / ``gt`` / ``le`` / ``lt``),
+checked when a config is composed.
+"""
 
 from __future__ import annotations
 
 from dataclasses import dataclass, field
-from typing import Literal
+from enum import StrEnum
 
 from gmloco.eval.metrics.locomotion import FailureCfg
 from gmloco.eval.mpm.box_scene import MpmSolverCfg
@@ -12,7 +17,14 @@ from gmloco.eval.mpm.window import SandWindowCfg
 
 __all__ = ["EpisodeSpec", "G1EvalCfg", "Scenario", "command", "episode_batches", "episode_specs"]
 
-Scenario = Literal["straight", "circle"]
+
+class Scenario(StrEnum):
+    """Command scenario of an episode."""
+
+    straight = "straight"
+    """Walk straight ahead at the commanded speed."""
+    circle = "circle"
+    """Walk a circle of ``G1EvalCfg.circle_radius`` (yaw rate = v / R)."""
 
 
 @dataclass(frozen=True)
@@ -28,24 +40,24 @@ class G1EvalCfg:
     terrains: tuple[str, ...] = ("dry_sand",)
     """Terrains (``gmloco.eval.mpm.window_terrain.terrain_cfg`` names: a preset medium, ``<medium>_rough``,
     ``<medium>_deep``, ``transition``)."""
-    scenarios: tuple[Scenario, ...] = ("straight",)
+    scenarios: tuple[Scenario, ...] = (Scenario.straight,)
     """Command scenarios."""
-    speeds: tuple[float, ...] = (1.0, 1.5, 2.0, 2.5)
+    speeds: tuple[float, ...] = field(default=(1.0, 1.5, 2.0, 2.5), metadata={"gt": 0})
     """Forward-speed commands [m/s]; episode k of a cell uses ``speeds[k % len(speeds)]``."""
-    num_episodes: int = 100
+    num_episodes: int = field(default=100, metadata={"ge": 1})
     """Episodes per (terrain, scenario)."""
-    shard: int = 0
+    shard: int = field(default=0, metadata={"ge": 0})
     """Which share of each cell's episodes this run scores: those whose index k has ``k % shards == shard``."""
-    shards: int = 1
+    shards: int = field(default=1, metadata={"ge": 1})
     """Shares a cell's episodes are split into (one run folder, e.g. one GPU, each; ``paper_tables`` pools the
     folders). With as many shares as speeds, each share walks one speed."""
-    episode_s: float = 10.0
+    episode_s: float = field(default=10.0, metadata={"gt": 0})
     """Episode length = course time limit [s]."""
-    circle_radius: float = 2.0
+    circle_radius: float = field(default=2.0, metadata={"gt": 0})
     """Radius of the circular walk [m] (yaw rate = v / R)."""
-    course_slack: float = 0.2
+    course_slack: float = field(default=0.2, metadata={"ge": 0, "lt": 1})
     """Fraction of the commanded path that may be left when time runs out and still count as finished [-]."""
-    bed_depth: float = 0.30
+    bed_depth: float = field(default=0.30, metadata={"gt": 0})
     """Sand depth of the flat and rough terrains [m] (the deep terrain has its own 0.30 m); a loaded sole of a
     walking G1 reaches 20-30 cm on MPM sand (``results/mpm_eval/convergence/batched_cuts``)."""
     window: SandWindowCfg = field(default_factory=lambda: SandWindowCfg(length=1.4, width=0.6))
@@ -53,9 +65,9 @@ class G1EvalCfg:
     walks as 1.8 m does, 0.6 m wide as 1.0 m does (``docs/mpm_eval.md``); a 1.0 x 0.5 m window was rejected. The
     window turns with the robot's heading (within ``turn_step``), so straight walks, circles and drifting headings
     share one setting; ``turn_with_robot=False`` gives the box of the grid's axes the earlier tables used."""
-    bed_margin: float = 0.6
+    bed_margin: float = field(default=0.6, metadata={"ge": 0})
     """Static beds: margin around the commanded path [m]."""
-    robots_per_batch: int = 32
+    robots_per_batch: int = field(default=32, metadata={"ge": 1})
     """Robots (lanes) simulated together in one MPM solver."""
     refill: bool = True
     """Start a lane's next episode as soon as its robot falls or its episode ends (one solver per cell, episodes
@@ -64,9 +76,9 @@ class G1EvalCfg:
     """Take a lane's sand out of the MPM solve once its robot has no episode left (``G1MpmScene.retire_robots``):
     the cell's tail, while its last robots walk, costs only their sand. False: idle lanes keep their sand in the
     solve (the runs up to the ablation-circle runs)."""
-    lane_gap: float = 2.0
+    lane_gap: float = field(default=2.0, metadata={"ge": 0})
     """Free space between neighbouring lanes' windows or paths [m] (robots may drift)."""
-    cell_capacity_factor: float = 1.5
+    cell_capacity_factor: float = field(default=1.5, metadata={"ge": 1, "also": (0.0,)})
     """Grid capacity = factor x particles / particles-per-cell (fixed capacity: CUDA graph); 0 = unbounded.
     The rheology solver sweeps the whole capacity, so its cost grows with the factor: 1.5 gave 1.46x the
     robot-frames/s of 3.0 (H200, 32 robots, results/mpm_eval/convergence/grid_capacity_solvers); an overflow stops the cell with an error."""
@@ -84,11 +96,11 @@ class G1EvalCfg:
     """Write the best walk of every (terrain, scenario, speed) group as an MCAP recording (``recordings/``): a success
     if any, else the longest time alive; a sidecar JSON names the episode. Runs before the square-window runs recorded the
     group's first episode to end."""
-    seed: int = 0
+    seed: int = field(default=0, metadata={"ge": 0, "le": 2**32 - 1})
     """Seed of the sand."""
     device: str | None = None
     """Warp device."""
-    max_minutes: float | None = None
+    max_minutes: float | None = field(default=None, metadata={"gt": 0})
     """Stop (resumable) after this much wall time [min]."""
     fit_time_box: bool = True
     """With ``max_minutes``: start only walks that can end before it (``g1_eval_fit``): a cell whose running walks

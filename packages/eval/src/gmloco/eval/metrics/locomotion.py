@@ -15,7 +15,7 @@
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 
@@ -41,11 +41,11 @@ __all__ = [
 class FailureCfg:
     """Failure rules of the paper."""
 
-    min_base_height: float = 0.2
+    min_base_height: float = field(default=0.2, metadata={"ge": 0})
     """Failure when the base (pelvis) is below this height above the sand surface [m]."""
-    max_tilt: float = math.pi / 4
+    max_tilt: float = field(default=math.pi / 4, metadata={"gt": 0})
     """Failure when |roll| or |pitch| exceeds this [rad]."""
-    time_limit_s: float = 10.0
+    time_limit_s: float = field(default=10.0, metadata={"gt": 0})
     """Failure when the course is not finished within this time [s]."""
 
 

@@ -22,7 +22,8 @@ from __future__ import annotations
 import time
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field, replace
-from typing import Any, Literal, get_args
+from enum import StrEnum
+from typing import Any, Literal
 
 import numpy as np
 
@@ -33,6 +34,7 @@ from gmloco.eval.mpm.materials import GranularMaterial, MpmMaterialCfg, apply_mp
 
 __all__ = [
     "MIN_RHEOLOGY_ITERATIONS",
+    "GridType",
     "MpmBoxScene",
     "MpmBoxSceneCfg",
     "MpmSolverCfg",
@@ -43,8 +45,26 @@ __all__ = [
     "region_offsets",
 ]
 
-VelocityHandover = Literal["predict", "rewind", "actual"]
-"""Coupling schemes: which collider velocity the MPM solve sees (``MpmSolverCfg.velocity_handover``)."""
+
+class VelocityHandover(StrEnum):
+    """Coupling schemes: which collider velocity the MPM solve sees (``MpmSolverCfg.velocity_handover``)."""
+
+    predict = "predict"
+    """The velocity plus g frame_dt."""
+    rewind = "rewind"
+    """The velocity minus the lagged sand wrench's change (Newton's ``example_mpm_twoway_coupling``)."""
+    actual = "actual"
+    """The velocity as it is."""
+
+
+class GridType(StrEnum):
+    """Grid of ``SolverImplicitMPM`` (``MpmSolverCfg.grid_type``)."""
+
+    sparse = "sparse"
+    dense = "dense"
+    fixed = "fixed"
+    """Fixed capacity (``max_active_cell_count``): allows CUDA graph capture."""
+
 
 MIN_RHEOLOGY_ITERATIONS = 25
 """Newton 1.5.2's Gauss-Seidel ``solve_granularity``: the eager solver loop runs ``max_iterations // 25`` batches."""
@@ -54,18 +74,18 @@ MIN_RHEOLOGY_ITERATIONS = 25
 class MpmSolverCfg:
     """Numerics of ``SolverImplicitMPM`` (names as in ``SolverImplicitMPM.Config``)."""
 
-    voxel_size: float = 0.05
+    voxel_size: float = field(default=0.05, metadata={"gt": 0})
     """Grid voxel size [m]; choose it by the convergence check (README)."""
-    frame_dt: float = 0.01
-    """MPM step = frame time [s] (100 Hz as Newton's coupled example)."""
-    rigid_substeps: int = 4
+    frame_dt: float = field(default=0.01, metadata={"gt": 0, "le": 0.02})
+    """MPM step = frame time [s] (100 Hz as Newton's coupled example); must divide the 0.02 s policy step."""
+    rigid_substeps: int = field(default=4, metadata={"ge": 1})
     """Rigid-solver substeps per frame."""
-    max_iterations: int = 50
+    max_iterations: int = field(default=50, metadata={"ge": 1})
     """Rheology solver iterations per step. Without a CUDA graph Newton runs ``max_iterations // 25`` batches of 25
     Gauss-Seidel sweeps, so fewer than 25 means *no* solve at all: no collider acts (issue 5's zero plate force)."""
     tolerance: float = 1.0e-4
     """Rheology solver tolerance."""
-    grid_type: Literal["sparse", "dense", "fixed"] = "sparse"
+    grid_type: GridType = GridType.sparse
     """Grid type; ``"fixed"`` allows CUDA graph capture (set ``max_active_cell_count``). Caution: in the box scene
     on CPU, ``"fixed"`` (padding 0 or 4) missed the box's impact and then launched it upwards; use ``"sparse"``."""
     grid_padding: int = 0
@@ -77,16 +97,16 @@ class MpmSolverCfg:
     rheology_solver: str = "auto"
     """Rheology solver (``SolverImplicitMPM.Config.solver``): ``"auto"`` (Gauss-Seidel for the Q1 velocity basis),
     one name, or a comma-separated warm-start sequence such as ``"cr,gs"`` (a Krylov solve, then Gauss-Seidel)."""
-    velocity_handover: VelocityHandover = "predict"
+    velocity_handover: VelocityHandover = VelocityHandover.predict
     """Collider velocity the MPM solve sees (the coupling scheme; :func:`hand_over_velocity`): ``"predict"``
     (velocity + g frame_dt), ``"rewind"`` (velocity minus the lagged sand wrench's change; every MPM result before
     the hand-over probes used it: it returns an impact twice, restitution ~1) or ``"actual"`` (the velocity as it is)."""
 
     def __post_init__(self) -> None:
         """Refuse settings under which Newton's eager (CPU / no-graph) rheology loop would not iterate."""
-        if self.velocity_handover not in get_args(VelocityHandover):
+        if self.velocity_handover not in set(VelocityHandover):
             raise ValueError(
-                f"velocity_handover={self.velocity_handover!r}: choose one of {get_args(VelocityHandover)}"
+                f"velocity_handover={self.velocity_handover!r}: choose one of {[v.value for v in VelocityHandover]}"
             )
         if self.max_iterations < MIN_RHEOLOGY_ITERATIONS:
             raise ValueError(

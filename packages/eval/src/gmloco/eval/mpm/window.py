@@ -18,7 +18,7 @@ Static windows (``moving=False``) are the naive baseline: a bed covering the who
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
@@ -77,21 +77,21 @@ class SandWindowCfg:
     """Recentre the window on the robot every frame (recycling columns); False = a static bed."""
     turn_with_robot: bool = True
     """Turn the moving window with the robot's heading (False: its sides stay on the grid's axes)."""
-    turn_step: float = math.radians(3.0)
+    turn_step: float = field(default=math.radians(3.0), metadata={"ge": 0})
     """Heading change of the robot that turns the window to it [rad]: the window lags the heading by at most this,
     and the gait's yaw sway below it does not re-seed the window's corners every step."""
-    length: float = 1.8
+    length: float = field(default=1.8, metadata={"gt": 0})
     """Window size along the robot's heading [m] (default: the rear wall 0.7 m behind the pelvis, beyond a trailing
     foot's reach; along x for a window that does not turn)."""
-    width: float = 1.0
+    width: float = field(default=1.0, metadata={"gt": 0})
     """Window size across the robot's heading [m] (along y for a window that does not turn)."""
-    lead: float = 0.2
+    lead: float = field(default=0.2, metadata={"ge": -5, "le": 5})
     """Window centre ahead of the pelvis along its heading [m] (static: at the start)."""
     offset_y: float = 0.0
     """Window centre left of the pelvis heading [m] (static beds around a circular course)."""
-    particles_per_voxel: int = 2
+    particles_per_voxel: int = field(default=2, metadata={"ge": 1})
     """Particles per voxel edge (8 per cell at 2)."""
-    jitter: float = 0.5
+    jitter: float = field(default=0.5, metadata={"ge": 0, "le": 1})
     """Random particle offset as a fraction of the spacing [-]."""
 
 

@@ -10,29 +10,76 @@
   with its deploy metadata (:mod:`gmloco.train.tasks.g1_granular.policy_metadata`) and checks it.
 * Held-out materials: :class:`HeldOutRegionCfg` (a (rho_c, mu_int) rectangle the DR never draws, see
   :func:`redraw_outside`) and :func:`r2_score` for the decoded eta.
+
+The exports are resolved lazily (PEP 562): ``gmloco.train.teacher_student.config`` (pure data, read by the
+pipeline's config schemas) imports without torch or rsl-rl.
 """
 
-from gmloco.train.teacher_student.config import (
-    CRITIC_CLASS,
-    STUDENT_ACTOR_CLASS,
-    STUDENT_PPO_CLASS,
-    STUDENT_RUNNER_CLASS,
-    TEACHER_ACTOR_CLASS,
-    TEACHER_PPO_CLASS,
-    DistillCfg,
-    ObsGroupsCfg,
-    PpoCfg,
-    StudentCfg,
-    TeacherCfg,
-    student_train_entries,
-)
-from gmloco.train.teacher_student.curriculum import LinearRamp
-from gmloco.train.teacher_student.heldout import DEFAULT_HELD_OUT, HeldOutRegionCfg, r2_score, redraw_outside
-from gmloco.train.teacher_student.runner import StudentRunner
-from gmloco.train.teacher_student.student import DEFAULT_HISTORY_LENGTH, StudentActor
-from gmloco.train.teacher_student.student_ppo import StudentPPO
-from gmloco.train.teacher_student.teacher import TeacherActor
-from gmloco.train.teacher_student.teacher_ppo import TeacherPPO
+from __future__ import annotations
+
+import importlib
+from typing import TYPE_CHECKING, Any
+
+if TYPE_CHECKING:
+    from gmloco.train.teacher_student.config import (
+        CRITIC_CLASS,
+        DEFAULT_HISTORY_LENGTH,
+        STUDENT_ACTOR_CLASS,
+        STUDENT_PPO_CLASS,
+        STUDENT_RUNNER_CLASS,
+        TEACHER_ACTOR_CLASS,
+        TEACHER_PPO_CLASS,
+        DistillCfg,
+        ObsGroupsCfg,
+        PpoCfg,
+        PpoOptimizer,
+        PpoSchedule,
+        StudentCfg,
+        TeacherCfg,
+        student_train_entries,
+    )
+    from gmloco.train.teacher_student.curriculum import LinearRamp
+    from gmloco.train.teacher_student.heldout import DEFAULT_HELD_OUT, HeldOutRegionCfg, r2_score, redraw_outside
+    from gmloco.train.teacher_student.runner import StudentRunner
+    from gmloco.train.teacher_student.student import StudentActor
+    from gmloco.train.teacher_student.student_ppo import StudentPPO
+    from gmloco.train.teacher_student.teacher import TeacherActor
+    from gmloco.train.teacher_student.teacher_ppo import TeacherPPO
+
+_CONFIG = "gmloco.train.teacher_student.config"
+_EXPORTS: dict[str, str] = {
+    **dict.fromkeys(
+        (
+            "CRITIC_CLASS",
+            "DEFAULT_HISTORY_LENGTH",
+            "STUDENT_ACTOR_CLASS",
+            "STUDENT_PPO_CLASS",
+            "STUDENT_RUNNER_CLASS",
+            "TEACHER_ACTOR_CLASS",
+            "TEACHER_PPO_CLASS",
+            "DistillCfg",
+            "ObsGroupsCfg",
+            "PpoCfg",
+            "PpoOptimizer",
+            "PpoSchedule",
+            "StudentCfg",
+            "TeacherCfg",
+            "student_train_entries",
+        ),
+        _CONFIG,
+    ),
+    "LinearRamp": "gmloco.train.teacher_student.curriculum",
+    "DEFAULT_HELD_OUT": "gmloco.train.teacher_student.heldout",
+    "HeldOutRegionCfg": "gmloco.train.teacher_student.heldout",
+    "r2_score": "gmloco.train.teacher_student.heldout",
+    "redraw_outside": "gmloco.train.teacher_student.heldout",
+    "StudentRunner": "gmloco.train.teacher_student.runner",
+    "StudentActor": "gmloco.train.teacher_student.student",
+    "StudentPPO": "gmloco.train.teacher_student.student_ppo",
+    "TeacherActor": "gmloco.train.teacher_student.teacher",
+    "TeacherPPO": "gmloco.train.teacher_student.teacher_ppo",
+}
+"""Public name -> the module that defines it."""
 
 __all__ = [
     "CRITIC_CLASS",
@@ -48,6 +95,8 @@ __all__ = [
     "LinearRamp",
     "ObsGroupsCfg",
     "PpoCfg",
+    "PpoOptimizer",
+    "PpoSchedule",
     "StudentActor",
     "StudentCfg",
     "StudentPPO",
@@ -59,3 +108,19 @@ __all__ = [
     "redraw_outside",
     "student_train_entries",
 ]
+
+
+def __getattr__(name: str) -> Any:
+    """Import the module defining the public ``name`` on first access and cache the value in this module."""
+    module = _EXPORTS.get(name)
+    if module is None:
+        # AttributeError lets ``from gmloco.train.teacher_student import losses`` fall back to the submodule
+        raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
+    value = getattr(importlib.import_module(module), name)
+    globals()[name] = value
+    return value
+
+
+def __dir__() -> list[str]:
+    """List the module's attributes, including the not-yet-imported public names."""
+    return sorted({*globals(), *__all__})

@@ -5,17 +5,21 @@ Pure data. ``TeacherCfg.to_rsl_rl`` and ``DistillCfg.to_rsl_rl`` return the ``ac
 (``teacher``) / ``algorithm`` / ``obs_groups`` entries of an rsl-rl train cfg; merge them onto a runner cfg, e.g.
 ``asdict(RslRlOnPolicyRunnerCfg(...)) | teacher.to_rsl_rl(groups)``. Network sizes follow Kamohara et al.,
 arXiv 2603.13707; values the paper does not give are marked "ours".
+
+The dataclasses are also the pipeline's structured configs (``workflows/schemas.py``): closed choices are ``str``
+enums, and a numeric field's valid range is written in its ``metadata`` (``ge`` / ``gt`` / ``le`` / ``lt``), checked
+when a config is composed.
 """
 
 from __future__ import annotations
 
 from dataclasses import asdict, dataclass, field
+from enum import Enum, StrEnum
 from typing import Literal
-
-from gmloco.train.teacher_student.student import DEFAULT_HISTORY_LENGTH
 
 __all__ = [
     "CRITIC_CLASS",
+    "DEFAULT_HISTORY_LENGTH",
     "STUDENT_ACTOR_CLASS",
     "STUDENT_PPO_CLASS",
     "STUDENT_RUNNER_CLASS",
@@ -24,6 +28,8 @@ __all__ = [
     "DistillCfg",
     "ObsGroupsCfg",
     "PpoCfg",
+    "PpoOptimizer",
+    "PpoSchedule",
     "StudentCfg",
     "TeacherCfg",
     "student_train_entries",
@@ -42,6 +48,26 @@ STUDENT_RUNNER_CLASS = f"{_PKG}.runner:StudentRunner"
 """Runner class for distillation (loads the teacher checkpoint)."""
 CRITIC_CLASS = "MLPModel"
 """The asymmetric critic is rsl-rl's stock MLP model on the privileged group."""
+DEFAULT_HISTORY_LENGTH = 50
+"""N: proprioceptive history frames seen by the student (1.0 s at 50 Hz)."""
+
+
+class PpoSchedule(StrEnum):
+    """Learning-rate schedule of rsl-rl's PPO."""
+
+    adaptive = "adaptive"
+    """Scale the rate so that the policy KL per update stays near ``desired_kl``."""
+    fixed = "fixed"
+    """Keep ``learning_rate``."""
+
+
+class PpoOptimizer(StrEnum):
+    """Optimizer names rsl-rl resolves."""
+
+    adam = "adam"
+    adamw = "adamw"
+    sgd = "sgd"
+    rmsprop = "rmsprop"
 
 
 @dataclass
@@ -79,34 +105,38 @@ class ObsGroupsCfg:
 class PpoCfg:
     """PPO hyper-parameters, the keyword arguments of rsl-rl's ``PPO`` (same names and defaults as mjlab's cfg)."""
 
-    num_learning_epochs: int = 5
+    num_learning_epochs: int = field(default=5, metadata={"ge": 1})
     """Passes over the rollout per update."""
-    num_mini_batches: int = 4
+    num_mini_batches: int = field(default=4, metadata={"ge": 1})
     """Mini-batches per pass; mini-batch size = num_envs * num_steps_per_env / num_mini_batches."""
-    learning_rate: float = 1e-3
+    learning_rate: float = field(default=1e-3, metadata={"gt": 0})
     """Adam learning rate (initial value under the adaptive schedule)."""
-    schedule: Literal["adaptive", "fixed"] = "adaptive"
+    schedule: PpoSchedule = PpoSchedule.adaptive
     """Learning-rate schedule; adaptive keeps the policy KL near ``desired_kl``."""
-    gamma: float = 0.99
+    gamma: float = field(default=0.99, metadata={"ge": 0, "le": 1})
     """Discount factor per policy step."""
-    lam: float = 0.95
+    lam: float = field(default=0.95, metadata={"ge": 0, "le": 1})
     """GAE lambda."""
-    entropy_coef: float = 0.005
+    entropy_coef: float = field(default=0.005, metadata={"ge": 0})
     """Entropy bonus weight."""
-    desired_kl: float = 0.01
+    desired_kl: float = field(default=0.01, metadata={"gt": 0})
     """Target KL divergence per update [nats] for the adaptive schedule."""
-    max_grad_norm: float = 1.0
+    max_grad_norm: float = field(default=1.0, metadata={"gt": 0})
     """Gradient-norm clip, applied to actor and critic separately."""
-    value_loss_coef: float = 1.0
+    value_loss_coef: float = field(default=1.0, metadata={"ge": 0})
     """Weight of the value loss."""
     use_clipped_value_loss: bool = True
     """Clip the value update around the rollout values."""
-    clip_param: float = 0.2
+    clip_param: float = field(default=0.2, metadata={"gt": 0})
     """PPO ratio clip epsilon."""
     normalize_advantage_per_mini_batch: bool = False
     """Normalize advantages per mini-batch instead of over the whole rollout."""
-    optimizer: Literal["adam", "adamw", "sgd", "rmsprop"] = "adam"
+    optimizer: PpoOptimizer = PpoOptimizer.adam
     """Optimizer name resolved by rsl-rl."""
+
+    def to_rsl_rl(self) -> dict:
+        """Return the fields as rsl-rl's ``PPO`` keyword arguments (enums as their names)."""
+        return {k: v.value if isinstance(v, Enum) else v for k, v in asdict(self).items()}
 
 
 def _gaussian(init_std: float) -> dict:
@@ -116,7 +146,7 @@ def _gaussian(init_std: float) -> dict:
 
 def _ppo_kwargs(ppo: PpoCfg, class_name: str) -> dict:
     """Return PPO keyword arguments with our algorithm class."""
-    kwargs = asdict(ppo)
+    kwargs = ppo.to_rsl_rl()
     kwargs.update(class_name=class_name, rnd_cfg=None, symmetry_cfg=None)
     return kwargs
 
@@ -252,27 +282,29 @@ class StudentCfg:
 class DistillCfg:
     """DAgger + PPO distillation: loss weights, their curriculum, and the teacher checkpoint."""
 
-    w_ppo_start: float = 0.0
+    w_ppo_start: float = field(default=0.0, metadata={"ge": 0})
     """w_PPO at the start (ours: pure imitation first)."""
-    w_ppo_end: float = 1.0
+    w_ppo_end: float = field(default=1.0, metadata={"ge": 0})
     """w_PPO after the curriculum."""
-    w_dist_start: float = 1.0
+    w_dist_start: float = field(default=1.0, metadata={"ge": 0})
     """w_dist, weight of ||a - a_hat||^2, at the start."""
-    w_dist_end: float = 0.1
+    w_dist_end: float = field(default=0.1, metadata={"ge": 0})
     """w_dist after the curriculum (ours)."""
-    curriculum_begin: int = 0
+    curriculum_begin: int = field(default=0, metadata={"ge": 0})
     """Learning iteration at which both weights start to ramp."""
-    curriculum_finish: int = 1000
+    curriculum_finish: int = field(default=1000, metadata={"ge": 1})
     """Learning iteration at which both weights reach their end values (ours)."""
-    latent_loss_weight: float = 1.0
+    latent_loss_weight: float = field(default=1.0, metadata={"ge": 0})
     """Weight of ||z - z_hat||^2 (paper: 1)."""
-    decoder_loss_weight: float = 1.0
+    decoder_loss_weight: float = field(default=1.0, metadata={"ge": 0})
     """Weight of (psi(z) - psi(z_hat))^2 (paper: 1)."""
     init_from_teacher: bool = True
     """Start the student's actor MLP, o_t normalizer, action std and critic from the teacher (ours)."""
     teacher_checkpoint: str | None = None
     """Path of the TeacherPPO checkpoint (``model_<it>.pt``); StudentRunner loads it at construction."""
-    ppo: PpoCfg = field(default_factory=lambda: PpoCfg(learning_rate=5e-4, schedule="fixed", entropy_coef=0.001))
+    ppo: PpoCfg = field(
+        default_factory=lambda: PpoCfg(learning_rate=5e-4, schedule=PpoSchedule.fixed, entropy_coef=0.001)
+    )
     """PPO hyper-parameters of the student (ours: fixed learning rate, the distillation terms dominate early)."""
 
     def to_rsl_rl(self, teacher: TeacherCfg, student: StudentCfg, groups: ObsGroupsCfg) -> dict:

@@ -21,12 +21,10 @@ from rsl_rl.modules import MLP, EmpiricalNormalization, HiddenState
 from tensordict import TensorDict
 
 from gmloco.train.teacher_student.actor_export import LatentActorExport
+from gmloco.train.teacher_student.config import DEFAULT_HISTORY_LENGTH
 from gmloco.train.teacher_student.networks import TemporalConvEncoder, history_to_time_major
 
 __all__ = ["DEFAULT_HISTORY_LENGTH", "StudentActor"]
-
-DEFAULT_HISTORY_LENGTH = 50
-"""N: proprioceptive history frames seen by the student (1.0 s at 50 Hz)."""
 
 
 class StudentActor(MLPModel):
