@@ -47,7 +47,7 @@ def test_known_term_kept_absent_term_rejected(tmp_path: Path) -> None:
     np.testing.assert_allclose(lateral["values"]["lateral_scale"], 0.2, rtol=1e-3)
     assert lateral["heldout_with_N"] < 1e-2 * lateral["heldout_without_N"]  # exact model: ~0 N held out
     assert overburden["verdict"] == "rejected" and "changes < 2 % or < 0.1 N" in overburden["reason"]
-    np.testing.assert_allclose(overburden["heldout_with_N"], overburden["heldout_without_N"], rtol=0.02)
+    assert abs(overburden["heldout_with_N"] - overburden["heldout_without_N"]) < 0.1  # below the 0.1 N floor
     assert out["fit_cli_args"] == ["--params", "lateral_scale", "--plastic-unloading", "off"]
 
 
@@ -92,3 +92,21 @@ def test_every_term_judged(tmp_path: Path) -> None:
     assert {t: r["verdict"] for t, r in out["terms"].items()} == {
         "depth_law": "kept", "lateral_scale": "kept", "plastic_unloading": "rejected", "overburden": "rejected",
         "added_mass": "rejected"}  # fmt: skip
+
+
+def test_fitted_datum_recovers_a_raised_surface(tmp_path: Path) -> None:
+    """A sand whose surface sits 6 mm above the nominal top: the fit finds the datum, the published model is aligned."""
+    from dataclasses import replace
+
+    from gmloco.eval.calibration.fit import fit_extensions, split_error
+
+    ds = load_dataset(_build(tmp_path))
+    shifted = replace(
+        ds, records={n: replace(r, pos=r.pos + np.array([0.0, 0.0, 0.006])) for n, r in ds.records.items()}
+    )
+    res = fit_extensions(shifted, replace(FIT, params=("lateral_scale",), plastic_unloading="off"))
+    np.testing.assert_allclose(res.datum, 0.006, atol=2e-4)
+    assert res.error_after["heldout"] < 0.05 * res.error_before["heldout"]
+    assert res.error_before_aligned is not None and res.error_before_aligned["heldout"] < res.error_before["heldout"]
+    nominal, _ = split_error(shifted, res.extensions, FIT)  # the same terms at the nominal datum fit worse
+    assert nominal["heldout"] > res.error_after["heldout"]

@@ -138,13 +138,20 @@ def _model_press(ds: CalibrationDataset, ext: RftExtensionsCfg, fit: SandFitCfg)
 
 
 def stance_depth(
-    ds: CalibrationDataset, ext: RftExtensionsCfg, fit: SandFitCfg, cfg: SummaryCfg
+    ds: CalibrationDataset,
+    ext: RftExtensionsCfg,
+    fit: SandFitCfg,
+    cfg: SummaryCfg,
+    datums: dict[str, float] | None = None,
 ) -> tuple[dict[str, Any] | None, str | None]:
     """Return (depths [m] and errors [%] of 3D-RFT before / calibrated after vs the dataset's sand, or None; reason).
 
     The load is the share ``stance_load_fraction`` of the G1 weight, or the largest the dataset's press reached if
-    less (the nearest load it has); each model is pressed the same way and its depth read at that load.
+    less (the nearest load it has); each model is pressed the same way and its depth read at that load. Depths are
+    measured from the surface each model was fitted to feel: the sand's depth for a model is its nominal depth plus
+    that model's datum (``datums``: ``before`` / ``after`` [m], 0 when absent).
     """
+    datums = datums or {}
     rec = ds.records.get("press")
     if rec is None:
         return None, "the dataset has no press record"
@@ -158,7 +165,11 @@ def stance_depth(
         depth = _depth_at_load(_model_press(ds, model, fit), load)
         if depth is None:
             return None, f"the {label} model does not carry {load:.3g} N within {MODEL_PRESS_DEPTH} m of depth"
-        out[f"{label}_depth_m"], out[label] = depth, 100.0 * (depth - sand) / sand
+        felt = sand + datums.get(label, 0.0)
+        if felt <= 0.0:
+            return None, f"the sand's depth below the {label} model's datum is not positive ({felt:.3g} m)"
+        out[f"{label}_depth_m"], out[label] = depth, 100.0 * (depth - felt) / felt
+        out[f"{label}_datum_m"], out[f"{label}_sand_depth_m"] = datums.get(label, 0.0), felt
     return out, None
 
 
@@ -201,7 +212,13 @@ def build_summary(
             _force_error(ds, after),
         )
         halved[mat] = bool(after <= cfg.max_error_ratio * before)
-        depth, reason = stance_depth(ds, ext, fit, cfg)
+        datums = {"before": float(report.get("datum_before_m", 0.0)), "after": float(report.get("datum_m", 0.0))}
+        body.setdefault("datum_m", {})[mat] = datums
+        aligned = report.get("force_error_before_aligned")
+        body.setdefault("force_error_before_aligned", {})[mat] = (
+            _force_error(ds, aligned["heldout"]) if aligned else None
+        )
+        depth, reason = stance_depth(ds, ext, fit, cfg, datums)
         body["stance_depth_error_pct"][mat] = depth
         if depth is None:
             body["missing"][f"stance_depth_error_pct.{mat}"] = reason
@@ -209,7 +226,8 @@ def build_summary(
         if cfg.figures:
             names = list(ds.records)
             models = {"3D-RFT": replay_forces(ds, RftExtensionsCfg(), fit, names),
-                      "calibrated": replay_forces(ds, ext, fit, names)}  # fmt: skip
+                      "3D-RFT at its datum": replay_forces(ds, RftExtensionsCfg(), fit, names, datums["before"]),
+                      "calibrated": replay_forces(ds, ext, fit, names, datums["after"])}  # fmt: skip
             figures.append(str(_fig_force_depth(ds, models, out.parent / f"force_depth_{mat}.png")))
     body["term_verdicts"] = {}
     for v in verdicts:
@@ -229,6 +247,8 @@ def build_summary(
         "force_error": "RMS over the held-out frames of the 3D force error [N]; relative: over the RMS measured force",
         "stance_depth_error_pct": "100 (model - sand) / sand of the depth of the sole's lowest point at load_N",
         "sources": "sand of each dataset: mpm is the judge; rft3d_reference is synthetic test data",
+        "datum_m": "height of the surface a sole feels above the nominal bed top, fitted per model [m]; "
+        "force_error_before_aligned: the published 3D-RFT at its own fitted datum",
     }
     body["inputs"] = {"fits": fits, "datasets": [files[f] for f in fits], "verdicts": verdicts}
     body["figures"] = figures

@@ -93,7 +93,7 @@ def _verdict(row: dict[str, Any], cfg: TermVerdictCfg) -> tuple[str, str]:
         if fit_gain:
             fit = f"fit {row['fit_without_N']:.3g} N without, {row['fit_with_N']:.3g} N with"
             reason = f"improves fit split only ({fit}; {held})"
-        elif with_ > without:
+        elif with_ - without >= cfg.min_change_n:
             reason = f"held-out force error is higher with it ({held})"
         else:
             floor = f"< {100 * cfg.min_change:g} % or < {cfg.min_change_n:g} N"
@@ -128,7 +128,7 @@ def term_verdicts(ds: CalibrationDataset, cfg: TermVerdictCfg) -> dict[str, Any]
         return cache[terms, plastic]
 
     full = fit(values, free)
-    published = dict(full.error_before)
+    published = dict(full.error_before_aligned or full.error_before)  # at its own datum when the datum is fitted
 
     def errors(terms: frozenset[str], plastic: PlasticMode) -> tuple[dict[str, float], RftExtensionsCfg]:
         """Return the RMS force error [N] per split and the terms of a variant (the published model if none)."""
