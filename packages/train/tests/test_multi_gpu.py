@@ -1,0 +1,68 @@
+# SPDX-License-Identifier: Apache-2.0
+"""GPU lists and ranks of data-parallel training (``gmloco.train.multi_gpu``), without starting any worker."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import pytest
+
+from gmloco.train.multi_gpu import GpuSelectionError, RankInfo, any_rank, check_gpus, gpus_problem, rank_info
+
+
+@pytest.mark.parametrize(
+    ("gpus", "words"),
+    [
+        ([0, 1, 0], "[0] are named more than once"),
+        ([1, -1], "negative GPU ids [-1]"),
+        ([0, 4], "GPU ids [4] do not exist: this machine has 2 CUDA device(s)"),
+    ],
+)
+def test_bad_gpu_lists_are_named(gpus: list[int], words: str) -> None:
+    """Duplicates, negative ids and ids past the device count are refused with a clause naming them."""
+    problem = gpus_problem(gpus, device_count=2)
+    assert problem is not None and words in problem
+    with pytest.raises(GpuSelectionError, match="bad value for 'gpus'"):
+        check_gpus(gpus, device_count=2)
+
+
+def test_good_gpu_lists_pass() -> None:
+    """Distinct existing ids pass; an empty list (train on ``device``) passes even without CUDA."""
+    assert gpus_problem([1, 0], device_count=2) is None
+    check_gpus([0, 1], device_count=2)
+    check_gpus([], device_count=0)
+
+
+def test_gpus_without_cuda_is_refused() -> None:
+    """A machine without CUDA refuses any GPU list and says how to train on the configured device."""
+    problem = gpus_problem([0], device_count=0)
+    assert problem is not None and "no CUDA device" in problem and "leave gpus empty" in problem
+
+
+def test_train_refuses_gpus_without_cuda_before_writing(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    """train() with ``gpus`` on a machine without CUDA raises before the run directory is created."""
+    import gmloco.train.multi_gpu as multi_gpu
+    from gmloco.train import TrainRunCfg, train
+
+    monkeypatch.setattr(multi_gpu, "cuda_device_count", lambda: 0)
+    run_dir = tmp_path / "run"
+    with pytest.raises(GpuSelectionError, match="no CUDA device"):
+        train(TrainRunCfg(gpus=(0, 1), run_dir=str(run_dir)))
+    assert not run_dir.exists()
+
+
+def test_rank_info_reads_the_rsl_rl_variables(monkeypatch: pytest.MonkeyPatch) -> None:
+    """RANK / LOCAL_RANK / WORLD_SIZE give the rank; without them the process is the one writing rank."""
+    for name in ("RANK", "LOCAL_RANK", "WORLD_SIZE"):
+        monkeypatch.delenv(name, raising=False)
+    assert rank_info() == RankInfo(0, 0, 1) and rank_info().writes and not rank_info().distributed
+    monkeypatch.setenv("RANK", "3")
+    monkeypatch.setenv("LOCAL_RANK", "1")
+    monkeypatch.setenv("WORLD_SIZE", "4")
+    ranks = rank_info()
+    assert ranks == RankInfo(3, 1, 4) and ranks.distributed and not ranks.writes
+
+
+def test_any_rank_outside_a_process_group_is_the_flag() -> None:
+    """Without a process group the stop decision is this process's own."""
+    assert any_rank(True, "cpu") and not any_rank(False, "cpu")
