@@ -88,3 +88,16 @@ def test_jump_stage_trains_at_smoke_scale(compose: Callable[..., DictConfig], tm
     metrics = train_teacher.run(cfg)
     assert metrics["iteration"] == 2.0
     assert (tmp_path / "train_teacher" / "model_2.pt").exists()
+
+
+def test_gpus_reach_the_run(compose: Callable[..., DictConfig], monkeypatch: pytest.MonkeyPatch, tmp_path: Any) -> None:
+    """``train_teacher.gpus`` becomes ``TrainRunCfg.gpus``; left empty, the run trains on the pipeline's device."""
+    import gmloco.train
+    import gmloco.train.multi_gpu as multi_gpu
+
+    monkeypatch.setattr(multi_gpu, "cuda_device_count", lambda: 2)
+    seen: list[Any] = []
+    monkeypatch.setattr(gmloco.train, "train", lambda cfg, on_iteration=None: seen.append(cfg) or {})
+    for gpus in ("[0,1]", "[]"):
+        train_teacher.run(compose("+exp=gm_loco", f"run_dir={tmp_path}", f"train_teacher.gpus={gpus}"))
+    assert seen[0].gpus == (0, 1) and seen[1].gpus == ()
