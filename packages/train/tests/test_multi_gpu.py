@@ -66,3 +66,35 @@ def test_rank_info_reads_the_rsl_rl_variables(monkeypatch: pytest.MonkeyPatch) -
 def test_any_rank_outside_a_process_group_is_the_flag() -> None:
     """Without a process group the stop decision is this process's own."""
     assert any_rank(True, "cpu") and not any_rank(False, "cpu")
+
+
+def test_visible_devices_maps_ids_through_cuda_visible_devices(monkeypatch: pytest.MonkeyPatch) -> None:
+    """The ids index ``CUDA_VISIBLE_DEVICES`` (mjlab's ``select_gpus``): [0, 1] of "3,5,6" are GPUs 3 and 5."""
+    from gmloco.train.multi_gpu import visible_devices
+
+    monkeypatch.setenv("CUDA_VISIBLE_DEVICES", "3,5,6")
+    assert visible_devices([0, 1]) == "3,5" and visible_devices([2]) == "6"
+
+
+def test_train_hands_several_gpus_to_the_launcher(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    """train() with two GPUs checks the run directory, sets a damaged checkpoint aside, then starts two ranks."""
+    import gmloco.train.multi_gpu as multi_gpu
+    import gmloco.train.training as training
+    from gmloco.train import TrainRunCfg, train
+
+    monkeypatch.setattr(multi_gpu, "cuda_device_count", lambda: 2)
+    monkeypatch.setattr(training, "visible_devices", lambda gpus: ",".join(str(g) for g in gpus))
+    launched: list[tuple] = []
+    monkeypatch.setattr(training, "launch_ranks", lambda *a: launched.append(a) or {"iteration": 0.0})
+    run_dir = tmp_path / "run"
+    run_dir.mkdir()
+    import torch
+
+    torch.save({"iter": 3}, run_dir / "model_3.pt")
+    (run_dir / "model_5.pt").write_bytes(b"truncated")
+    metrics = train(TrainRunCfg(gpus=(0, 1), run_dir=str(run_dir)))
+    ((fn, cfg, workers, visible, log_dir),) = launched
+    assert fn is training.train_rank and cfg.gpus == (0, 1) and workers == 2 and visible == "0,1"
+    assert log_dir == str(run_dir / "torchrunx")
+    assert (run_dir / "train_cfg.json").exists() and (run_dir / "model_5.pt.corrupt").exists()
+    assert metrics["corrupt_checkpoints_skipped"] == 1.0

@@ -163,9 +163,22 @@ def train(cfg: TrainRunCfg, on_iteration: Callable[[int, int], None] | None = No
     if len(cfg.gpus) == 1:
         return _train(replace(cfg, device=f"cuda:{cfg.gpus[0]}"), rank_info(), on_iteration)
     if len(cfg.gpus) > 1 and not rank_info().distributed:
-        run_dir = _prepare_run_dir(cfg)  # refuse a bad resume before any worker starts
-        return launch_ranks(train_rank, cfg, len(cfg.gpus), visible_devices(cfg.gpus), str(run_dir / "torchrunx"))
+        return _launch(cfg)
     return _train(cfg, rank_info(), on_iteration)
+
+
+def _launch(cfg: TrainRunCfg) -> dict[str, float]:
+    """Start one rank per GPU of ``cfg.gpus`` and return rank 0's metrics.
+
+    The run directory is checked and its damaged checkpoints are set aside here, before any worker starts, so every
+    rank reads the same newest checkpoint.
+    """
+    run_dir = _prepare_run_dir(cfg)
+    checkpoint, skipped = resumable_checkpoint(run_dir) if cfg.resume else (None, [])
+    for line in skipped:
+        print(f"train: {line}; resuming from {checkpoint}", file=sys.stderr)
+    summary = launch_ranks(train_rank, cfg, len(cfg.gpus), visible_devices(cfg.gpus), str(run_dir / "torchrunx"))
+    return summary | {"corrupt_checkpoints_skipped": float(len(skipped))}
 
 
 def train_rank(cfg: TrainRunCfg) -> dict[str, float]:
