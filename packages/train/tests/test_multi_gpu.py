@@ -98,3 +98,29 @@ def test_train_hands_several_gpus_to_the_launcher(tmp_path: Path, monkeypatch: p
     assert log_dir == str(run_dir / "torchrunx")
     assert (run_dir / "train_cfg.json").exists() and (run_dir / "model_5.pt.corrupt").exists()
     assert metrics["corrupt_checkpoints_skipped"] == 1.0
+
+
+def _rank_env(names: tuple[str, ...]) -> dict[str, str | None]:
+    """The worker's values of ``names`` (run in each torchrunx worker)."""
+    import os
+
+    return {name: os.environ.get(name) for name in names}
+
+
+@pytest.mark.slow
+def test_launch_ranks_sets_the_rsl_rl_variables(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    """Two workers get RANK / LOCAL_RANK / WORLD_SIZE from torchrunx; their logs go to this launch's folder."""
+    import os
+    import sys
+
+    import cloudpickle
+
+    from gmloco.train.multi_gpu import launch_ranks
+
+    cloudpickle.register_pickle_by_value(sys.modules[__name__])  # the workers cannot import a test module
+    monkeypatch.delenv("TORCHRUNX_LOG_DIR", raising=False)
+    names = ("RANK", "LOCAL_RANK", "WORLD_SIZE", "CUDA_VISIBLE_DEVICES")
+    seen = launch_ranks(_rank_env, names, 2, "", str(tmp_path / "logs"))
+    assert seen == {"RANK": "0", "LOCAL_RANK": "0", "WORLD_SIZE": "2", "CUDA_VISIBLE_DEVICES": ""}
+    assert list((tmp_path / "logs").rglob("*.log"))
+    assert "TORCHRUNX_LOG_DIR" not in os.environ

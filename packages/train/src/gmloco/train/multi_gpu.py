@@ -137,7 +137,6 @@ def launch_ranks(
     import torchrunx
 
     logging.basicConfig(level=logging.INFO)  # torchrunx forwards the workers' output through logging
-    os.environ.setdefault("TORCHRUNX_LOG_DIR", log_dir)
     extra = None if cuda_visible_devices is None else {"CUDA_VISIBLE_DEVICES": cuda_visible_devices}
     launcher = torchrunx.Launcher(
         hostnames=["localhost"],
@@ -146,7 +145,16 @@ def launch_ranks(
         copy_env_vars=torchrunx.DEFAULT_ENV_VARS_FOR_COPY + COPIED_ENV_VARS,
         extra_env_vars=extra,
     )
-    return launcher.run(fn, arg).rank(0)
+    # torchrunx reads the log folder from the environment when it starts; set it for this launch only, so the
+    # next stage of a pipeline logs to its own folder
+    own_log_dir = "TORCHRUNX_LOG_DIR" not in os.environ
+    if own_log_dir:
+        os.environ["TORCHRUNX_LOG_DIR"] = log_dir
+    try:
+        return launcher.run(fn, arg).rank(0)
+    finally:
+        if own_log_dir:
+            os.environ.pop("TORCHRUNX_LOG_DIR", None)
 
 
 def any_rank(flag: bool, device: Any) -> bool:
