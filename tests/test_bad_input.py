@@ -40,6 +40,8 @@ CASES = [
     (["+exp=gm_loco", "mismatch.real=README.md"], "mismatch.real", ["not an MCAP recording"]),
     (["+exp=gm_loco", "analyze_logs.inputs=[/nonexistent/logs]"], "analyze_logs.inputs", ["does not exist"]),
     (["+exp=ppo_rigid", "train_teacher.material.mu_int=[0.6,0.3]"], "train_teacher.material.mu_int", ["not a range"]),
+    (["+exp=gm_loco", "train_teacher.gpus=[0,0]"], "train_teacher.gpus", ["[0] are named more than once"]),
+    (["+exp=gm_loco", "distill.gpus=[1,-1]"], "distill.gpus", ["element -1", ">= 0"]),
 ]
 
 
@@ -64,6 +66,7 @@ def test_bad_input_names_key_and_choices(
         (["+exp=gm_loco", "train_teacher.num_envz=8"], "train_teacher.num_envz"),
         ([], "+exp"),
         (["+exp=gm_loco", "eval_mpm.num_episodes=-1"], "eval_mpm.num_episodes=-1"),
+        (["+exp=gm_loco", "train_teacher.gpus=[0,0]"], "train_teacher.gpus"),
     ],
 )
 def test_cli_bad_input_exits_2_without_traceback(args: list[str], key: str) -> None:

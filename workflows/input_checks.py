@@ -105,8 +105,23 @@ def _material_problem(section: DictConfig) -> tuple[str, str] | None:
     return None
 
 
+def _gpus_problem(cfg: DictConfig, name: str) -> tuple[str, str] | None:
+    """``<stage>.gpus`` must name distinct CUDA devices this machine has."""
+    gpus = [int(g) for g in cfg[name].get("gpus", [])]
+    if not gpus:
+        return None
+    from gmloco.train.multi_gpu import cuda_device_count, gpus_problem
+
+    if (problem := gpus_problem(gpus, cuda_device_count())) is None:
+        return None
+    return f"{name}.gpus", f"bad value for '{name}.gpus' {gpus}: {problem}."
+
+
 def input_problem(cfg: DictConfig) -> tuple[str, str] | None:
     """First problem with the inputs of the selected stages, as ``(key, message)``; else None."""
+    for name in ("train_teacher", "distill"):
+        if name in cfg.stages and (found := _gpus_problem(cfg, name)) is not None:
+            return found
     if "train_teacher" in cfg.stages and (found := _jump_problem(cfg.train_teacher)) is not None:
         return found
     if "train_teacher" in cfg.stages and (found := _calibrated_problem(cfg.train_teacher)) is not None:

@@ -219,6 +219,7 @@ def run_training(cfg: DictConfig, name: str, **run_cfg: Any) -> dict[str, float 
                 run_dir=str(out),
                 save_interval=int(section.save_interval),
                 num_steps_per_env=int(section.num_steps_per_env),
+                gpus=tuple(int(g) for g in section.get("gpus", [])),
                 **run_cfg,
             ),
             on_iteration=lambda done, _total: update(done),

@@ -196,6 +196,9 @@ class PolicyTrainingCfg(StageCfg):
     """Iterations between checkpoints (one is always written when a call ends)."""
     ppo: PpoCfg = field(default_factory=PpoCfg)
     """PPO hyper-parameters (``gmloco.train.teacher_student.PpoCfg``; GM-Loco values by default)."""
+    gpus: list[int] = field(default_factory=list, metadata=each(integer=True, ge=0))
+    """CUDA devices to train on, e.g. ``[0,1]``: several train data-parallel, one rank per GPU with the full
+    ``num_envs`` each (``gmloco.train.TrainRunCfg.gpus``). Empty: the pipeline's ``device``."""
 
 
 @dataclass

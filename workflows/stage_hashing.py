@@ -18,7 +18,7 @@ from omegaconf import DictConfig, OmegaConf
 from workflows.run_dir import config_hash
 from workflows.stage_registry import StageSpec
 
-__all__ = ["VOLATILE_KEYS", "VOLATILE_STAGE_KEYS", "hashable_config", "stage_hashes"]
+__all__ = ["PLACEMENT_KEYS", "VOLATILE_KEYS", "VOLATILE_STAGE_KEYS", "hashable_config", "stage_hashes"]
 
 VOLATILE_KEYS = frozenset(
     {
@@ -40,6 +40,10 @@ VOLATILE_KEYS = frozenset(
 VOLATILE_STAGE_KEYS = frozenset({"out_dir", "max_minutes", "resume", "fit_time_box", "device"})
 """Keys of a stage section that never change its result (``fit_time_box``: which walks one time box starts;
 ``device``: ``eval_mpm``'s copy of the pipeline's)."""
+
+PLACEMENT_KEYS = {"train_teacher": frozenset({"gpus"}), "distill": frozenset({"gpus"})}
+"""Keys of one stage's section that say where it runs, like the top-level ``device``: a training run resumes its
+checkpoints on any number of GPUs."""
 
 
 def _relocate(obj: Any, roots: Sequence[tuple[str, str]]) -> Any:
@@ -64,7 +68,8 @@ def hashable_config(cfg: DictConfig, stage_names: Sequence[str]) -> dict[str, An
         if key in VOLATILE_KEYS:
             continue
         if key in stage_names and isinstance(value, dict):
-            value = {k: v for k, v in value.items() if k not in VOLATILE_STAGE_KEYS}
+            skip = VOLATILE_STAGE_KEYS | PLACEMENT_KEYS.get(str(key), frozenset())
+            value = {k: v for k, v in value.items() if k not in skip}
         out[str(key)] = _relocate(value, roots)
     return out
 

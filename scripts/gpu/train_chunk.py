@@ -46,7 +46,20 @@ def _parse() -> argparse.Namespace:
         help="start a new run (new task config) from the artifact's policy weights instead of resuming it",
     )
     p.add_argument("--out", type=Path, required=True)
-    return p.parse_args()
+    p.add_argument(
+        "--gpus",
+        type=int,
+        nargs="+",
+        default=[],
+        help="CUDA device ids trained on data-parallel, one rank each (TrainRunCfg.gpus); default: --device alone",
+    )
+    args = p.parse_args()
+    if args.gpus:
+        from gmloco.train.multi_gpu import cuda_device_count, gpus_problem
+
+        if (problem := gpus_problem(args.gpus, cuda_device_count())) is not None:
+            p.error(f"--gpus {' '.join(map(str, args.gpus))}: {problem}")
+    return args
 
 
 def _seed_run_dir(run_dir: Path, artifact: Path, weights_only: bool) -> tuple[int | None, str | None]:
@@ -136,6 +149,7 @@ def main() -> None:
         max_minutes=args.max_minutes,
         seed=args.seed,
         device=args.device,
+        gpus=tuple(args.gpus),
         run_dir=str(run_dir),
     )
     t0 = time.time()

@@ -149,7 +149,20 @@ def _parse(argv: list[str] | None) -> argparse.Namespace:
     p.add_argument("--runs-root", type=Path, default=Path("runs/gpu"))
     p.add_argument("--artifacts", type=Path, default=Path("artifacts"))
     p.add_argument("--out", type=Path, required=True)
-    return p.parse_args(argv)
+    p.add_argument(
+        "--gpus",
+        type=int,
+        nargs="+",
+        default=[],
+        help="CUDA device ids trained on data-parallel, one rank each (TrainRunCfg.gpus); default: --device alone",
+    )
+    args = p.parse_args(argv)
+    if args.gpus:
+        from gmloco.train.multi_gpu import cuda_device_count, gpus_problem
+
+        if (problem := gpus_problem(args.gpus, cuda_device_count())) is not None:
+            p.error(f"--gpus {' '.join(map(str, args.gpus))}: {problem}")
+    return args
 
 
 def _newest(folder: Path) -> Path | None:
@@ -419,6 +432,7 @@ def main(argv: list[str] | None = None) -> dict[str, Any]:
         max_minutes=args.max_minutes - args.post_minutes,
         seed=args.seed,
         device=args.device,
+        gpus=tuple(args.gpus),
         run_dir=str(run_dir),
         save_interval=args.save_interval,
         num_steps_per_env=args.num_steps_per_env,

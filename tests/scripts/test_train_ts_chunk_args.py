@@ -66,3 +66,16 @@ def test_foot_faces_box_reaches_the_contact_model_cfg() -> None:
         assert len(box_collider(contact_model_cfg(name, task.foot_faces).collider).areas) == 150
         assert len(box_collider(contact_model_cfg(name).collider).areas) == 25
     assert chunk._task(chunk._parse(["--stage", "teacher", "--out", "unused", "--no-held-out"])).foot_faces == "sole"
+
+
+@pytest.mark.parametrize(("gpus", "words"), [(["0", "0"], "named more than once"), (["-1"], "negative GPU ids")])
+def test_bad_gpus_exit_2(gpus: list[str], words: str, capsys: pytest.CaptureFixture[str]) -> None:
+    """``--gpus`` naming a GPU twice or a negative id stops the script with exit code 2 and names the problem."""
+    with pytest.raises(SystemExit) as info:
+        _load()._parse(["--stage", "teacher", "--out", "unused", "--gpus", *gpus])
+    assert info.value.code == 2 and words in capsys.readouterr().err
+
+
+def test_gpus_reach_the_parsed_args() -> None:
+    """Without ``--gpus`` the run trains on ``--device`` alone."""
+    assert _load()._parse(["--stage", "teacher", "--out", "unused"]).gpus == []

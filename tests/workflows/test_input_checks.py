@@ -32,3 +32,21 @@ def test_calibrated_contact_model_needs_its_fitted_terms(tmp_path: Path, monkeyp
     fitted.write_text("{}")
     assert input_problem(_cfg("rft3d_calibrated")) is None
     assert input_problem(_cfg("rft3d")) is None
+
+
+@pytest.mark.parametrize("stage", ["train_teacher", "distill"])
+def test_gpus_without_cuda_is_bad_input(stage: str, monkeypatch: pytest.MonkeyPatch) -> None:
+    """``<stage>.gpus`` on a machine without CUDA names the key and says to leave it empty; empty passes."""
+    import gmloco.train.multi_gpu as multi_gpu
+
+    monkeypatch.setattr(multi_gpu, "cuda_device_count", lambda: 0)
+    section = {"contact_model": "rft3d", "jump": None, "gpus": [0, 1]}
+    cfg = OmegaConf.create({"stages": [stage], stage: section, "train_teacher": section})
+    assert isinstance(cfg, DictConfig)
+    found = input_problem(cfg)
+    assert found is not None
+    key, message = found
+    assert key == f"{stage}.gpus" and "no CUDA device" in message and "leave gpus empty" in message
+    cfg[stage].gpus = []
+    cfg.train_teacher.gpus = []
+    assert input_problem(cfg) is None

@@ -109,3 +109,16 @@ def test_material_fields_left_at_default_keep_the_terrains(compose: Callable[...
     section = compose("+exp=ppo_rft3d", "train_teacher.terrain=deep", "train_teacher.material.packing=[0.6,1.0]")
     material = task_cfg(section.train_teacher).material
     assert material.mu_int == (0.1, 0.4) and material.packing == (0.6, 1.0)
+
+
+def test_gpus_reach_the_run(compose: Callable[..., DictConfig], monkeypatch: pytest.MonkeyPatch, tmp_path: Any) -> None:
+    """``train_teacher.gpus`` becomes ``TrainRunCfg.gpus``; left empty, the run trains on the pipeline's device."""
+    import gmloco.train
+    import gmloco.train.multi_gpu as multi_gpu
+
+    monkeypatch.setattr(multi_gpu, "cuda_device_count", lambda: 2)
+    seen: list[Any] = []
+    monkeypatch.setattr(gmloco.train, "train", lambda cfg, on_iteration=None: seen.append(cfg) or {})
+    for gpus in ("[0,1]", "[]"):
+        train_teacher.run(compose("+exp=gm_loco", f"run_dir={tmp_path}", f"train_teacher.gpus={gpus}"))
+    assert seen[0].gpus == (0, 1) and seen[1].gpus == ()

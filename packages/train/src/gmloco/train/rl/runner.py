@@ -13,6 +13,7 @@ from pathlib import Path
 import torch
 from mjlab.rl import MjlabOnPolicyRunner
 
+from gmloco.train.multi_gpu import any_rank, rank_info
 from gmloco.train.sand import get_sand
 
 __all__ = ["CHECKPOINT_PATTERN", "GmlocoOnPolicyRunner", "latest_checkpoint"]
@@ -30,7 +31,9 @@ def latest_checkpoint(run_dir: str | Path) -> Path | None:
 class GmlocoOnPolicyRunner(MjlabOnPolicyRunner):
     """mjlab's runner plus: time-boxed ``learn``, tmp + ``os.replace`` saves, floor levels and assist in checkpoints.
 
-    After :meth:`learn`, :attr:`summary` holds the run's metrics (see :meth:`_summary`).
+    After :meth:`learn`, :meth:`summary` returns the run's metrics. Under several ranks (``gmloco.train.multi_gpu``)
+    it keeps rsl-rl's contract: parameters broadcast from rank 0 before learning, gradients all-reduced by the
+    algorithm, files written by rank 0 only; the time box stops every rank at the same iteration.
     """
 
     keep_checkpoints: int = 3
@@ -59,12 +62,14 @@ class GmlocoOnPolicyRunner(MjlabOnPolicyRunner):
             )
         obs = self.env.get_observations().to(self.device)
         self.alg.train_mode()
+        if self.is_distributed:  # every rank starts from rank 0's weights (rsl-rl ``OnPolicyRunner.learn``)
+            self.alg.broadcast_parameters()
         self.logger.init_logging_writer()
         start_it = self.current_learning_iteration
         self._times: list[tuple[float, float]] = []
         self.stopped_by_deadline = False
         for it in range(start_it, start_it + num_learning_iterations):
-            if deadline is not None and self._times and time.monotonic() + 1.5 * self._slowest() > deadline:
+            if self._deadline_near(deadline):
                 self.stopped_by_deadline = True
                 break
             obs = self._iteration(it, start_it, start_it + num_learning_iterations, obs)
@@ -110,6 +115,32 @@ class GmlocoOnPolicyRunner(MjlabOnPolicyRunner):
     def _slowest(self) -> float:
         """Slowest iteration so far [s]."""
         return max(c + learn for c, learn in self._times)
+
+    def _deadline_near(self, deadline: float | None) -> bool:
+        """Whether one more iteration (1.5x the slowest so far) would cross ``deadline`` on any rank."""
+        if deadline is None or not self._times:
+            return False
+        near = time.monotonic() + 1.5 * self._slowest() > deadline
+        return any_rank(near, self.device) if self.is_distributed else near
+
+    def _configure_multi_gpu(self) -> None:
+        """rsl-rl's rank set-up; CPU ranks (the multi-process tests) open a gloo group where rsl-rl opens NCCL.
+
+        rsl-rl requires ``device == cuda:<LOCAL_RANK>`` and the NCCL backend; on CPU the same rank contract runs with
+        gloo, so the data-parallel path is tested without a GPU.
+        """
+        ranks = rank_info()
+        if not self.device.startswith("cpu") or not ranks.distributed:
+            super()._configure_multi_gpu()
+            return
+        self.gpu_world_size, self.is_distributed = ranks.world_size, True
+        self.gpu_local_rank, self.gpu_global_rank = ranks.local_rank, ranks.rank
+        self.cfg["multi_gpu"] = {
+            "global_rank": ranks.rank,
+            "local_rank": ranks.local_rank,
+            "world_size": ranks.world_size,
+        }
+        torch.distributed.init_process_group(backend="gloo", rank=ranks.rank, world_size=ranks.world_size)
 
     # Checkpoints.
 
@@ -175,7 +206,8 @@ class GmlocoOnPolicyRunner(MjlabOnPolicyRunner):
         n = len(self._times)
         collect = sum(c for c, _ in times) / len(times)
         learn = sum(lt for _, lt in times) / len(times)
-        steps = self.cfg["num_steps_per_env"] * self.env.num_envs
+        # every rank steps its own num_envs (rsl-rl's logger counts the collection size the same way)
+        steps = self.cfg["num_steps_per_env"] * self.env.num_envs * self.gpu_world_size
         rew, length = self.logger.rewbuffer, self.logger.lenbuffer
         return {
             "iterations_done": float(n),
