@@ -12,12 +12,36 @@ from __future__ import annotations
 from collections.abc import Callable
 from dataclasses import replace
 
+import pytest
 import torch
 from rsl_rl.env import VecEnv
 
-from gmloco.train.teacher_student import ObsGroupsCfg, PpoSchedule, TeacherCfg, TeacherPPO
+from gmloco.train.teacher_student import ObsGroupsCfg, PpoCfg, PpoSchedule, TeacherCfg, TeacherPPO
 
 ITERATIONS = 40
+DESIRED_KL = 0.01
+"""Target KL of the adaptive schedule in these tests [nats] (the G1 teacher's)."""
+
+
+def _rollout(env: VecEnv, alg: TeacherPPO, obs: object, steps: int = 4) -> object:
+    """Fill the rollout storage as rsl-rl's runner does (normalizers update after every step); return the obs."""
+    with torch.inference_mode():
+        for _ in range(steps):
+            obs, rew, dones, extras = env.step(alg.act(obs))  # type: ignore[arg-type]
+            alg.process_env_step(obs, rew, dones, extras)  # type: ignore[arg-type]
+        alg.compute_returns(obs)  # type: ignore[arg-type]
+    return obs
+
+
+def _minibatch_kls(alg: TeacherPPO) -> list[float]:
+    """Mean KL(stored || recomputed) of every mini-batch of one epoch, with no optimizer step in between."""
+    kls = []
+    for batch in alg.storage.mini_batch_generator(alg.num_mini_batches, 1):
+        with torch.inference_mode():
+            alg.actor(batch.observations, stochastic_output=True)
+            old, new = batch.old_distribution_params, alg.actor.output_distribution_params
+            kls.append(float(alg.actor.get_kl_divergence(old, new).mean()))  # type: ignore[arg-type]
+    return kls
 
 
 def _train(env: VecEnv, alg: TeacherPPO, iterations: int) -> dict[str, list[float]]:
@@ -36,11 +60,7 @@ def _train(env: VecEnv, alg: TeacherPPO, iterations: int) -> dict[str, list[floa
     alg.train_mode()
     obs = env.get_observations()
     for _ in range(iterations):
-        with torch.inference_mode():
-            for _ in range(4):
-                obs, rew, dones, extras = env.step(alg.act(obs))
-                alg.process_env_step(obs, rew, dones, extras)
-            alg.compute_returns(obs)
+        obs = _rollout(env, alg, obs)
         kls.clear()
         alg.update()
         log["lr"].append(alg.learning_rate)
@@ -55,7 +75,9 @@ def _teacher(
     """A 256-env toy env and a teacher with the adaptive schedule (desired KL 0.01, start 1e-3)."""
     torch.manual_seed(0)
     env = make_env(num_envs=256, seed=0)
-    ppo = replace(cfg.ppo, schedule=PpoSchedule.adaptive, desired_kl=0.01, learning_rate=1e-3, num_learning_epochs=5)
+    ppo = replace(
+        cfg.ppo, schedule=PpoSchedule.adaptive, desired_kl=DESIRED_KL, learning_rate=1e-3, num_learning_epochs=5
+    )
     teacher = replace(cfg, ppo=ppo, init_std=1.0)
     alg = TeacherPPO.construct_algorithm(
         env.get_observations(), env, runner_cfg(teacher.to_rsl_rl(ObsGroupsCfg())), "cpu"
@@ -63,20 +85,60 @@ def _teacher(
     return env, alg  # type: ignore[return-value]
 
 
+@pytest.mark.parametrize("entropy_coef", [0.0, PpoCfg().entropy_coef])
 def test_adaptive_rate_moves_both_ways_and_the_actor_learns(
-    make_env: Callable[..., VecEnv], teacher_cfg: TeacherCfg, runner_cfg: Callable[[dict], dict]
+    make_env: Callable[..., VecEnv], teacher_cfg: TeacherCfg, runner_cfg: Callable[[dict], dict], entropy_coef: float
 ) -> None:
-    """On a short run the adaptive rate rises and falls, stays off its floor, the actor moves and its std falls."""
-    env, alg = _teacher(make_env, teacher_cfg, runner_cfg)
+    """On a short run the adaptive rate rises and falls, reaches above 3e-4, the actor moves and its std falls.
+
+    Run with no entropy bonus and with the package default (0.005): the bonus must not hold the std up.
+    """
+    cfg = replace(teacher_cfg, ppo=replace(teacher_cfg.ppo, entropy_coef=entropy_coef))
+    env, alg = _teacher(make_env, cfg, runner_cfg)
     mlp0 = [p.detach().clone() for p in alg.actor.mlp.parameters()]
     log = _train(env, alg, ITERATIONS)
     steps = [b / a for a, b in zip(log["lr"], log["lr"][1:], strict=False)]
     assert any(s > 1.0 for s in steps) and any(s < 1.0 for s in steps), log["lr"]
+    assert max(log["lr"]) > 3e-4, log["lr"]  # the committed G1 teachers never logged a rate above 3e-4
     assert min(log["lr"][ITERATIONS // 2 :]) > 1e-5, log["lr"]  # never pinned at the floor once settled
-    assert sum(log["kl"][-10:]) / 10 < 4 * 0.01, log["kl"]  # the KL is held near its target
+    assert sum(log["kl"][-10:]) / 10 < 4 * DESIRED_KL, log["kl"]  # the KL is held near its target
     assert log["std"][-1] < 0.8 * log["std"][0], log["std"]
     moved = [float((p - q).abs().max()) for p, q in zip(alg.actor.mlp.parameters(), mlp0, strict=True)]
     assert max(moved) > 1e-2, moved
+
+
+def test_first_minibatch_kl_is_zero_before_any_step(
+    make_env: Callable[..., VecEnv], teacher_cfg: TeacherCfg, runner_cfg: Callable[[dict], dict]
+) -> None:
+    """Recomputed on the stored observations before any step, the policy equals the one that acted.
+
+    A KL above zero at a zero step (a sampled latent in the update, an encoder that differs between rollout and
+    update, a stored observation that the env overwrote) pins the adaptive rate whatever the step size. Only the
+    running normalizers move between acting and updating; after two warm-up rollouts (3,072 samples in their
+    statistics) 1,024 more shift them by ~1e-5 nats of KL, so the bound is desired_kl / 100.
+    """
+    env, alg = _teacher(make_env, teacher_cfg, runner_cfg)
+    alg.train_mode()
+    obs = env.get_observations()
+    for _ in range(2):
+        obs = _rollout(env, alg, obs)
+        alg.update()
+    _rollout(env, alg, obs)
+    kls = _minibatch_kls(alg)
+    assert len(kls) == alg.num_mini_batches
+    assert max(kls) < DESIRED_KL / 100, kls
+
+
+def test_frozen_normalizers_give_an_exact_zero_kl(
+    make_env: Callable[..., VecEnv], teacher_cfg: TeacherCfg, runner_cfg: Callable[[dict], dict]
+) -> None:
+    """With the running statistics frozen (eval-mode normalizers) the recomputed distribution is bit-identical."""
+    env, alg = _teacher(make_env, teacher_cfg, runner_cfg)
+    alg.train_mode()
+    for norm in (alg.actor.obs_normalizer, alg.actor.encoder_normalizer):
+        norm.eval()  # EmpiricalNormalization.update is a no-op outside training mode
+    _rollout(env, alg, env.get_observations())
+    assert _minibatch_kls(alg) == [0.0] * alg.num_mini_batches
 
 
 def test_encoder_follows_the_adaptive_rate_and_decoder_keeps_its_own(
