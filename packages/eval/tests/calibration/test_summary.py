@@ -97,3 +97,52 @@ def test_bad_input_exits_2(fitted: tuple[Path, Path], tmp_path: Path, capsys: py
                  ["--fits", str(report), "--stance-load-fraction", "1.5"]):  # fmt: skip
         assert summary_main([*args, "--out", str(out), "--no-figures"]) == 2
         assert "error:" in capsys.readouterr().err and not out.exists()
+
+
+def _predicted_file(tmp: Path, models: tuple[str, ...], max_points: float = 15.0) -> Path:
+    """Write a prediction of one policy on dry sand at 1 m/s: MPM 76 %, every model 80 % (within 15 points)."""
+    from gmloco.eval.calibration.predict import main as predict_main
+
+    gate_paths = []
+    for model in models:
+        gate = tmp / f"gate_{model}.json"
+        gate.write_text(json.dumps({"policy": "artifacts/gm_loco_student_td", "success_pct": {"dry_sand": {"1": 80.0}},
+                                    "setup": {"contact_model": model}}))  # fmt: skip
+        gate_paths.append(str(gate))
+    mpm = tmp / "mpm.json"
+    row = {"policy": "gm_loco_student_td", "terrain": "dry_sand", "scenario": "straight", "v=1 m/s": 76.0}
+    mpm.write_text(json.dumps({"speed_rows": [row]}))
+    out = tmp / "predicted.json"
+    assert predict_main(["--gate", *gate_paths, "--mpm", str(mpm), "--out", str(out), "--no-figures"]) == 0
+    if max_points != 15.0:
+        out.write_text(json.dumps({**json.loads(out.read_text()), "max_points": max_points}))
+    return out
+
+
+def test_predicted_success_fills_its_key_and_check(
+    fitted: tuple[Path, Path], tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """--predicted fills predicted_vs_mpm_success and judges the calibrated model; a file judged otherwise exits 2."""
+    _, report = fitted
+    out = tmp_path / "summary.json"
+    predicted = _predicted_file(tmp_path, ("rft3d", "rft3d_calibrated"))
+    assert summary_main(["--fits", str(report), "--predicted", str(predicted), "--out", str(out), "--no-figures"]) == 0
+    body = json.loads(out.read_text())
+    cell = body["predicted_vs_mpm_success"]["gm_loco_student_td"]["dry_sand"]["1"]
+    assert cell["mpm_success_pct"] == 76.0 and cell["difference_points"] == {"rft3d": 4.0, "rft3d_calibrated": 4.0}
+    assert "predicted_vs_mpm_success" not in body["missing"] and body["inputs"]["predicted"] == str(predicted)
+    assert body["pass"]["predicted_success_within_15_points"] == {"gm_loco_student_td": True}
+    (tmp_path / "p").mkdir()
+    published_only = _predicted_file(tmp_path / "p", ("rft3d",))
+    assert (
+        summary_main(["--fits", str(report), "--predicted", str(published_only), "--out", str(out), "--no-figures"])
+        == 0
+    )
+    body = json.loads(out.read_text())
+    assert body["pass"]["predicted_success_within_15_points"] == {"gm_loco_student_td": None}
+    assert "rft3d_calibrated" in body["missing"]["predicted_vs_mpm_success.gm_loco_student_td"]
+    out.unlink()
+    (tmp_path / "q").mkdir()
+    other = _predicted_file(tmp_path / "q", ("rft3d_calibrated",), max_points=10.0)
+    assert summary_main(["--fits", str(report), "--predicted", str(other), "--out", str(out), "--no-figures"]) == 2
+    assert "within 10.0 points, not 15.0" in capsys.readouterr().err and not out.exists()

@@ -1,5 +1,5 @@
 # SPDX-License-Identifier: Apache-2.0
-"""Figures of the sand calibration: force against depth per experiment, and the held-out error of each term."""
+"""Figures of the sand calibration: force-depth per experiment, held-out error per term, predicted vs MPM success."""
 
 from __future__ import annotations
 
@@ -10,7 +10,7 @@ import numpy as np
 
 from gmloco.eval.calibration.dataset import CalibrationDataset
 
-__all__ = ["fig_force_depth", "fig_term_errors"]
+__all__ = ["fig_force_depth", "fig_predicted_success", "fig_term_errors"]
 
 
 def fig_force_depth(ds: CalibrationDataset, models: dict[str, dict[str, np.ndarray]], path: str | Path) -> Path:
@@ -69,6 +69,43 @@ def fig_term_errors(verdicts: dict[str, Any], path: str | Path) -> Path:
     ax.set_xticks(x, [f"{t}\n{r['verdict']}" for t, r in zip(terms, rows, strict=True)], fontsize=7)
     ax.set(ylabel="held-out RMS force error [N]", title=f"{verdicts['material']}: extension terms")
     ax.legend(fontsize=7)
+    fig.tight_layout()
+    fig.savefig(path, dpi=90)
+    plt.close(fig)
+    return Path(path)
+
+
+def fig_predicted_success(policy: str, table: dict[str, Any], path: str | Path, band: float = 15.0) -> Path:
+    """Write MPM and predicted success [%] against commanded speed [m/s], one panel per material.
+
+    Args:
+        policy: Policy name (the title).
+        table: ``{material: {speed key: cell}}`` of ``gmloco.eval.calibration.predict`` (MPM and each model's).
+        path: PNG to write.
+        band: Half-width of the shaded tolerance around MPM [percentage points].
+    """
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    materials = list(table)
+    fig, axes = plt.subplots(1, len(materials), figsize=(3.6 * len(materials), 3.2), squeeze=False, sharey=True)
+    for ax, material in zip(axes.flat, materials, strict=True):
+        keys = list(table[material])
+        v = np.array([float(k) for k in keys])
+        mpm = np.array([table[material][k]["mpm_success_pct"] for k in keys])
+        ax.fill_between(v, mpm - band, mpm + band, color="k", alpha=0.1, lw=0, label=f"MPM +/- {band:g} points")
+        ax.plot(v, mpm, "k-o", lw=2.0, label="MPM")
+        models = sorted({m for k in keys for m in table[material][k]["predicted_success_pct"]})
+        for model in models:
+            pred = [table[material][k]["predicted_success_pct"].get(model) for k in keys]
+            y = np.array([np.nan if p is None else p for p in pred], dtype=float)
+            ax.plot(v, y, "--s", lw=1.2, label=f"training sim, {model}")
+        ax.set(title=material, xlabel="commanded speed [m/s]", ylim=(-5.0, 105.0))
+    axes.flat[0].set_ylabel("success [%]")
+    axes.flat[0].legend(fontsize=6)
+    fig.suptitle(f"{policy}: success on MPM and as predicted")
     fig.tight_layout()
     fig.savefig(path, dpi=90)
     plt.close(fig)

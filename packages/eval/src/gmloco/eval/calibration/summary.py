@@ -4,10 +4,13 @@
 Written: held-out force error of the published 3D-RFT and of the fit per material (N, and relative to the RMS
 measured force of the held-out frames), the stance depth error of both against the dataset's sand, the fits'
 acceptance, the per-term verdicts if given, a pass map against the issue's thresholds, and the figures beside the
-JSON. Keys these inputs cannot give are null, with the reason under ``missing``; never a made-up number.
+JSON. Keys these inputs cannot give are null, with the reason under ``missing``; never a made-up number. With
+``--predicted`` (the output of ``python -m gmloco.eval.calibration.predict``) ``predicted_vs_mpm_success`` and its
+pass check come from the policies run in the training simulator and on MPM.
 
 python -m gmloco.eval.calibration.summary --fits results/sand_calibration/fit_*.json
         --verdicts results/sand_calibration/verdicts_*.json --out results/sand_calibration/summary.json
+        --predicted results/sand_calibration/predicted_vs_mpm_success.json
 """
 
 from __future__ import annotations
@@ -64,6 +67,10 @@ class SummaryCfg:
     """Pass: calibrated stance depth within this of the dataset sand's [%]."""
     robot: str = "g1"
     """Robot the datasets must be for (contract)."""
+    max_success_points: float = 15.0
+    """Pass: success predicted by the calibrated simulator within this of MPM's [percentage points]."""
+    calibrated_contact_model: str = "rft3d_calibrated"
+    """Contact model of the training simulator whose prediction the pass check judges."""
     figures: bool = True
     """Write the PNG figures beside the JSON."""
 
@@ -187,10 +194,34 @@ def _all_pass(flags: list[bool | None]) -> bool | None:
     return None if any(f is None for f in flags) or not flags else True
 
 
+def _predicted(path: str, body: dict[str, Any], cfg: SummaryCfg) -> dict[str, bool | None]:
+    """Fill ``predicted_vs_mpm_success`` from a prediction file; return the calibrated model's verdict per policy."""
+    doc = _read_json(path, "predicted success", ("predicted_vs_mpm_success", "within_15_points", "max_points"))
+    if float(doc["max_points"]) != cfg.max_success_points:
+        raise ValueError(
+            f"predicted success {path} judges within {doc['max_points']} points, not {cfg.max_success_points}"
+        )
+    body["predicted_vs_mpm_success"] = doc["predicted_vs_mpm_success"]
+    body["missing"].pop("predicted_vs_mpm_success", None)
+    verdict = {p: by_model.get(cfg.calibrated_contact_model) for p, by_model in doc["within_15_points"].items()}
+    for policy in (p for p, v in verdict.items() if v is None):
+        body["missing"][f"predicted_vs_mpm_success.{policy}"] = (
+            f"no gate of {policy} with contact model {cfg.calibrated_contact_model} in {path}"
+        )
+    if cfg.figures:
+        body["figures"] += [f for f in doc.get("figures", []) if Path(f).is_file()]
+    return verdict
+
+
 def build_summary(
-    fits: list[str], datasets: list[str] | None, verdicts: list[str], out: str | Path, cfg: SummaryCfg
+    fits: list[str],
+    datasets: list[str] | None,
+    verdicts: list[str],
+    out: str | Path,
+    cfg: SummaryCfg,
+    predicted: str | None = None,
 ) -> dict[str, Any]:
-    """Compute the summary from fit reports (and their datasets, verdicts), write it and its figures; return it."""
+    """Compute the summary from fit reports (and their datasets, verdicts, predicted success), write it; return it."""
     reports = {f: _read_json(f, "fit report", ("force_error_before", "force_error_after", "extensions",
                                                 "dataset_sha256", "accepted")) for f in fits}  # fmt: skip
     files = _datasets(reports, datasets)
@@ -236,13 +267,15 @@ def build_summary(
                                                     for t, r in table["terms"].items()}  # fmt: skip
         if cfg.figures:
             figures.append(str(_fig_term_errors(table, out.parent / f"term_errors_{table['material']}.png")))
+    body["figures"] = figures
+    success_ok = None if predicted is None else _predicted(predicted, body, cfg)
     checks = {"force_error_halved": halved, "stance_depth_within_20_pct": depth_ok,
-              "residual_floors_at_most_2": None, "predicted_success_within_15_points": None}  # fmt: skip
+              "residual_floors_at_most_2": None, "predicted_success_within_15_points": success_ok}  # fmt: skip
     flat = [x for c in checks.values() for x in (c.values() if isinstance(c, dict) else [c])]
     body["pass"] = {**checks, "all": _all_pass(flat)}
     body["thresholds"] = {"force_error_ratio_max": cfg.max_error_ratio,
                           "stance_depth_error_pct_max": cfg.max_stance_depth_error_pct,
-                          "residual_floor_max": 2.0, "success_points_max": 15.0}  # fmt: skip
+                          "residual_floor_max": 2.0, "success_points_max": cfg.max_success_points}  # fmt: skip
     body["notes"] = {
         "force_error": "RMS over the held-out frames of the 3D force error [N]; relative: over the RMS measured force",
         "stance_depth_error_pct": "100 (model - sand) / sand of the depth of the sole's lowest point at load_N",
@@ -250,8 +283,7 @@ def build_summary(
         "datum_m": "height of the surface a sole feels above the nominal bed top, fitted per model [m]; "
         "force_error_before_aligned: the published 3D-RFT at its own fitted datum",
     }
-    body["inputs"] = {"fits": fits, "datasets": [files[f] for f in fits], "verdicts": verdicts}
-    body["figures"] = figures
+    body["inputs"] = {"fits": fits, "datasets": [files[f] for f in fits], "verdicts": verdicts, "predicted": predicted}
     atomic_write_json(out, body, allow_nan=False, newline=True)
     return body
 
@@ -279,6 +311,7 @@ def parse_args(argv: list[str] | None) -> argparse.Namespace:
     p.add_argument("--datasets", nargs="+", default=None, help="their datasets (default: the ones the reports name)")
     p.add_argument("--verdicts", nargs="*", default=[], help="outputs of python -m gmloco.eval.calibration.verdicts")
     p.add_argument("--out", default="results/sand_calibration/summary.json")
+    p.add_argument("--predicted", default=None, help="output of python -m gmloco.eval.calibration.predict")
     p.add_argument("--stance-load-fraction", type=float, default=1.0, help="share of the G1 weight on the sole [-]")
     p.add_argument("--robot", default="g1")
     p.add_argument("--no-figures", action="store_true")
@@ -292,7 +325,7 @@ def main(argv: list[str] | None = None) -> int:
         if not 0.0 < a.stance_load_fraction <= 1.0:
             raise ValueError(f"--stance-load-fraction {a.stance_load_fraction} must lie in (0, 1]")
         cfg = SummaryCfg(stance_load_fraction=a.stance_load_fraction, robot=a.robot, figures=not a.no_figures)
-        body = build_summary(a.fits, a.datasets, a.verdicts, a.out, cfg)
+        body = build_summary(a.fits, a.datasets, a.verdicts, a.out, cfg, a.predicted)
     except (ContractError, FileNotFoundError, ValueError) as e:
         print(f"error: {e}", file=sys.stderr)
         return 2

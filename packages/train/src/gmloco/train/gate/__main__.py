@@ -2,7 +2,8 @@
 """Command line of the training gate (exit 2 on bad input).
 
 Example: ``python -m gmloco.train.gate --policy artifacts/gm_loco_student_td --out results/training_gate/summary.json
---device cuda:0 --num-envs 1024``.
+--device cuda:0 --num-envs 1024``. A success-by-speed table in the calibrated simulator: ``--contact-model
+rft3d_calibrated --parts success``.
 """
 
 from __future__ import annotations
@@ -11,8 +12,10 @@ import argparse
 import json
 import sys
 from collections.abc import Sequence
+from typing import get_args
 
-from gmloco.train.gate.config import GateCfg
+from gmloco.train.config import ContactModelName
+from gmloco.train.gate.config import GATE_PARTS, GateCfg, GatePart
 
 
 def _floats(text: str) -> tuple[float, ...]:
@@ -44,6 +47,15 @@ def _positive_float(text: str) -> float:
     return value
 
 
+def _parts(text: str) -> tuple[GatePart, ...]:
+    """Parse ``"success,yaw"`` into gate parts (each once, in the summary's order)."""
+    names = {x.strip() for x in text.split(",") if x.strip()}
+    unknown = sorted(names - set(GATE_PARTS))
+    if not names or unknown:
+        raise argparse.ArgumentTypeError(f"{text!r}: unknown parts {unknown}; choose from {','.join(GATE_PARTS)}")
+    return tuple(p for p in GATE_PARTS if p in names)
+
+
 def _parse(argv: Sequence[str] | None) -> argparse.Namespace:
     """Arguments (argparse exits 2 on a malformed one)."""
     d = GateCfg()
@@ -57,6 +69,12 @@ def _parse(argv: Sequence[str] | None) -> argparse.Namespace:
     p.add_argument("--speeds", type=_floats, default=d.speeds, help="forward speeds [m/s]")
     p.add_argument("--yaw-rates", type=_floats, default=d.yaw_rates, help="yaw rates [rad/s], none zero")
     p.add_argument("--held-out-grid", default="3,3", help="held-out materials along rho_c,mu_int")
+    p.add_argument("--contact-model", choices=get_args(ContactModelName), default=d.contact_model,
+                   help="granular contact model of the simulator")  # fmt: skip
+    p.add_argument("--rft-extensions", default=d.rft_extensions_file, help="fitted terms of rft3d_calibrated")
+    p.add_argument(
+        "--parts", type=_parts, default=d.parts, help=f"parts measured, e.g. success (default {','.join(d.parts)})"
+    )
     p.add_argument("--device", default=d.device)
     p.add_argument("--seed", type=int, default=d.seed)
     return p.parse_args(argv)
@@ -80,6 +98,10 @@ def _cfg(args: argparse.Namespace) -> GateCfg:
             f"--held-out-grid {args.held_out_grid!r}: expected two integers >= 1 with at least two points (R^2 of "
             "the decoded eta needs more than one material), e.g. 3,3"
         )
+    if args.contact_model == "rft3d_calibrated":
+        from gmloco.contact.extensions_io import load_rft_extensions
+
+        load_rft_extensions(args.rft_extensions)  # a missing or malformed file stops here, before any env is built
     return GateCfg(
         policy_dir=args.policy,
         out_path=args.out,
@@ -90,6 +112,9 @@ def _cfg(args: argparse.Namespace) -> GateCfg:
         speeds=args.speeds,
         yaw_rates=args.yaw_rates,
         held_out_grid=(grid[0], grid[1]),
+        contact_model=args.contact_model,
+        rft_extensions_file=args.rft_extensions,
+        parts=args.parts,
         device=args.device,
         seed=args.seed,
     )
@@ -105,7 +130,7 @@ def main(argv: Sequence[str] | None = None) -> int:
         from gmloco.train.gate.run import run_gate
 
         summary = run_gate(cfg)
-    except (GateInputError, ValueError) as err:
+    except (GateInputError, FileNotFoundError, ValueError) as err:
         print(f"gmloco.train.gate: {err}", file=sys.stderr)
         return 2
     print(json.dumps({"pass": summary["pass"], "out": args.out}, indent=1))

@@ -4,12 +4,20 @@
 from __future__ import annotations
 
 from dataclasses import dataclass, field
+from typing import Literal
 
 from gmloco.train.config import ContactModelName
 from gmloco.train.evaluation import RolloutCriteriaCfg
 from gmloco.train.teacher_student.heldout import DEFAULT_HELD_OUT, HeldOutRegionCfg
 
-__all__ = ["GateCfg", "GateThresholdsCfg"]
+__all__ = ["GATE_PARTS", "GateCfg", "GatePart", "GateThresholdsCfg"]
+
+GatePart = Literal["success", "yaw", "circle", "apex", "eta"]
+"""A measured part of the gate: forward cells (``success_pct``, ``vel_error_mps``, ``heading_drift_deg``), yaw
+cells (``yaw_rate_ratio``), the circle (``circle_dtw_m``), the swing apex (``swing_apex_cm``), the held-out eta
+(``eta_r2_heldout``)."""
+GATE_PARTS: tuple[GatePart, ...] = ("success", "yaw", "circle", "apex", "eta")
+"""Every part, in the order of the summary's keys."""
 
 
 @dataclass
@@ -77,6 +85,11 @@ class GateCfg(RolloutCriteriaCfg):
     """Start of each episode left out of the eta R^2 (the history fills) [s]."""
     contact_model: ContactModelName = "rft3d"
     """Granular contact model of the simulator (PPO-Rigid is gated on sand too)."""
+    rft_extensions_file: str = "results/sand_calibration/rft3d_calibrated.json"
+    """Fitted ``RftExtensionsCfg`` file that ``contact_model="rft3d_calibrated"`` reads (other models ignore it)."""
+    parts: tuple[GatePart, ...] = GATE_PARTS
+    """Parts measured; the cells of the others are not run and their keys are null (e.g. ``("success",)`` for a
+    success-by-speed table)."""
     num_envs: int = 1024
     """Envs stepped at once; the cells run in batches of this size."""
     device: str = "cpu"

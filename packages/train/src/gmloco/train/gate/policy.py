@@ -15,9 +15,15 @@ __all__ = ["GateInputError", "GatePolicy", "gpu_minutes", "read_policy"]
 PolicyKind = Literal["student", "teacher", "ppo"]
 """Acting policy: a ``StudentPPO`` or ``TeacherPPO`` checkpoint, or an mjlab ONNX export of vanilla PPO."""
 
-_BEFORE_FIELDS: dict[str, Any] = {"foot_faces": "sole", "yaw_command": "heading_envs", "heading_stiffness": 0.5}
+_BEFORE_FIELDS: dict[str, Any] = {
+    "foot_faces": "sole",
+    "yaw_command": "heading_envs",
+    "heading_stiffness": 0.5,
+    "rft_extensions_file": "results/sand_calibration/rft3d_calibrated.json",
+    "rft_extension_ranges": {},
+}
 """Task fields absent from runs trained before they existed, and the behaviour those runs had (the sole-only RFT
-collider; mjlab's heading envs, whose heading control uses stiffness 0.5)."""
+collider; mjlab's heading envs, whose heading control uses stiffness 0.5; no fitted RFT terms, none randomized)."""
 
 
 class GateInputError(ValueError):

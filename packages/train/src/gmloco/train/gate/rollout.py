@@ -52,20 +52,30 @@ class GateCell:
 
 
 def gate_cells(cfg: GateCfg) -> list[GateCell]:
-    """Every episode of the gate: per material forward, yaw and circle cells, then the held-out grid."""
+    """Every episode of the gate's ``parts``: per material forward, yaw and circle cells, then the held-out grid.
+
+    The forward cells are the ``speeds`` (part ``success``) and ``apex_speed`` (part ``apex``), each once.
+    """
     import gmloco.contact as gc
 
+    parts = set(cfg.parts)
+    speeds = list(cfg.speeds) if "success" in parts else []
+    if "apex" in parts and cfg.apex_speed not in speeds:
+        speeds.append(cfg.apex_speed)
     commands: list[tuple[CellKind, tuple[float, float, float]]] = []
-    for v in cfg.speeds:
+    for v in speeds:
         commands.append(("forward", (v, 0.0, 0.0)))
-    for w in cfg.yaw_rates:
+    for w in cfg.yaw_rates if "yaw" in parts else ():
         commands.append(("yaw", (cfg.yaw_forward_speed, 0.0, w)))
-    commands.append(("circle", (cfg.circle_speed, 0.0, cfg.circle_speed / cfg.circle_radius_m)))
+    if "circle" in parts:
+        commands.append(("circle", (cfg.circle_speed, 0.0, cfg.circle_speed / cfg.circle_radius_m)))
     cells = []
     for name in cfg.materials:
         p = gc.MATERIAL_PRESETS[name]
         for kind, cmd in commands:
             cells += [GateCell(kind, name, float(p.rho_c), float(p.mu_int), float(p.mu_surf), cmd)] * cfg.repeats
+    if "eta" not in parts:
+        return cells
     for rho, mu in zip(*cfg.held_out.grid(*cfg.held_out_grid), strict=True):
         label = f"held_out_rho{rho:.0f}_mu{mu:.3f}"
         cell = GateCell("held_out", label, float(rho), float(mu), cfg.held_out_mu_surf, (cfg.held_out_speed, 0.0, 0.0))
@@ -84,6 +94,8 @@ def _env_cfg(cfg: GateCfg, policy: GatePolicy, history_length: int) -> Any:
         policy.task,
         play=True,
         contact_model=cfg.contact_model,
+        rft_extensions_file=cfg.rft_extensions_file,
+        rft_extension_ranges={},  # the fitted terms as fitted: the gate draws no domain randomization of them
         terrain=replace(policy.task.terrain, floor=cfg.floor),
         command_curriculum=False,
         episode_length_s=cfg.duration_s + 1.0,

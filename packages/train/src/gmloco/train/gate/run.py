@@ -29,6 +29,15 @@ def write_json(path: str | Path, doc: dict[str, Any]) -> None:
     os.replace(tmp, out)
 
 
+def _extensions(cfg: GateCfg) -> dict[str, Any] | None:
+    """The fitted terms the ``rft3d_calibrated`` model ran with and their file; None for the other models."""
+    if cfg.contact_model != "rft3d_calibrated":
+        return None
+    from gmloco.contact.extensions_io import load_rft_extensions
+
+    return {"file": cfg.rft_extensions_file, "values": asdict(load_rft_extensions(cfg.rft_extensions_file))}
+
+
 def run_gate(cfg: GateCfg) -> dict[str, Any]:
     """Score ``cfg.policy_dir``; return (and with ``cfg.out_path`` write) the gate summary.
 
@@ -46,7 +55,7 @@ def run_gate(cfg: GateCfg) -> dict[str, Any]:
         "policy": str(cfg.policy_dir),
         "actor": policy.kind,
         **metrics,
-        "pass": gate_pass(metrics, cfg.thresholds, cfg.materials),
+        "pass": gate_pass(metrics, cfg.thresholds, cfg.materials, cfg.parts),
         "thresholds": asdict(cfg.thresholds),
         "setup": {
             "episodes_per_cell": cfg.repeats,
@@ -55,6 +64,8 @@ def run_gate(cfg: GateCfg) -> dict[str, Any]:
             "num_envs": cfg.num_envs,
             "device": cfg.device,
             "contact_model": cfg.contact_model,
+            "rft_extensions": _extensions(cfg),
+            "parts": list(cfg.parts),
             "yaw_command": policy.task.yaw_command,
             "heading_stiffness": policy.task.heading_stiffness,
             "gpu_minutes_by_run": minutes,

@@ -11,7 +11,7 @@ import numpy as np
 from gmloco.train.gate.config import GateCfg, GateThresholdsCfg
 from gmloco.train.teacher_student.heldout import r2_score
 
-__all__ = ["gate_metrics", "gate_pass"]
+__all__ = ["PART_KEYS", "gate_metrics", "gate_pass"]
 
 
 def _key(value: float) -> str:
@@ -36,6 +36,37 @@ def _rows(rows: list[dict[str, Any]], kind: str, material: str, command: tuple[f
     ]
 
 
+PART_KEYS: dict[str, tuple[str, ...]] = {
+    "success": ("success_pct", "vel_error_mps", "heading_drift_deg"),
+    "yaw": ("yaw_rate_ratio",),
+    "circle": ("circle_dtw_m",),
+    "apex": ("swing_apex_cm",),
+    "eta": ("eta_r2_heldout",),
+}
+"""Summary keys of each gate part (``GatePart``)."""
+
+
+def _forward(cfg: GateCfg, rows: list[dict[str, Any]], out: dict[str, Any]) -> None:
+    """Fill ``success_pct``, ``vel_error_mps`` and ``heading_drift_deg`` from the forward cells."""
+    for key in PART_KEYS["success"]:
+        out[key] = {m: {} for m in cfg.materials}
+    for m in cfg.materials:
+        for v in cfg.speeds:
+            sel = _rows(rows, "forward", m, (v, 0.0, 0.0))
+            out["success_pct"][m][_key(v)] = 100.0 * float(np.mean([not r["failed"] for r in sel]))
+            out["vel_error_mps"][m][_key(v)] = _mean([r["vel_error"] for r in sel])
+            out["heading_drift_deg"][m][_key(v)] = _mean([r["drift_deg"] for r in sel])
+
+
+def _eta_r2(rows: list[dict[str, Any]]) -> float | None:
+    """Pooled R^2 of the decoded eta over the held-out cells (None without a decoded eta)."""
+    held = [r for r in rows if r["cell"].kind == "held_out" and "eta" in r]
+    if not held:
+        return None
+    r2 = r2_score(np.concatenate([r["eta"][0] for r in held]), np.concatenate([r["eta"][1] for r in held]))
+    return r2 if math.isfinite(r2) else None
+
+
 def gate_metrics(cfg: GateCfg, rows: list[dict[str, Any]]) -> dict[str, Any]:
     """Return the issue's keys from the episode rows of :func:`gmloco.train.gate.rollout.run_cells`.
 
@@ -43,31 +74,27 @@ def gate_metrics(cfg: GateCfg, rows: list[dict[str, Any]]) -> dict[str, Any]:
     ([%], [m/s], [deg], means over episodes); ``yaw_rate_ratio``: ``{material: {w_z: mean achieved / commanded}}``;
     ``circle_dtw_m``: ``{material: mean DTW error}`` [m]; ``swing_apex_cm``: ``{material: mean apex}`` [cm] of the
     ``apex_speed`` forward cells; ``eta_r2_heldout``: pooled R^2 of the held-out cells (None without a decoded eta).
+    The keys of a part not in ``cfg.parts`` are None.
     """
-    out: dict[str, Any] = {k: {} for k in ("success_pct", "vel_error_mps", "yaw_rate_ratio", "heading_drift_deg")}
-    out |= {"circle_dtw_m": {}, "swing_apex_cm": {}}
-    for m in cfg.materials:
-        for key in ("success_pct", "vel_error_mps", "heading_drift_deg", "yaw_rate_ratio"):
-            out[key][m] = {}
-        for v in cfg.speeds:
-            sel = _rows(rows, "forward", m, (v, 0.0, 0.0))
-            out["success_pct"][m][_key(v)] = 100.0 * float(np.mean([not r["failed"] for r in sel]))
-            out["vel_error_mps"][m][_key(v)] = _mean([r["vel_error"] for r in sel])
-            out["heading_drift_deg"][m][_key(v)] = _mean([r["drift_deg"] for r in sel])
-        for w in cfg.yaw_rates:
-            sel = _rows(rows, "yaw", m, (cfg.yaw_forward_speed, 0.0, w))
-            out["yaw_rate_ratio"][m][_key(w)] = _mean([r["yaw_rate"] / w for r in sel])
-        out["circle_dtw_m"][m] = _mean([r["dtw_m"] for r in _rows(rows, "circle", m)])
-        apex = [h for r in _rows(rows, "forward", m, (cfg.apex_speed, 0.0, 0.0)) for h in r["apex_m"]]
-        out["swing_apex_cm"][m] = 100.0 * float(np.mean(apex)) if apex else None
-    held = [r for r in rows if r["cell"].kind == "held_out" and "eta" in r]
-    if held:
-        pred = np.concatenate([r["eta"][0] for r in held])
-        true = np.concatenate([r["eta"][1] for r in held])
-        r2 = r2_score(pred, true)
-        out["eta_r2_heldout"] = r2 if math.isfinite(r2) else None
-    else:
-        out["eta_r2_heldout"] = None
+    keys = ("success_pct", "vel_error_mps", "yaw_rate_ratio", "heading_drift_deg", "circle_dtw_m", "swing_apex_cm")
+    out: dict[str, Any] = dict.fromkeys((*keys, "eta_r2_heldout"))
+    if "success" in cfg.parts:
+        _forward(cfg, rows, out)
+    if "yaw" in cfg.parts:
+        out["yaw_rate_ratio"] = {
+            m: {_key(w): _mean([r["yaw_rate"] / w for r in _rows(rows, "yaw", m, (cfg.yaw_forward_speed, 0.0, w))])
+                for w in cfg.yaw_rates}
+            for m in cfg.materials
+        }  # fmt: skip
+    if "circle" in cfg.parts:
+        out["circle_dtw_m"] = {m: _mean([r["dtw_m"] for r in _rows(rows, "circle", m)]) for m in cfg.materials}
+    if "apex" in cfg.parts:
+        out["swing_apex_cm"] = {}
+        for m in cfg.materials:
+            apex = [h for r in _rows(rows, "forward", m, (cfg.apex_speed, 0.0, 0.0)) for h in r["apex_m"]]
+            out["swing_apex_cm"][m] = 100.0 * float(np.mean(apex)) if apex else None
+    if "eta" in cfg.parts:
+        out["eta_r2_heldout"] = _eta_r2(rows)
     return out
 
 
@@ -77,20 +104,38 @@ def _all_within(table: dict[str, dict[str, float | None]], ok: Any) -> bool:
     return bool(values) and all(v is not None and ok(v) for v in values)
 
 
-def gate_pass(metrics: dict[str, Any], thresholds: GateThresholdsCfg, materials: tuple[str, ...]) -> dict[str, bool]:
-    """Compare every key with its threshold; ``all`` is their conjunction (a missing value fails)."""
-    t = thresholds
-    apex = metrics["swing_apex_cm"]
+def _verdicts(metrics: dict[str, Any], t: GateThresholdsCfg, materials: tuple[str, ...]) -> dict[str, bool]:
+    """Compare every key of every part with its threshold (a missing value fails)."""
+    apex = metrics["swing_apex_cm"] or {}
     first, last = apex.get(materials[0]), apex.get(materials[-1])
-    circles = list(metrics["circle_dtw_m"].values())
-    verdict = {
-        "success_pct": _all_within(metrics["success_pct"], lambda v: v >= t.success_pct),
-        "vel_error_mps": _all_within(metrics["vel_error_mps"], lambda v: v <= t.vel_error_mps),
-        "yaw_rate_ratio": _all_within(metrics["yaw_rate_ratio"], lambda v: abs(v - 1.0) <= t.yaw_rate_tolerance),
-        "heading_drift_deg": _all_within(metrics["heading_drift_deg"], lambda v: v <= t.heading_drift_deg),
+    circles = list((metrics["circle_dtw_m"] or {}).values())
+    eta = metrics["eta_r2_heldout"]
+    return {
+        "success_pct": _all_within(metrics["success_pct"] or {}, lambda v: v >= t.success_pct),
+        "vel_error_mps": _all_within(metrics["vel_error_mps"] or {}, lambda v: v <= t.vel_error_mps),
+        "yaw_rate_ratio": _all_within(metrics["yaw_rate_ratio"] or {}, lambda v: abs(v - 1.0) <= t.yaw_rate_tolerance),
+        "heading_drift_deg": _all_within(metrics["heading_drift_deg"] or {}, lambda v: v <= t.heading_drift_deg),
         "circle_dtw_m": bool(circles) and all(v is not None and v <= t.circle_dtw_m for v in circles),
         "swing_apex_cm": first is not None and last is not None and last - first >= t.swing_apex_rise_cm,
-        "eta_r2_heldout": metrics["eta_r2_heldout"] is not None and metrics["eta_r2_heldout"] >= t.eta_r2_heldout,
-        "gpu_minutes": metrics.get("gpu_minutes") is not None and metrics["gpu_minutes"] <= t.gpu_minutes,
+        "eta_r2_heldout": eta is not None and eta >= t.eta_r2_heldout,
     }
-    return verdict | {"all": all(verdict.values())}
+
+
+def gate_pass(
+    metrics: dict[str, Any],
+    thresholds: GateThresholdsCfg,
+    materials: tuple[str, ...],
+    parts: tuple[str, ...] = tuple(PART_KEYS),
+) -> dict[str, bool | None]:
+    """Compare every key with its threshold; ``all`` is their conjunction (a missing value fails).
+
+    The keys of a part not in ``parts`` are None (not measured), and ``all`` is then False: a partial run never
+    passes the gate.
+    """
+    verdict: dict[str, bool | None] = dict(_verdicts(metrics, thresholds, materials))
+    for part, keys in PART_KEYS.items():
+        if part not in parts:
+            verdict |= dict.fromkeys(keys)
+    minutes = metrics.get("gpu_minutes")
+    verdict["gpu_minutes"] = minutes is not None and minutes <= thresholds.gpu_minutes
+    return verdict | {"all": all(v is True for v in verdict.values())}

@@ -1,0 +1,218 @@
+# SPDX-License-Identifier: Apache-2.0
+"""MPM success against the training simulator's prediction, per policy, material and speed; bad input exits 2.
+
+The prediction of a contact model is the gate's straight-walking success (``python -m gmloco.train.gate
+--contact-model NAME --parts success``); the judge is the committed MPM success by speed (``speed_rows`` of
+``results/mpm_eval/summary.json`` or ``tables/tables.json``, or ``tables/table_speeds.csv``).
+
+python -m gmloco.eval.calibration.predict --gate results/sand_calibration/gate_*.json
+        --mpm results/mpm_eval/summary.json --out results/sand_calibration/predicted_vs_mpm_success.json
+"""
+
+from __future__ import annotations
+
+import argparse
+import csv
+import json
+import re
+import sys
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+from gmloco.deploy.atomic_io import atomic_write_json
+
+__all__ = ["MAX_POINTS", "PredictCfg", "predict_success", "read_gate", "read_mpm_speeds"]
+
+MAX_POINTS = 15.0
+"""A prediction is right when |predicted - MPM success| is at most this [percentage points] (issue 35's test)."""
+
+_SPEED_COLUMN = re.compile(r"^v=([0-9.]+) m/s$")
+"""Column of the MPM speed table holding the success [%] at one commanded speed, e.g. ``v=1.5 m/s``."""
+
+
+@dataclass(frozen=True)
+class PredictCfg:
+    """What is compared and the tolerance of a prediction."""
+
+    scenario: str = "straight"
+    """MPM scenario whose speed rows are compared (the gate's forward cells walk straight)."""
+    figures: bool = True
+    """Write one figure per policy beside the JSON."""
+
+
+def _speed_key(v: float) -> str:
+    """Speed [m/s] as a JSON key, the gate's form: ``1``, ``1.5``."""
+    return f"{v:g}"
+
+
+def _load_json(path: str | Path, what: str) -> dict[str, Any]:
+    """Read a JSON object (FileNotFoundError / ValueError naming the file)."""
+    path = Path(path)
+    if not path.is_file():
+        raise FileNotFoundError(f"{what} {path} not found")
+    try:
+        body = json.loads(path.read_text())
+    except json.JSONDecodeError as e:
+        raise ValueError(f"{what} {path} is not JSON: {e}") from e
+    if not isinstance(body, dict):
+        raise ValueError(f"{what} {path} is not a JSON object")
+    return body
+
+
+def read_gate(path: str | Path) -> tuple[str, str, dict[str, dict[str, float]]]:
+    """Return (policy name, contact model, success [%] by material and speed key) of a gate summary."""
+    body = _load_json(path, "gate summary")
+    success, setup = body.get("success_pct"), body.get("setup", {})
+    if "policy" not in body or not isinstance(setup, dict) or "contact_model" not in setup:
+        raise ValueError(
+            f"gate summary {path} lacks policy or setup.contact_model: is it python -m gmloco.train.gate's?"
+        )
+    if not isinstance(success, dict) or not success:
+        raise ValueError(f"gate summary {path} has no success table: run the gate with --parts success")
+    table = {m: {_speed_key(float(v)): float(s) for v, s in row.items() if s is not None} for m, row in success.items()}
+    return Path(str(body["policy"]).rstrip("/")).name, str(setup["contact_model"]), table
+
+
+def _speed_rows(path: Path) -> list[dict[str, Any]]:
+    """Rows (policy, terrain, scenario, ``v=<speed> m/s`` columns) of an MPM speed table, JSON or CSV."""
+    if path.suffix == ".csv":
+        if not path.is_file():
+            raise FileNotFoundError(f"MPM speed table {path} not found")
+        with path.open(newline="") as fh:
+            return list(csv.DictReader(fh))
+    rows = _load_json(path, "MPM summary").get("speed_rows")
+    if not isinstance(rows, list):
+        raise ValueError(f"MPM summary {path} has no speed_rows: give results/mpm_eval/summary.json")
+    return rows
+
+
+def read_mpm_speeds(path: str | Path, scenario: str = "straight") -> dict[str, dict[str, dict[str, float]]]:
+    """Return MPM success [%] by policy, terrain and speed key of the ``scenario`` rows of an MPM speed table."""
+    out: dict[str, dict[str, dict[str, float]]] = {}
+    for row in _speed_rows(Path(path)):
+        if row.get("scenario") != scenario:
+            continue
+        speeds = {}
+        for column, value in row.items():
+            match = _SPEED_COLUMN.match(str(column))
+            if match and value not in (None, ""):
+                speeds[_speed_key(float(match.group(1)))] = float(value)
+        out.setdefault(str(row["policy"]), {})[str(row["terrain"])] = speeds
+    if not out:
+        raise ValueError(f"MPM speed table {path} has no {scenario!r} rows")
+    return out
+
+
+def _gates(paths: list[str]) -> dict[str, dict[str, dict[str, dict[str, float]]]]:
+    """Return success [%] by policy, contact model, material and speed key; one gate per policy and model."""
+    out: dict[str, dict[str, dict[str, dict[str, float]]]] = {}
+    for path in paths:
+        policy, model, table = read_gate(path)
+        if model in out.get(policy, {}):
+            raise ValueError(f"two gate summaries of {policy} with contact model {model!r}: give one each ({path})")
+        out.setdefault(policy, {})[model] = table
+    return out
+
+
+def _cell(mpm: float, predicted: dict[str, float | None], cfg: PredictCfg) -> dict[str, Any]:
+    """One (policy, material, speed): MPM success, each model's, their difference [points] and its verdict."""
+    diff = {m: None if p is None else p - mpm for m, p in predicted.items()}
+    return {
+        "mpm_success_pct": mpm,
+        "predicted_success_pct": predicted,
+        "difference_points": diff,
+        "within_15_points": {m: None if d is None else bool(abs(d) <= MAX_POINTS) for m, d in diff.items()},
+    }
+
+
+def _compare(policy: str, gates: dict[str, Any], mpm: dict[str, dict[str, float]], cfg: PredictCfg) -> dict:
+    """Cells of one policy: every material of its gates, every speed both the gates and MPM have."""
+    materials = sorted({m for table in gates.values() for m in table})
+    unknown = [m for m in materials if m not in mpm]
+    if unknown:
+        raise ValueError(
+            f"{policy}: materials {unknown} of the gate have no MPM {cfg.scenario} row; MPM has {sorted(mpm)}"
+        )
+    out: dict[str, Any] = {}
+    for material in materials:
+        speeds = [v for v in mpm[material] if any(v in t.get(material, {}) for t in gates.values())]
+        if not speeds:
+            raise ValueError(f"{policy} on {material}: no speed in both the gate and MPM (MPM: {list(mpm[material])})")
+        out[material] = {v: _cell(mpm[material][v], {m: t.get(material, {}).get(v) for m, t in gates.items()}, cfg)
+                         for v in sorted(speeds, key=float)}  # fmt: skip
+    return out
+
+
+def _all_within(table: dict[str, Any], model: str) -> bool | None:
+    """Every cell of a model within the tolerance (None if the model predicts none)."""
+    flags = [c["within_15_points"].get(model) for per in table.values() for c in per.values()]
+    flags = [f for f in flags if f is not None]
+    return all(flags) if flags else None
+
+
+def predict_success(gates: list[str], mpm: str, out: str | Path, cfg: PredictCfg) -> dict[str, Any]:
+    """Compare gate summaries with the MPM success by speed; write the JSON (and figures) to ``out``; return it.
+
+    Raises:
+        ValueError: If a gate's policy or material has no MPM speed row, or no speed is in both.
+    """
+    judged, predicted = read_mpm_speeds(mpm, cfg.scenario), _gates(gates)
+    table: dict[str, Any] = {}
+    for policy, by_model in predicted.items():
+        if policy not in judged:
+            raise ValueError(
+                f"policy {policy!r} has no MPM {cfg.scenario} speed rows in {mpm}; MPM has {sorted(judged)}"
+            )
+        table[policy] = _compare(policy, by_model, judged[policy], cfg)
+    models = sorted({m for by_model in predicted.values() for m in by_model})
+    body: dict[str, Any] = {
+        "predicted_vs_mpm_success": table,
+        "within_15_points": {p: {m: _all_within(t, m) for m in models} for p, t in table.items()},
+        "contact_models": models,
+        "max_points": MAX_POINTS,
+        "scenario": cfg.scenario,
+        "notes": {
+            "predicted_success_pct": "straight-walking success [%] of the gate in the training simulator, per model",
+            "difference_points": "predicted - MPM success [percentage points]; only speeds MPM has are compared",
+        },
+        "inputs": {"gates": list(gates), "mpm": str(mpm)},
+        "figures": [],
+    }
+    out = Path(out)
+    if cfg.figures:
+        out.parent.mkdir(parents=True, exist_ok=True)
+        from gmloco.eval.calibration.figures import fig_predicted_success
+
+        body["figures"] = [str(fig_predicted_success(policy, t, out.parent / f"predicted_success_{policy}.png"))
+                           for policy, t in table.items()]  # fmt: skip
+    atomic_write_json(out, body, allow_nan=False, newline=True)
+    return body
+
+
+def parse_args(argv: list[str] | None) -> argparse.Namespace:
+    """Parse the command line."""
+    p = argparse.ArgumentParser(
+        prog="python -m gmloco.eval.calibration.predict", description=(__doc__ or "").splitlines()[0]
+    )
+    p.add_argument("--gate", nargs="+", required=True, help="gate summaries (python -m gmloco.train.gate)")
+    p.add_argument("--mpm", default="results/mpm_eval/summary.json", help="MPM summary or table_speeds.csv")
+    p.add_argument("--out", default="results/sand_calibration/predicted_vs_mpm_success.json")
+    p.add_argument("--no-figures", action="store_true")
+    return p.parse_args(argv)
+
+
+def main(argv: list[str] | None = None) -> int:
+    """Compare and write; return the exit code (2: bad input)."""
+    a = parse_args(argv)
+    try:
+        body = predict_success(a.gate, a.mpm, a.out, PredictCfg(figures=not a.no_figures))
+    except (FileNotFoundError, ValueError) as e:
+        print(f"error: {e}", file=sys.stderr)
+        return 2
+    print(json.dumps({"within_15_points": body["within_15_points"], "out": a.out}, indent=1))
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
