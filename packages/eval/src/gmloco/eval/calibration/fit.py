@@ -41,12 +41,16 @@ __all__ = [
 
 FIT_BOUNDS: dict[str, tuple[float, float, float]] = {
     "depth_exponent": (0.3, 3.0, 1.0),
+    "depth_ref": (0.005, 1.0, 0.05),
     "depth_saturation": (0.0, 200.0, 0.0),
     "lateral_scale": (0.0, 2.0, 1.0),
     "overburden": (0.0, 10.0, 0.0),
     "added_mass": (0.0, 10.0, 0.0),
 }
-"""(lower, upper, neutral start) of each fitted value; ``depth_saturation`` is fitted as 1 / d_s [1/m] (0 = off)."""
+"""(lower, upper, neutral start) of each fitted value; ``depth_saturation`` is fitted as 1 / d_s [1/m] (0 = off).
+
+With the exponent n != 1, the reference depth sets the law's scale: d_ref (d / d_ref)^n = d_ref^(1 - n) d^n, so the
+pair fits a power law C d^n (a stiffer or softer medium than the published one); at n = 1 it has no effect."""
 
 DATUM_BOUNDS: tuple[float, float, float] = (-0.01, 0.04, 0.0)
 """(lower, upper, start) of the fitted datum: height of the felt sand surface above the nominal bed top [m]."""
@@ -56,7 +60,14 @@ DATUM_BOUNDS: tuple[float, float, float] = (-0.01, 0.04, 0.0)
 class SandFitCfg:
     """Fit settings."""
 
-    params: tuple[str, ...] = ("depth_exponent", "depth_saturation", "lateral_scale", "overburden", "added_mass")
+    params: tuple[str, ...] = (
+        "depth_exponent",
+        "depth_ref",
+        "depth_saturation",
+        "lateral_scale",
+        "overburden",
+        "added_mass",
+    )
     """Extension values to fit (keys of :data:`FIT_BOUNDS`)."""
     plastic_unloading: Literal["off", "on", "both"] = "both"
     """Plastic unloading with footprint memory: fixed off / on, or both fitted and the better fit-split one kept."""

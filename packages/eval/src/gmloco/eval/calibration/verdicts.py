@@ -26,7 +26,7 @@ from gmloco.eval.calibration.fit import FIT_BOUNDS, SandFitCfg, SandFitResult, f
 __all__ = ["TERMS", "TermVerdictCfg", "term_verdicts"]
 
 TERMS: dict[str, tuple[str, ...]] = {
-    "depth_law": ("depth_exponent", "depth_saturation"),
+    "depth_law": ("depth_exponent", "depth_ref", "depth_saturation"),
     "lateral_scale": ("lateral_scale",),
     "plastic_unloading": (),
     "overburden": ("overburden",),
