@@ -6,6 +6,8 @@ Usage::
     python workflows/sweep.py +sweep=optuna_teacher                        # gm_loco teacher; runs/gm_loco/<time>
     python workflows/sweep.py +sweep=optuna_ppo_dr max_minutes=9           # vanilla PPO-3D-RFT, eval objective
     python workflows/sweep.py +sweep=optuna_teacher run_dir=runs/gm_loco/<time>   # resume the study
+    python workflows/sweep.py +sweep=optuna_teacher 'sweep.storage=postgresql+psycopg2://u:pw@host:5432/db'
+    python workflows/sweep.py +sweep=optuna_teacher sweep.storage=journal:runs/s.journal 'sweep.gpus=[0,1]'
 
 One study per run directory: ``study.db`` (SQLite, ``sweep.storage`` empty) with a seeded TPE sampler and a
 median pruner; with ``sweep.storage=<RDB URL or journal:file>`` every worker that runs the same command, on any
