@@ -11,9 +11,10 @@ Usage::
 
 One study per run directory: ``study.db`` (SQLite, ``sweep.storage`` empty) with a seeded TPE sampler and a
 median pruner; with ``sweep.storage=<RDB URL or journal:file>`` every worker that runs the same command, on any
-machine, joins the study by name, and ``sweep.gpus=[0,1,...]`` runs one worker (one trial at a time) per GPU. Each trial is the pipeline's train stage in its own run directory ``trials/<number>/`` (resolved config,
-git state, manifest: ``pipeline_run.run_pipeline``) trained in ``sweep.report_chunks`` resumed chunks; after each
-chunk the objective ``sweep.metric`` is reported to the pruner. A call stops at ``max_minutes``; a trial cut by the
+machine, joins the study by name, and ``sweep.gpus=[0,1,...]`` runs one worker (one trial at a time) per GPU.
+Each trial is the pipeline's train stage in its own run directory ``trials/<number>/`` (resolved config, git
+state, manifest: ``pipeline_run.run_pipeline``) trained in ``sweep.report_chunks`` resumed chunks; after each chunk
+the objective ``sweep.metric`` is reported to the pruner. A call stops at ``max_minutes``; a trial cut by the
 time box (or by a kill) is enqueued again and continues from its checkpoint on the next call. The study is
 summarized in ``study_summary.json``, ``trials.csv``, ``best_config.yaml`` (the best trial's resolved config) and
 ``figures/`` (``sweep.png``, Optuna's ``optimization_history.png`` and ``param_importances.png``).
@@ -438,9 +439,9 @@ def _create_study(cfg: DictConfig, storage: SweepStorage, space: Sequence[Search
         direction="maximize" if str(sweep.direction) == "maximize" else "minimize",
         load_if_exists=True,
     )
+    check_signature(study, signature(str(sweep.metric), str(sweep.direction), _distributions(space)), storage.display())
     # The sampler's RNG lives in this process: a resumed call seeded like the first would repeat its samples, so
     # the seed is offset by the trials already stored (still reproducible from the study's history).
-    check_signature(study, signature(str(sweep.metric), str(sweep.direction), _distributions(space)), storage.display())
     seed = int(sweep.sampler_seed) + len(study.get_trials(deepcopy=False))
     if worker:  # workers seeded alike would propose the same values: each adds its host and process id
         import os

@@ -66,7 +66,11 @@ def postgres_url() -> Iterator[str]:
     if prefix:
         shutil.chown(base, user="postgres")
     data, port = base / "data", _free_port()
-    run = lambda *args: subprocess.run([*prefix, *args], check=True, capture_output=True, text=True, timeout=120)  # noqa: E731
+
+    def run(*args: str) -> None:
+        """Run one of the server's programs (as its user); raise when it fails."""
+        subprocess.run([*prefix, *args], check=True, capture_output=True, text=True, timeout=120)
+
     run("initdb", "-D", str(data), "-U", "gmloco", "--auth=trust", "-E", "UTF8")
     options = f"-p {port} -k {base} -c listen_addresses=127.0.0.1"
     run("pg_ctl", "-D", str(data), "-l", str(base / "server.log"), "-w", "-o", options, "start")
