@@ -374,8 +374,13 @@ class SweepCfg:
     """Finished trials (complete, pruned or failed) the study should hold."""
     sampler_seed: int = ranged(_interp("${seed}"), integer=True, ge=0, le=2**32 - 1)
     """Seed of the TPE sampler (seeded samplers make sweeps reproducible)."""
-    storage: str = _interp("sqlite:///${paths.runs_dir}/optuna.db")
-    """Optuna storage URL (an RDB URL shares one study across machines)."""
+    storage: str = ""
+    """Where the study lives (``workflows/sweep_storage.py``). Empty: the embedded SQLite file ``<run_dir>/study.db``
+    (one worker). An RDB URL (``postgresql+psycopg2://user@host:5432/db``) or ``journal:<file>``: a study that every
+    worker started with the same command joins by ``study_name``, on any machine."""
+    gpus: list[int] = field(default_factory=list, metadata=each(integer=True, ge=0))
+    """CUDA devices of this machine, one worker process (one trial at a time) on each; ``device`` and
+    ``train_teacher.gpus`` are set per worker. Empty: one worker on ``device``."""
     params: dict[str, Any] = field(default_factory=dict)
     """Search space: key -> ``{type: float|int|categorical, low, high, log, step, choices}``. Keys are config
     overrides (``train_teacher.ppo.learning_rate``) or ``task.<field path>`` of ``gmloco.train.GranularTaskCfg``

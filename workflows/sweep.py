@@ -6,13 +6,18 @@ Usage::
     python workflows/sweep.py +sweep=optuna_teacher                        # gm_loco teacher; runs/gm_loco/<time>
     python workflows/sweep.py +sweep=optuna_ppo_dr max_minutes=9           # vanilla PPO-3D-RFT, eval objective
     python workflows/sweep.py +sweep=optuna_teacher run_dir=runs/gm_loco/<time>   # resume the study
+    python workflows/sweep.py +sweep=optuna_teacher 'sweep.storage=postgresql+psycopg2://u:pw@host:5432/db'
+    python workflows/sweep.py +sweep=optuna_teacher sweep.storage=journal:runs/s.journal 'sweep.gpus=[0,1]'
 
-One study per run directory: ``study.db`` (SQLite, ``sweep.storage``) with a seeded TPE sampler and a median
-pruner. Each trial is the pipeline's train stage in its own run directory ``trials/<number>/`` (resolved config,
-git state, manifest: ``pipeline_run.run_pipeline``) trained in ``sweep.report_chunks`` resumed chunks; after each
-chunk the objective ``sweep.metric`` is reported to the pruner. A call stops at ``max_minutes``; a trial cut by the
+One study per run directory: ``study.db`` (SQLite, ``sweep.storage`` empty) with a seeded TPE sampler and a
+median pruner; with ``sweep.storage=<RDB URL or journal:file>`` every worker that runs the same command, on any
+machine, joins the study by name, and ``sweep.gpus=[0,1,...]`` runs one worker (one trial at a time) per GPU.
+Each trial is the pipeline's train stage in its own run directory ``trials/<number>/`` (resolved config, git
+state, manifest: ``pipeline_run.run_pipeline``) trained in ``sweep.report_chunks`` resumed chunks; after each chunk
+the objective ``sweep.metric`` is reported to the pruner. A call stops at ``max_minutes``; a trial cut by the
 time box (or by a kill) is enqueued again and continues from its checkpoint on the next call. The study is
-summarized in ``study_summary.json``, ``trials.csv`` and ``figures/sweep.png``.
+summarized in ``study_summary.json``, ``trials.csv``, ``best_config.yaml`` (the best trial's resolved config) and
+``figures/`` (``sweep.png``, Optuna's ``optimization_history.png`` and ``param_importances.png``).
 
 Exit codes: 0 the study holds ``n_trials`` finished trials (at least one complete); 1 none completed; 2 bad input;
 3 the time box was reached (rerun the same command with ``run_dir=`` to continue).
@@ -48,6 +53,14 @@ from workflows.run_dir import (
 from workflows.schemas import REPO_ROOT
 from workflows.stage_registry import StageSpec
 from workflows.stage_runner import PipelineConfigError, resolve_device
+from workflows.sweep_storage import SweepStorage, parse_storage
+from workflows.sweep_workers import (
+    check_signature,
+    claimed_trials,
+    gpu_worker_cfgs,
+    run_gpu_workers,
+    signature,
+)
 
 __all__ = ["Objective", "SearchParam", "apply_task_overrides", "main", "parse_space", "run_sweep"]
 
@@ -382,6 +395,10 @@ def _prepare(cfg: DictConfig) -> DictConfig:
     cfg.stages = ["train_teacher"]
     if str(cfg.sweep.direction) not in ("maximize", "minimize"):
         raise _bad("sweep.direction", f"direction must be 'maximize' or 'minimize', got '{cfg.sweep.direction}'.")
+    parse_storage(str(cfg.sweep.storage), Path(cfg.run_dir))
+    _check_gpus(cfg)
+    if len(cfg.sweep.gpus) == 1:
+        cfg = gpu_worker_cfgs(cfg)[0]
     if str(getattr(cfg.scale, "value", cfg.scale)) == "smoke":
         cfg.sweep.n_trials = min(int(cfg.sweep.n_trials), int(cfg.sweep.smoke_trials))
         cfg.sweep.task_overrides = {**cfg.sweep.task_overrides, **cfg.sweep.smoke_task_overrides}
@@ -393,27 +410,45 @@ def _prepare(cfg: DictConfig) -> DictConfig:
     return cfg
 
 
-def _create_study(cfg: DictConfig) -> Any:
-    """Create or load the study: seeded TPE sampler, median pruner over training iterations."""
+def _check_gpus(cfg: DictConfig) -> None:
+    """``sweep.gpus`` must name distinct CUDA devices of this machine."""
+    gpus = [int(g) for g in cfg.sweep.gpus]
+    if not gpus:
+        return
+    from gmloco.train.multi_gpu import cuda_device_count, gpus_problem
+
+    if (problem := gpus_problem(gpus, cuda_device_count())) is not None:
+        raise _bad("sweep.gpus", f"bad value {gpus}: {problem}.")
+
+
+def _create_study(cfg: DictConfig, storage: SweepStorage, space: Sequence[SearchParam], worker: bool) -> Any:
+    """Create or join the study: seeded TPE sampler, median pruner over training iterations, same search.
+
+    ``worker``: one of several processes sampling the study at once (a shared storage or ``sweep.gpus``).
+    """
     import optuna
 
-    storage = str(cfg.sweep.storage)
-    if storage.startswith("sqlite:///"):
-        Path(storage.removeprefix("sqlite:///")).parent.mkdir(parents=True, exist_ok=True)
     optuna.logging.set_verbosity(optuna.logging.WARNING)
     sweep = cfg.sweep
     study = optuna.create_study(
         study_name=str(sweep.study_name),
-        storage=storage,
+        storage=storage.open(),
         pruner=optuna.pruners.MedianPruner(
             n_startup_trials=int(sweep.pruner_startup_trials), n_warmup_steps=int(sweep.pruner_warmup_steps)
         ),
         direction="maximize" if str(sweep.direction) == "maximize" else "minimize",
         load_if_exists=True,
     )
+    check_signature(study, signature(str(sweep.metric), str(sweep.direction), _distributions(space)), storage.display())
     # The sampler's RNG lives in this process: a resumed call seeded like the first would repeat its samples, so
     # the seed is offset by the trials already stored (still reproducible from the study's history).
     seed = int(sweep.sampler_seed) + len(study.get_trials(deepcopy=False))
+    if worker:  # workers seeded alike would propose the same values: each adds its host and process id
+        import os
+        import socket
+        import zlib
+
+        seed = zlib.crc32(f"{seed}:{socket.gethostname()}:{os.getpid()}".encode())
     study.sampler = optuna.samplers.TPESampler(seed=seed, n_startup_trials=int(sweep.n_startup_trials))
     return study
 
@@ -426,6 +461,11 @@ def _retry(study: Any, trial: Any) -> None:
     attrs = {"run_dir": trial.user_attrs.get("run_dir"), "retry_of": trial.number, "reports": reports}
     study.tell(trial.number, state=TrialState.FAIL, skip_if_finished=True)
     study.enqueue_trial(dict(trial.params), user_attrs={k: v for k, v in attrs.items() if v is not None})
+
+
+def _distributions(space: Sequence[SearchParam]) -> dict[str, Any]:
+    """Optuna distribution of each searched key."""
+    return {p.key: p.distribution() for p in space}
 
 
 def requeue_interrupted(study: Any) -> list[int]:
@@ -461,6 +501,13 @@ def _tell(study: Any, trial: Any, outcome: TrialOutcome) -> None:
         study.tell(trial, state=TrialState.PRUNED if outcome.state == "pruned" else TrialState.FAIL)
 
 
+def _space(cfg: DictConfig) -> list[SearchParam]:
+    """The parsed ``sweep.params``."""
+    params = OmegaConf.to_container(cfg.sweep.params, resolve=True)
+    assert isinstance(params, dict)
+    return parse_space({str(k): v for k, v in params.items()})
+
+
 def _setup(cfg: DictConfig) -> tuple[Path, Objective, list[SearchParam], dict[str, Any]]:
     """Check the objective and search space, then seed and write the sweep's resolved config and git state."""
     objective = Objective.parse(str(cfg.sweep.metric))
@@ -468,9 +515,7 @@ def _setup(cfg: DictConfig) -> tuple[Path, Objective, list[SearchParam], dict[st
         raise _bad(
             "sweep.metric", "eval/<key> objectives need a policy.onnx: only train_teacher.algorithm=ppo exports one."
         )
-    params = OmegaConf.to_container(cfg.sweep.params, resolve=True)
-    assert isinstance(params, dict)
-    space = parse_space({str(k): v for k, v in params.items()})
+    space = _space(cfg)
     check_space(cfg, space, dict(cfg.sweep.task_overrides))
     seed_everything(int(cfg.seed))
     root = Path(cfg.run_dir)
@@ -484,20 +529,47 @@ def run_sweep(cfg: DictConfig) -> dict[str, Any]:
     Returns:
         The study summary also written to ``<run_dir>/study_summary.json``, with ``exit_code``.
     """
-    from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeElapsedColumn
-
     cfg = _prepare(cfg)
     root, objective, space, git = _setup(cfg)
-    deadline = None if cfg.max_minutes is None else time.monotonic() + 60.0 * float(cfg.max_minutes)
-    study = _create_study(cfg)
-    if cfg.sweep.requeue_interrupted and (requeued := requeue_interrupted(study)):
+    storage = parse_storage(str(cfg.sweep.storage), root)
+    study = _create_study(cfg, storage, space, worker=storage.shared)
+    # Running trials of a shared study may belong to live workers elsewhere: only a lone worker requeues them.
+    if cfg.sweep.requeue_interrupted and not storage.shared and (requeued := requeue_interrupted(study)):
         console.print(f"continuing interrupted trials {requeued} from their checkpoints")
-    distributions = {p.key: p.distribution() for p in space}
+    if len(cfg.sweep.gpus) > 1:
+        console.print(f"one worker per GPU: {list(cfg.sweep.gpus)}")
+        timed_out = EXIT_INCOMPLETE in run_gpu_workers(gpu_worker_cfgs(cfg), _gpu_worker)
+    else:
+        timed_out = _work(cfg, study, objective, space, root)
+    n_complete = sum(t.state.name == "COMPLETE" for t in finished_trials(study))
+    code = EXIT_INCOMPLETE if timed_out else (EXIT_OK if n_complete else EXIT_FAILED)
+    summary = write_report(study, cfg, root, git, finished_trials(study), code)
+    console.print(f"study summary: {root / 'study_summary.json'} (best: {summary['best']})")
+    if code == EXIT_INCOMPLETE:
+        console.print(f"resume: rerun the same command with run_dir={root}")
+    return summary
+
+
+def _gpu_worker(cfg: DictConfig) -> int:
+    """One GPU's worker process of ``sweep.gpus``: join the study, run trials; exit 3 at the time box, else 0."""
+    root = Path(cfg.run_dir)
+    space = _space(cfg)
+    study = _create_study(cfg, parse_storage(str(cfg.sweep.storage), root), space, worker=True)
+    timed_out = _work(cfg, study, Objective.parse(str(cfg.sweep.metric)), space, root)
+    return EXIT_INCOMPLETE if timed_out else EXIT_OK
+
+
+def _work(cfg: DictConfig, study: Any, objective: Objective, space: Sequence[SearchParam], root: Path) -> bool:
+    """Ask, run and tell trials until the study holds ``n_trials`` finished or running ones; True at the time box."""
+    from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeElapsedColumn
+
+    deadline = None if cfg.max_minutes is None else time.monotonic() + 60.0 * float(cfg.max_minutes)
+    distributions = _distributions(space)
     total, timed_out = int(cfg.sweep.n_trials), False
     columns = (TextColumn("[bold]{task.description}"), BarColumn(), MofNCompleteColumn(), TimeElapsedColumn())
     with Progress(*columns, console=console) as progress:
         bar = progress.add_task("sweep", total=total, completed=min(total, len(finished_trials(study))))
-        while len(finished_trials(study)) < total:
+        while claimed_trials(study, finished_trials(study)) < total:
             if deadline is not None and time.monotonic() >= deadline:
                 timed_out = True
                 break
@@ -512,13 +584,7 @@ def run_sweep(cfg: DictConfig) -> dict[str, Any]:
             progress.update(bar, completed=min(total, len(finished_trials(study))))
             if timed_out:
                 break
-    n_complete = sum(t.state.name == "COMPLETE" for t in finished_trials(study))
-    code = EXIT_INCOMPLETE if timed_out else (EXIT_OK if n_complete else EXIT_FAILED)
-    summary = write_report(study, cfg, root, git, finished_trials(study), code)
-    console.print(f"study summary: {root / 'study_summary.json'} (best: {summary['best']})")
-    if code == EXIT_INCOMPLETE:
-        console.print(f"resume: rerun the same command with run_dir={root}")
-    return summary
+    return timed_out
 
 
 # Report: study_summary.json, trials.csv, figures/sweep.png.
@@ -621,6 +687,17 @@ def _figure_or_note(path: Path, *args: Any) -> str:
     return path.name
 
 
+def _write_best_config(cfg: DictConfig, root: Path, trials: Sequence[Any], best: dict | None) -> str | None:
+    """Write the best trial's resolved config (as its trial folder has it) to ``best_config.yaml``; its name."""
+    if best is None:
+        return None
+    trial = next(t for t in trials if t.number == best["number"])
+    trial_dir = root / str(trial.user_attrs.get("run_dir", f"trials/{trial.number:04d}"))
+    tcfg, _ = _trial_cfg(cfg, trial, trial_dir, None)
+    atomic_write_yaml(root / "best_config.yaml", OmegaConf.to_container(tcfg, resolve=True, enum_to_str=True))
+    return "best_config.yaml"
+
+
 def write_report(
     study: Any, cfg: DictConfig, root: Path, git: dict[str, Any], trials: Sequence[Any], code: int
 ) -> dict:
@@ -633,7 +710,7 @@ def write_report(
     states = {s: sum(r["state"] == s for r in rows) for s in ("complete", "pruned", "fail")}
     summary = {
         "study_name": str(cfg.sweep.study_name),
-        "storage": str(cfg.sweep.storage),
+        "storage": parse_storage(str(cfg.sweep.storage), root).display(),
         "metric": str(cfg.sweep.metric),
         "direction": str(cfg.sweep.direction),
         "n_trials": int(cfg.sweep.n_trials),
@@ -652,6 +729,11 @@ def write_report(
         "exit_code": code,
     }
     summary["figure"] = _figure_or_note(root / "figures" / "sweep.png", rows, importances, why, cfg)
+    if summary["figure"] == "sweep.png":
+        from workflows.sweep_figures import write_optuna_figures
+
+        summary["figures"] = write_optuna_figures(study, root / "figures", importances is not None)
+    summary["best_config"] = _write_best_config(cfg, root, trials, best)
     atomic_write_json(root / "study_summary.json", summary)
     _write_csv(root / "trials.csv", rows)
     return summary

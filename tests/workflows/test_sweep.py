@@ -99,11 +99,13 @@ def _sweep_cfg(compose: Callable[..., DictConfig], run_dir: Path, n_trials: int)
     return cfg
 
 
-def _load_study(run_dir: Path) -> Any:
-    """The study stored in the run directory."""
+def _load_study(run_dir: Path, storage: str = "") -> Any:
+    """The study stored in the run directory (or in ``storage``)."""
     import optuna
 
-    return optuna.load_study(study_name="gm_loco", storage=f"sqlite:///{run_dir}/study.db")
+    from workflows.sweep_storage import parse_storage
+
+    return optuna.load_study(study_name="gm_loco", storage=parse_storage(storage, run_dir).open())
 
 
 def test_parse_space_names_the_bad_entry() -> None:
@@ -297,7 +299,12 @@ def test_importances_rank_the_parameter_that_matters(compose: Callable[..., Dict
 
 @pytest.mark.parametrize(
     ("args", "key"),
-    [(["+sweep=optuna_teacher", "sweep.metric=mean_reward"], "sweep.metric"), ([], "sweep")],
+    [
+        (["+sweep=optuna_teacher", "sweep.metric=mean_reward"], "sweep.metric"),
+        ([], "sweep"),
+        (["+sweep=optuna_teacher", "sweep.storage=study.db"], "sweep.storage"),
+        (["+sweep=optuna_teacher", "sweep.gpus=[0]", "device=cpu"], "sweep.gpus"),
+    ],
 )
 def test_bad_sweep_input_exits_2(tmp_path: Path, args: list[str], key: str) -> None:
     """A malformed metric or no +sweep= is one paragraph naming the key, exit code 2, nothing written."""
@@ -305,6 +312,87 @@ def test_bad_sweep_input_exits_2(tmp_path: Path, args: list[str], key: str) -> N
     assert res.returncode == 2, res.stderr[-3000:]
     assert f"'{key}'" in res.stderr or f"{key}" in res.stderr
     assert not (tmp_path / "study.db").exists() and not (tmp_path / "config.yaml").exists()
+
+
+def test_workers_join_a_shared_study_and_refuse_another_search(
+    compose: Callable[..., DictConfig], fake_training: Callable[..., FakeTraining], tmp_path: Path
+) -> None:
+    """Two workers (run dirs) on one journal study; a worker with another search space is refused, exit code 2.
+
+    The report has Optuna's optimization history and the best trial's resolved config.
+    """
+    fake_training()
+    storage = f"journal:{tmp_path / 'shared.journal'}"
+    first_cfg = _sweep_cfg(compose, tmp_path / "a", 2)
+    first_cfg.sweep.storage = storage
+    first = sweep.run_sweep(first_cfg)
+    assert first["exit_code"] == 0 and first["finished"] == 2 and first["storage"] == storage
+    assert not (tmp_path / "a" / "study.db").exists()
+    second_cfg = _sweep_cfg(compose, tmp_path / "b", 3)
+    second_cfg.sweep.storage = storage
+    second = sweep.run_sweep(second_cfg)
+    assert second["finished"] == 3 and sorted(r["run_dir"] for r in second["trials"])[-1] == "trials/0002"
+    assert (tmp_path / "b" / "trials" / "0002").is_dir() and not (tmp_path / "b" / "trials" / "0000").exists()
+    # Report: Optuna's figure and the best trial's config (rebuilt from its values wherever it ran).
+    assert second["figures"] == ["optimization_history.png"]  # importances need 5 complete trials
+    assert (tmp_path / "b" / "figures" / "optimization_history.png").stat().st_size > 5_000
+    best = OmegaConf.load(tmp_path / "b" / second["best_config"])
+    assert best.sweep.trial_params.number == second["best"]["number"]
+    assert best.train_teacher.ppo.learning_rate == pytest.approx(second["best"]["params"][LR_KEY])
+    # Another search on the same study name is refused (and so is another objective direction).
+    other = _sweep_cfg(compose, tmp_path / "c", 4)
+    other.sweep.storage = storage
+    other.sweep.params[MU_KEY]["high"] = 0.3
+    with pytest.raises(PipelineConfigError, match=r"sweep.params: study 'gm_loco' .*holds a different search"):
+        sweep.run_sweep(other)
+    res = run_cli(
+        [
+            "tests/workflows/sweep_fake_worker.py",
+            "+sweep=optuna_teacher",
+            "+scale=smoke",
+            "device=cpu",
+            f"run_dir={tmp_path / 'd'}",
+            f"sweep.storage={storage}",
+        ],
+        timeout=300,
+    )
+    assert res.returncode == 2, res.stderr[-3000:]
+    assert (
+        "holds a different search" in res.stderr and "'task.robot_dr.push_velocity' only in this config" in res.stderr
+    )
+
+
+def test_gpu_workers_get_one_gpu_each(compose: Callable[..., DictConfig], tmp_path: Path) -> None:
+    """``sweep.gpus=[0, 2]``: two worker configs on cuda:0 and cuda:2, each training on its GPU alone."""
+    from workflows.sweep_workers import gpu_worker_cfgs
+
+    cfg = compose("+exp=gm_loco", "+sweep=optuna_teacher", f"run_dir={tmp_path}", "sweep.gpus=[0,2]")
+    cfg.train_teacher.gpus = [0, 1]
+    workers = gpu_worker_cfgs(cfg)
+    assert [w.device for w in workers] == ["cuda:0", "cuda:2"]
+    assert [list(w.sweep.gpus) for w in workers] == [[0], [2]]
+    assert all(list(w.train_teacher.gpus) == [] for w in workers) and list(cfg.sweep.gpus) == [0, 2]
+
+
+def test_gpu_worker_processes_fill_one_study(
+    compose: Callable[..., DictConfig], fake_training: Callable[..., FakeTraining], tmp_path: Path
+) -> None:
+    """Two spawned worker processes (as ``sweep.gpus`` starts, here on the CPU) run 4 distinct trials of one study."""
+    from tests.workflows import sweep_fake_worker
+    from workflows.sweep_workers import gpu_worker_cfgs, run_gpu_workers
+
+    fake_training()
+    cfg = _sweep_cfg(compose, tmp_path, 4)
+    cfg.sweep.storage, cfg.sweep.gpus = f"journal:{tmp_path / 'study.journal'}", [0, 1]
+    cfg.sweep.n_trials = 4  # what sweep._prepare makes of smoke_trials
+    workers = gpu_worker_cfgs(cfg)
+    for w in workers:
+        w.device = "cpu"
+    assert run_gpu_workers(workers, sweep_fake_worker.gpu_worker) == [0, 0]
+    trials = _load_study(tmp_path, f"journal:{tmp_path / 'study.journal'}").trials
+    assert 4 <= len(trials) <= 5 and all(t.state.is_finished() for t in trials)
+    assert len({t.params[MU_KEY] for t in trials}) == len(trials)
+    assert sorted(d.name for d in (tmp_path / "trials").iterdir()) == [f"{t.number:04d}" for t in trials]
 
 
 @pytest.mark.slow
