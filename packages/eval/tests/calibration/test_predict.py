@@ -117,3 +117,14 @@ def test_mismatched_input_exits_2(case: str, message: str, tmp_path: Path, capsy
     code, body = _run(tmp_path, gates[case](), _mpm(tmp_path), "--no-figures")
     assert code == 2 and body == {}
     assert message in capsys.readouterr().err
+
+
+def test_only_judged_materials_lists_the_rest(tmp_path: Path) -> None:
+    """With --only-judged-materials a gated material without an MPM row is left out and named, not an error."""
+    gates = [_gate(tmp_path, "rft3d", {"dry_sand": {"1": 100.0}, "basalt": {"1": 100.0}})]
+    code, _ = _run(tmp_path, gates, _mpm(tmp_path), "--no-figures")
+    assert code == 2
+    code, body = _run(tmp_path, gates, _mpm(tmp_path), "--no-figures", "--only-judged-materials")
+    assert code == 0
+    assert list(body["predicted_vs_mpm_success"][POLICY]) == ["dry_sand"]
+    assert body["not_judged_on_mpm"] == {POLICY: ["basalt"]}

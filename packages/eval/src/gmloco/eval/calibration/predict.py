@@ -39,6 +39,9 @@ class PredictCfg:
     """MPM scenario whose speed rows are compared (the gate's forward cells walk straight)."""
     figures: bool = True
     """Write one figure per policy beside the JSON."""
+    only_judged_materials: bool = False
+    """Compare a policy on the materials MPM has judged it on and list the others under ``not_judged_on_mpm``
+    (False: a gated material without an MPM row is an error)."""
 
 
 def _speed_key(v: float) -> str:
@@ -130,7 +133,9 @@ def _compare(policy: str, gates: dict[str, Any], mpm: dict[str, dict[str, float]
     """Cells of one policy: every material of its gates, every speed both the gates and MPM have."""
     materials = sorted({m for table in gates.values() for m in table})
     unknown = [m for m in materials if m not in mpm]
-    if unknown:
+    if unknown and cfg.only_judged_materials:
+        materials = [m for m in materials if m in mpm]
+    elif unknown:
         raise ValueError(
             f"{policy}: materials {unknown} of the gate have no MPM {cfg.scenario} row; MPM has {sorted(mpm)}"
         )
@@ -159,12 +164,16 @@ def predict_success(gates: list[str], mpm: str, out: str | Path, cfg: PredictCfg
     """
     judged, predicted = read_mpm_speeds(mpm, cfg.scenario), _gates(gates)
     table: dict[str, Any] = {}
+    not_judged: dict[str, list[str]] = {}
     for policy, by_model in predicted.items():
         if policy not in judged:
             raise ValueError(
                 f"policy {policy!r} has no MPM {cfg.scenario} speed rows in {mpm}; MPM has {sorted(judged)}"
             )
         table[policy] = _compare(policy, by_model, judged[policy], cfg)
+        gated = {m for t in by_model.values() for m in t}
+        if gated - set(table[policy]):
+            not_judged[policy] = sorted(gated - set(table[policy]))
     models = sorted({m for by_model in predicted.values() for m in by_model})
     body: dict[str, Any] = {
         "predicted_vs_mpm_success": table,
@@ -176,6 +185,7 @@ def predict_success(gates: list[str], mpm: str, out: str | Path, cfg: PredictCfg
             "predicted_success_pct": "straight-walking success [%] of the gate in the training simulator, per model",
             "difference_points": "predicted - MPM success [percentage points]; only speeds MPM has are compared",
         },
+        "not_judged_on_mpm": not_judged,
         "inputs": {"gates": list(gates), "mpm": str(mpm)},
         "figures": [],
     }
@@ -199,6 +209,8 @@ def parse_args(argv: list[str] | None) -> argparse.Namespace:
     p.add_argument("--mpm", default="results/mpm_eval/summary.json", help="MPM summary or table_speeds.csv")
     p.add_argument("--out", default="results/sand_calibration/predicted_vs_mpm_success.json")
     p.add_argument("--no-figures", action="store_true")
+    p.add_argument("--only-judged-materials", action="store_true",
+                   help="compare each policy on the materials MPM judged it on; list the others (default: error)")  # fmt: skip
     return p.parse_args(argv)
 
 
@@ -206,7 +218,9 @@ def main(argv: list[str] | None = None) -> int:
     """Compare and write; return the exit code (2: bad input)."""
     a = parse_args(argv)
     try:
-        body = predict_success(a.gate, a.mpm, a.out, PredictCfg(figures=not a.no_figures))
+        body = predict_success(
+            a.gate, a.mpm, a.out, PredictCfg(figures=not a.no_figures, only_judged_materials=a.only_judged_materials)
+        )
     except (FileNotFoundError, ValueError) as e:
         print(f"error: {e}", file=sys.stderr)
         return 2
