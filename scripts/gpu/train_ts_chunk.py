@@ -58,7 +58,11 @@ def _parse(argv: list[str] | None) -> argparse.Namespace:
     p = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     p.add_argument("--stage", required=True, choices=sorted(RUNS))
     p.add_argument("--run", default=None, help="run name (default gm_loco_teacher / gm_loco_student)")
-    p.add_argument("--contact-model", default="rft3d", choices=["rft3d", "heuristic_rft", "cone_multi", "rigid"])
+    p.add_argument(
+        "--contact-model",
+        default="rft3d",
+        choices=["rft3d", "rft3d_calibrated", "heuristic_rft", "cone_multi", "rigid"],
+    )
     p.add_argument("--terrain", default="flat", choices=["flat", "rough", "deep"])
     p.add_argument("--num-envs", type=int, default=4096)
     p.add_argument("--num-steps-per-env", type=int, default=24)
