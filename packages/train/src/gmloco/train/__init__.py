@@ -13,8 +13,9 @@ the defining module on first access.
 
 from __future__ import annotations
 
-import importlib
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING
+
+from gmloco.train.lazy_exports import lazy_exports
 
 if TYPE_CHECKING:
     from gmloco.train.config import (
@@ -75,17 +76,4 @@ __all__ = [
 ]
 
 
-def __getattr__(name: str) -> Any:
-    """Import the module defining the public ``name`` on first access and cache the value in this module."""
-    module = _EXPORTS.get(name)
-    if module is None:
-        # AttributeError lets ``from gmloco.train import mdp`` fall back to importing the submodule
-        raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
-    value = getattr(importlib.import_module(module), name)
-    globals()[name] = value
-    return value
-
-
-def __dir__() -> list[str]:
-    """List the module's attributes, including the not-yet-imported public names."""
-    return sorted({*globals(), *__all__})
+__getattr__, __dir__ = lazy_exports(globals(), _EXPORTS)

@@ -156,3 +156,20 @@ def check_contract(ds: CalibrationDataset, robot: str, rate_hz: float | None) ->
 def file_sha256(path: str | Path) -> str:
     """Return the SHA-256 of a file (provenance of a fit)."""
     return hashlib.sha256(Path(path).read_bytes()).hexdigest()
+
+
+def read_json_object(path: str | Path, what: str, required: tuple[str, ...] = ()) -> dict[str, Any]:
+    """Read a JSON object holding the ``required`` keys (FileNotFoundError / ValueError naming the file)."""
+    path = Path(path)
+    if not path.is_file():
+        raise FileNotFoundError(f"{what} {path} not found")
+    try:
+        body = json.loads(path.read_text())
+    except json.JSONDecodeError as e:
+        raise ValueError(f"{what} {path} is not JSON: {e}") from e
+    if not isinstance(body, dict):
+        raise ValueError(f"{what} {path} is not a JSON object")
+    missing = [k for k in required if k not in body]
+    if missing:
+        raise ValueError(f"{what} {path} lacks {missing}: is it the output of the right command?")
+    return body

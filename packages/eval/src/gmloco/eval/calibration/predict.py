@@ -21,6 +21,7 @@ from pathlib import Path
 from typing import Any
 
 from gmloco.deploy.atomic_io import atomic_write_json
+from gmloco.eval.calibration.dataset import read_json_object
 
 __all__ = ["MAX_POINTS", "PredictCfg", "predict_success", "read_gate", "read_mpm_speeds"]
 
@@ -49,23 +50,9 @@ def _speed_key(v: float) -> str:
     return f"{v:g}"
 
 
-def _load_json(path: str | Path, what: str) -> dict[str, Any]:
-    """Read a JSON object (FileNotFoundError / ValueError naming the file)."""
-    path = Path(path)
-    if not path.is_file():
-        raise FileNotFoundError(f"{what} {path} not found")
-    try:
-        body = json.loads(path.read_text())
-    except json.JSONDecodeError as e:
-        raise ValueError(f"{what} {path} is not JSON: {e}") from e
-    if not isinstance(body, dict):
-        raise ValueError(f"{what} {path} is not a JSON object")
-    return body
-
-
 def read_gate(path: str | Path) -> tuple[str, str, dict[str, dict[str, float]]]:
     """Return (policy name, contact model, success [%] by material and speed key) of a gate summary."""
-    body = _load_json(path, "gate summary")
+    body = read_json_object(path, "gate summary")
     success, setup = body.get("success_pct"), body.get("setup", {})
     if "policy" not in body or not isinstance(setup, dict) or "contact_model" not in setup:
         raise ValueError(
@@ -84,7 +71,7 @@ def _speed_rows(path: Path) -> list[dict[str, Any]]:
             raise FileNotFoundError(f"MPM speed table {path} not found")
         with path.open(newline="") as fh:
             return list(csv.DictReader(fh))
-    rows = _load_json(path, "MPM summary").get("speed_rows")
+    rows = read_json_object(path, "MPM summary").get("speed_rows")
     if not isinstance(rows, list):
         raise ValueError(f"MPM summary {path} has no speed_rows: give results/mpm_eval/summary.json")
     return rows

@@ -26,7 +26,14 @@ import numpy as np
 
 from gmloco.contact import ContactRFT3DCfg, RftExtensionsCfg
 from gmloco.deploy.atomic_io import atomic_write_json
-from gmloco.eval.calibration.dataset import CalibrationDataset, ContractError, check_contract, file_sha256, load_dataset
+from gmloco.eval.calibration.dataset import (
+    CalibrationDataset,
+    ContractError,
+    check_contract,
+    file_sha256,
+    load_dataset,
+    read_json_object,
+)
 from gmloco.eval.calibration.fit import SandFitCfg, dataset_material, replay_forces
 from gmloco.eval.calibration.protocol import SoleRecord, run_experiment
 from gmloco.eval.calibration.rft_sand import centred_sole_collider, rft_sole_sand
@@ -73,21 +80,6 @@ class SummaryCfg:
     """Contact model of the training simulator whose prediction the pass check judges."""
     figures: bool = True
     """Write the PNG figures beside the JSON."""
-
-
-def _read_json(path: str | Path, what: str, required: tuple[str, ...]) -> dict[str, Any]:
-    """Read a JSON object holding ``required`` keys (ValueError naming the file otherwise)."""
-    path = Path(path)
-    if not path.is_file():
-        raise FileNotFoundError(f"{what} {path} not found")
-    try:
-        body = json.loads(path.read_text())
-    except json.JSONDecodeError as e:
-        raise ValueError(f"{what} {path} is not JSON: {e}") from e
-    missing = [k for k in required if not isinstance(body, dict) or k not in body]
-    if missing:
-        raise ValueError(f"{what} {path} lacks {missing}: is it the output of the right command?")
-    return body
 
 
 def _fit_cfg(report: dict[str, Any]) -> SandFitCfg:
@@ -196,7 +188,7 @@ def _all_pass(flags: list[bool | None]) -> bool | None:
 
 def _predicted(path: str, body: dict[str, Any], cfg: SummaryCfg) -> dict[str, bool | None]:
     """Fill ``predicted_vs_mpm_success`` from a prediction file; return the calibrated model's verdict per policy."""
-    doc = _read_json(path, "predicted success", ("predicted_vs_mpm_success", "within_15_points", "max_points"))
+    doc = read_json_object(path, "predicted success", ("predicted_vs_mpm_success", "within_15_points", "max_points"))
     if float(doc["max_points"]) != cfg.max_success_points:
         raise ValueError(
             f"predicted success {path} judges within {doc['max_points']} points, not {cfg.max_success_points}"
@@ -222,7 +214,7 @@ def build_summary(
     predicted: str | None = None,
 ) -> dict[str, Any]:
     """Compute the summary from fit reports (and their datasets, verdicts, predicted success), write it; return it."""
-    reports = {f: _read_json(f, "fit report", ("force_error_before", "force_error_after", "extensions",
+    reports = {f: read_json_object(f, "fit report", ("force_error_before", "force_error_after", "extensions",
                                                 "dataset_sha256", "accepted")) for f in fits}  # fmt: skip
     files = _datasets(reports, datasets)
     body: dict[str, Any] = {k: {} for k in SUMMARY_KEYS[:3]}
@@ -262,7 +254,7 @@ def build_summary(
             figures.append(str(_fig_force_depth(ds, models, out.parent / f"force_depth_{mat}.png")))
     body["term_verdicts"] = {}
     for v in verdicts:
-        table = _read_json(v, "verdicts", ("material", "terms", "published"))
+        table = read_json_object(v, "verdicts", ("material", "terms", "published"))
         body["term_verdicts"][table["material"]] = {t: {"verdict": r["verdict"], "reason": r["reason"]}
                                                     for t, r in table["terms"].items()}  # fmt: skip
         if cfg.figures:

@@ -17,8 +17,10 @@ pipeline's config schemas) imports without torch or rsl-rl.
 
 from __future__ import annotations
 
-import importlib
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING
+
+from gmloco.train.lazy_exports import lazy_exports
+from gmloco.train.teacher_student import config  # pure data: no torch, no rsl-rl
 
 if TYPE_CHECKING:
     from gmloco.train.teacher_student.config import (
@@ -48,26 +50,7 @@ if TYPE_CHECKING:
 
 _CONFIG = "gmloco.train.teacher_student.config"
 _EXPORTS: dict[str, str] = {
-    **dict.fromkeys(
-        (
-            "CRITIC_CLASS",
-            "DEFAULT_HISTORY_LENGTH",
-            "STUDENT_ACTOR_CLASS",
-            "STUDENT_PPO_CLASS",
-            "STUDENT_RUNNER_CLASS",
-            "TEACHER_ACTOR_CLASS",
-            "TEACHER_PPO_CLASS",
-            "DistillCfg",
-            "ObsGroupsCfg",
-            "PpoCfg",
-            "PpoOptimizer",
-            "PpoSchedule",
-            "StudentCfg",
-            "TeacherCfg",
-            "student_train_entries",
-        ),
-        _CONFIG,
-    ),
+    **dict.fromkeys(config.__all__, _CONFIG),
     "LinearRamp": "gmloco.train.teacher_student.curriculum",
     "DEFAULT_HELD_OUT": "gmloco.train.teacher_student.heldout",
     "HeldOutRegionCfg": "gmloco.train.teacher_student.heldout",
@@ -110,17 +93,4 @@ __all__ = [
 ]
 
 
-def __getattr__(name: str) -> Any:
-    """Import the module defining the public ``name`` on first access and cache the value in this module."""
-    module = _EXPORTS.get(name)
-    if module is None:
-        # AttributeError lets ``from gmloco.train.teacher_student import losses`` fall back to the submodule
-        raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
-    value = getattr(importlib.import_module(module), name)
-    globals()[name] = value
-    return value
-
-
-def __dir__() -> list[str]:
-    """List the module's attributes, including the not-yet-imported public names."""
-    return sorted({*globals(), *__all__})
+__getattr__, __dir__ = lazy_exports(globals(), _EXPORTS)
