@@ -38,6 +38,14 @@ def _parse() -> argparse.Namespace:
     p.add_argument("--iterations", type=int, default=40, help="PPO iterations per task")
     p.add_argument("--warmup", type=int, default=5, help="PPO iterations left out of the medians")
     p.add_argument("--sim-steps", type=int, default=400, help="physics substeps timed for the sim rate")
+    p.add_argument(
+        "--uniform-action-scale",
+        type=float,
+        default=None,
+        help="replace the task's joint-position action scale by this one value for every joint [rad] (A/B of the "
+        "action scale; default: the task's own)",
+    )
+    p.add_argument("--entropy-coef", type=float, default=None, help="replace the PPO entropy bonus (default: task's)")
     p.add_argument("--device", default="cuda:0")
     p.add_argument("--out", type=Path, default=Path("bench.json"))
     return p.parse_args()
@@ -65,8 +73,21 @@ def bench_sim(env: Any, steps: int) -> dict[str, float]:
     return {"sim_physics_steps_per_s": steps * env.num_envs / dt, "sim_s_per_substep": dt / steps}
 
 
-def bench_ppo(task: str, num_envs: int, iterations: int, warmup: int, sim_steps: int, device: str) -> dict[str, float]:
-    """Build the task's env and runner as mjlab's train script does, then time PPO iterations."""
+def bench_ppo(
+    task: str,
+    num_envs: int,
+    iterations: int,
+    warmup: int,
+    sim_steps: int,
+    device: str,
+    uniform_action_scale: float | None = None,
+    entropy_coef: float | None = None,
+) -> dict[str, Any]:
+    """Build the task's env and runner as mjlab's train script does, then time PPO iterations.
+
+    Besides the timers it records, per iteration, the learning rate the adaptive schedule left, the mean action
+    std and the mean episode reward (``curve``), so the schedule's behaviour compares across tasks.
+    """
     from mjlab.envs import ManagerBasedRlEnv
     from mjlab.rl import MjlabOnPolicyRunner, RslRlVecEnvWrapper
     from mjlab.tasks.registry import load_env_cfg, load_rl_cfg, load_runner_cls
@@ -75,6 +96,10 @@ def bench_ppo(task: str, num_envs: int, iterations: int, warmup: int, sim_steps:
     env_cfg.scene.num_envs = num_envs
     rl_cfg = load_rl_cfg(task)
     rl_cfg.logger = "tensorboard"
+    if uniform_action_scale is not None:
+        env_cfg.actions["joint_pos"].scale = uniform_action_scale  # type: ignore[attr-defined]
+    if entropy_coef is not None:
+        rl_cfg.algorithm.entropy_coef = entropy_coef
     t_build = time.perf_counter()
     env = ManagerBasedRlEnv(cfg=env_cfg, device=device)
     build_s = time.perf_counter() - t_build
@@ -86,12 +111,16 @@ def bench_ppo(task: str, num_envs: int, iterations: int, warmup: int, sim_steps:
     runner = runner_cls(wrapped, asdict(rl_cfg), log_dir, device)
     times: list[tuple[float, float]] = []
     rewards: list[float] = []
+    curve: dict[str, list[float]] = {"learning_rate": [], "action_std": [], "mean_reward": []}
     original_log = runner.logger.log
 
     def _log(*args: Any, **kwargs: Any) -> None:  # record rsl-rl's own collection/learning timers
         times.append((kwargs["collect_time"], kwargs["learn_time"]))
         if len(runner.logger.rewbuffer) > 0:
             rewards.append(statistics.mean(runner.logger.rewbuffer))
+        curve["learning_rate"].append(float(kwargs["learning_rate"]))
+        curve["action_std"].append(float(kwargs["action_std"].mean().item()))
+        curve["mean_reward"].append(rewards[-1] if rewards else float("nan"))
         original_log(*args, **kwargs)
 
     runner.logger.log = _log
@@ -115,6 +144,9 @@ def bench_ppo(task: str, num_envs: int, iterations: int, warmup: int, sim_steps:
         "ppo_collection_env_steps_per_s": steps_per_iter / collect,
         "ppo_mean_reward_last": rewards[-1] if rewards else float("nan"),
         "num_steps_per_env": rl_cfg.num_steps_per_env,
+        "uniform_action_scale": uniform_action_scale,
+        "entropy_coef": rl_cfg.algorithm.entropy_coef,
+        "curve": curve,
     }
 
 
@@ -142,7 +174,14 @@ def main() -> None:
     for task in args.tasks:
         print(f"[bench] {task}", flush=True)
         results["tasks"][task] = bench_ppo(  # type: ignore[index]
-            task, args.num_envs, args.iterations, args.warmup, args.sim_steps, args.device
+            task,
+            args.num_envs,
+            args.iterations,
+            args.warmup,
+            args.sim_steps,
+            args.device,
+            args.uniform_action_scale,
+            args.entropy_coef,
         )
         print(json.dumps(results["tasks"][task], indent=1), flush=True)  # type: ignore[index]
         args.out.parent.mkdir(parents=True, exist_ok=True)
