@@ -24,16 +24,16 @@ import sys
 import threading
 from collections.abc import Callable, Iterator
 from contextlib import contextmanager
-from dataclasses import fields
 from pathlib import Path
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING
 
-from omegaconf import DictConfig, OmegaConf
+from omegaconf import DictConfig
 
 if not __package__:  # run as ``python workflows/<name>.py``: the checkout root makes ``workflows`` importable
     sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
 from workflows.pipeline_report import say, stage_bar
+from workflows.section_cfg import section_as
 from workflows.stage_registry import StageIncompleteError
 
 if TYPE_CHECKING:
@@ -49,13 +49,8 @@ def eval_cfg(cfg: DictConfig) -> G1EvalCfg:
     """
     from gmloco.eval.g1.config import G1EvalCfg
 
-    section = OmegaConf.to_object(cfg.eval_mpm)
-    assert isinstance(section, G1EvalCfg)
-    values: dict[str, Any] = {f.name: getattr(section, f.name) for f in fields(G1EvalCfg)}
-    values = {k: tuple(v) if isinstance(v, list) else v for k, v in values.items()}
-    if values["device"] == "auto":
-        values["device"] = None
-    return G1EvalCfg(**values)
+    auto = cfg.eval_mpm.device == "auto"
+    return section_as(G1EvalCfg, cfg.eval_mpm, **({"device": None} if auto else {}))
 
 
 def _episodes_logged(log: Path) -> int:

@@ -18,6 +18,7 @@ from typing import Any
 from omegaconf import DictConfig, OmegaConf
 
 from workflows.pipeline_report import say, stage_bar
+from workflows.section_cfg import section_as
 from workflows.stage_registry import StageIncompleteError
 
 __all__ = [
@@ -134,19 +135,10 @@ def vanilla_ppo_overrides(section: DictConfig) -> dict[str, Any]:
 
 
 def teacher_cfg(section: DictConfig) -> Any:
-    """Return the ``TeacherCfg`` of the ``train_teacher`` section (VAE teacher)."""
+    """Return the ``TeacherCfg`` of the ``train_teacher`` section (VAE teacher; the section extends it)."""
     from gmloco.train.teacher_student import TeacherCfg
 
-    dims = tuple(int(d) for d in section.hidden_dims)
-    return TeacherCfg(
-        actor_hidden_dims=dims,
-        critic_hidden_dims=dims,
-        encoder_hidden_dims=tuple(int(d) for d in section.encoder_hidden_dims),
-        latent_dim=int(section.latent_dim),
-        kl_weight=float(section.kl_weight),
-        decoder_learning_rate=None if section.decoder_learning_rate is None else float(section.decoder_learning_rate),
-        ppo=ppo_cfg(section),
-    )
+    return section_as(TeacherCfg, section)
 
 
 def distill_overrides(cfg: DictConfig) -> dict[str, Any]:

@@ -3,11 +3,12 @@
 
 Each ``conf/<group>/*.yaml`` extends its schema through its defaults list (``- base_<group>``), so a typo in
 an override or a YAML file fails at composition with the key's name. Where a package dataclass is the config it is
-used as it is: the PPO settings (``gmloco.train.teacher_student.PpoCfg``), the distillation
-(``teacher_student.DistillCfg``), the training material (``gmloco.train.MaterialRangeCfg``) and the MPM evaluation
-(``gmloco.eval.g1.config.G1EvalCfg``) are extended with the stage's fields and defaults, not copied. The train
-stage's task and network fields are still read one by one into ``GranularTaskCfg`` / ``TeacherCfg``
-(``policy_training.py``), whose ``Literal`` fields OmegaConf cannot hold.
+used as it is: the PPO settings (``gmloco.train.teacher_student.PpoCfg``), the teacher's networks and losses
+(``teacher_student.TeacherCfg``), the distillation (``teacher_student.DistillCfg``), the training material
+(``gmloco.train.MaterialRangeCfg``) and the MPM evaluation (``gmloco.eval.g1.config.G1EvalCfg``) are extended with
+the stage's fields and defaults, not copied; a stage turns its section back into the package dataclass with
+``workflows.section_cfg.section_as``. The train stage's task fields are still read one by one into
+``GranularTaskCfg`` (``policy_training.py``), whose ``Literal`` fields OmegaConf cannot hold.
 """
 
 from __future__ import annotations
@@ -23,7 +24,7 @@ from omegaconf import MISSING, DictConfig, OmegaConf
 from gmloco.eval.g1.config import G1EvalCfg, Scenario
 from gmloco.train.config import MaterialRangeCfg
 from gmloco.train.teacher_student.config import DistillCfg as DistillAlgorithmCfg
-from gmloco.train.teacher_student.config import PpoCfg
+from gmloco.train.teacher_student.config import PpoCfg, TeacherCfg
 from workflows.config_ranges import each, ranged
 from workflows.stage_registry import stage_names
 
@@ -202,8 +203,12 @@ class PolicyTrainingCfg(StageCfg):
 
 
 @dataclass
-class TrainTeacherCfg(PolicyTrainingCfg):
-    """Train stage: vanilla PPO or the GM-Loco VAE teacher on mjlab with a granular contact model (issues 4, 6)."""
+class TrainTeacherCfg(TeacherCfg, PolicyTrainingCfg):
+    """Train stage: vanilla PPO or the GM-Loco VAE teacher on mjlab with a granular contact model (issues 4, 6).
+
+    The stage's training fields plus the package's ``gmloco.train.teacher_student.TeacherCfg`` (networks, VAE
+    encoder and decoder, loss weights, the PPO settings), all at ``train_teacher.<field>``.
+    """
 
     out_dir: str = _interp("${run_dir}/train_teacher")
     algorithm: TrainAlgorithm = TrainAlgorithm.vae_teacher
@@ -220,18 +225,15 @@ class TrainTeacherCfg(PolicyTrainingCfg):
     foot_clearance: FootClearanceForm = FootClearanceForm.penalty
     """Swing-height term: the project page's L2 penalty or the public code's exp reward (pays standing still)."""
     hidden_dims: list[int] = field(default_factory=lambda: [512, 256, 128], metadata=each(integer=True, ge=1))
-    """Actor and critic MLP widths (GM-Loco: 512, 256, 128)."""
-    latent_dim: int = ranged(16, ge=1)
-    """Terrain latent size z of the VAE teacher (ours; the paper does not give it)."""
-    kl_weight: float = ranged(1.0e-4, ge=0)
-    """beta, weight of the teacher's KL term (ours; see ``TeacherCfg.kl_weight``)."""
-    decoder_learning_rate: float | None = ranged(1.0e-3, gt=0)
-    """Fixed Adam learning rate of the teacher's eta decoder (null: the adaptive rate; the encoder always follows it)."""
+    """Actor and critic MLP widths (``gmloco.train.TrainRunCfg.hidden_dims``; GM-Loco: 512, 256, 128); the VAE
+    teacher's ``actor_hidden_dims`` and ``critic_hidden_dims`` follow it unless set."""
+    actor_hidden_dims: tuple[int, ...] = field(default=_interp("${.hidden_dims}"), metadata=each(integer=True, ge=1))
+    """VAE teacher's actor MLP widths (``TeacherCfg.actor_hidden_dims``); default: ``hidden_dims``."""
+    critic_hidden_dims: tuple[int, ...] = field(default=_interp("${.hidden_dims}"), metadata=each(integer=True, ge=1))
+    """VAE teacher's critic MLP widths (``TeacherCfg.critic_hidden_dims``); default: ``hidden_dims``."""
     warm_start_ppo: str | None = None
     """vae_teacher: a vanilla-PPO checkpoint of the same task (e.g. ``artifacts/ppo_rft3d/checkpoint.pt``) whose
     actor and critic start a fresh teacher run; null: from scratch."""
-    encoder_hidden_dims: list[int] = field(default_factory=lambda: [256, 128, 64], metadata=each(integer=True, ge=1))
-    """Teacher terrain encoder widths (paper)."""
     history_length: int = ranged(50, ge=1)
     """N, frames of the ``history`` group the teacher encoder reads (the student reads the same N)."""
     jump: JumpSectionCfg | None = None

@@ -122,3 +122,51 @@ def test_gpus_reach_the_run(compose: Callable[..., DictConfig], monkeypatch: pyt
     for gpus in ("[0,1]", "[]"):
         train_teacher.run(compose("+exp=gm_loco", f"run_dir={tmp_path}", f"train_teacher.gpus={gpus}"))
     assert seen[0].gpus == (0, 1) and seen[1].gpus == ()
+
+
+def test_teacher_section_is_the_package_teacher_cfg(compose: Callable[..., DictConfig]) -> None:
+    """Without overrides ``train_teacher`` holds ``TeacherCfg()``, as tuples; ``hidden_dims`` sets both MLPs."""
+    from gmloco.train.teacher_student import TeacherCfg
+    from workflows.policy_training import teacher_cfg
+
+    assert teacher_cfg(compose("+exp=gm_loco").train_teacher) == TeacherCfg()
+    teacher = teacher_cfg(compose("+exp=gm_loco", "train_teacher.hidden_dims=[64,32]").train_teacher)
+    assert teacher.actor_hidden_dims == teacher.critic_hidden_dims == (64, 32)
+    teacher = teacher_cfg(compose("+exp=gm_loco", "train_teacher.critic_hidden_dims=[256,128]").train_teacher)
+    assert teacher.actor_hidden_dims == (512, 256, 128) and teacher.critic_hidden_dims == (256, 128)
+
+
+def test_every_teacher_field_reaches_the_actor_and_teacher_ppo(
+    compose: Callable[..., DictConfig], monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """Networks, latent and loss weights set at ``train_teacher.<field>`` arrive in the rsl-rl entries."""
+    seen = _captured(monkeypatch)
+    cfg = compose(
+        "+exp=gm_loco",
+        "train_teacher.encoder_hidden_dims=[64,32]",
+        "train_teacher.decoder_hidden_dims=[32,64]",
+        "train_teacher.latent_dim=8",
+        "train_teacher.actor_latent=sample",
+        "train_teacher.reconstruction_weight=2.0",
+    )
+    train_teacher.run(cfg)
+    actor, algorithm = seen["rsl_rl_overrides"]["actor"], seen["rsl_rl_overrides"]["algorithm"]
+    assert actor["encoder_hidden_dims"] == (64, 32) and actor["decoder_hidden_dims"] == (32, 64)
+    assert actor["latent_dim"] == 8 and actor["actor_latent"] == "sample" and type(actor["actor_latent"]) is str
+    assert algorithm["reconstruction_weight"] == 2.0
+
+
+@pytest.mark.parametrize(
+    ("override", "key"),
+    [
+        ("train_teacher.latent_dim=0", "train_teacher.latent_dim"),
+        ("train_teacher.kl_weight=-1", "train_teacher.kl_weight"),
+    ],
+)
+def test_teacher_fields_keep_their_ranges(compose: Callable[..., DictConfig], override: str, key: str) -> None:
+    """The package's bounds on the teacher's fields are checked at composition, naming the key."""
+    from workflows.config_errors import ConfigInputError
+
+    with pytest.raises(ConfigInputError) as info:
+        compose("+exp=gm_loco", override)
+    assert info.value.key == key

@@ -15,7 +15,6 @@ from __future__ import annotations
 
 from dataclasses import asdict, dataclass, field
 from enum import Enum, StrEnum
-from typing import Literal
 
 __all__ = [
     "CRITIC_CLASS",
@@ -25,6 +24,7 @@ __all__ = [
     "STUDENT_RUNNER_CLASS",
     "TEACHER_ACTOR_CLASS",
     "TEACHER_PPO_CLASS",
+    "ActorLatent",
     "DistillCfg",
     "ObsGroupsCfg",
     "PpoCfg",
@@ -59,6 +59,15 @@ class PpoSchedule(StrEnum):
     """Scale the rate so that the policy KL per update stays near ``desired_kl``."""
     fixed = "fixed"
     """Keep ``learning_rate``."""
+
+
+class ActorLatent(StrEnum):
+    """Latent the teacher's actor reads."""
+
+    mean = "mean"
+    """mu of q(z | .): deterministic in z, so the PPO ratio is exact (ours)."""
+    sample = "sample"
+    """A reparameterised sample of q(z | .)."""
 
 
 class PpoOptimizer(StrEnum):
@@ -155,33 +164,33 @@ def _ppo_kwargs(ppo: PpoCfg, class_name: str) -> dict:
 class TeacherCfg:
     """GM-Loco teacher: actor/critic MLPs, VAE terrain encoder, eta decoder, PPO + VAE loss."""
 
-    actor_hidden_dims: tuple[int, ...] = (512, 256, 128)
+    actor_hidden_dims: tuple[int, ...] = field(default=(512, 256, 128), metadata={"ge": 1, "integer": True})
     """Actor MLP hidden widths (paper)."""
-    critic_hidden_dims: tuple[int, ...] = (512, 256, 128)
+    critic_hidden_dims: tuple[int, ...] = field(default=(512, 256, 128), metadata={"ge": 1, "integer": True})
     """Critic MLP hidden widths (paper)."""
     activation: str = "elu"
     """Activation of every network (paper: ELU)."""
-    encoder_hidden_dims: tuple[int, ...] = (256, 128, 64)
+    encoder_hidden_dims: tuple[int, ...] = field(default=(256, 128, 64), metadata={"ge": 1, "integer": True})
     """Terrain encoder MLP widths (paper); linear mu / log-variance heads follow."""
-    decoder_hidden_dims: tuple[int, ...] = (64, 128, 256)
+    decoder_hidden_dims: tuple[int, ...] = field(default=(64, 128, 256), metadata={"ge": 1, "integer": True})
     """Stiffness decoder MLP widths (paper); output is eta, shape ``[num_envs, 1]``."""
-    latent_dim: int = 16
+    latent_dim: int = field(default=16, metadata={"ge": 1})
     """Size of the terrain latent z (ours; not given by the paper)."""
-    encoder_history_steps: int | None = None
+    encoder_history_steps: int | None = field(default=None, metadata={"ge": 1, "integer": True})
     """Newest history frames fed to the encoder (None: all N)."""
     obs_normalization: bool = True
     """Running mean/std normalization of o_t, the encoder input and the critic input."""
-    init_std: float = 1.0
+    init_std: float = field(default=1.0, metadata={"gt": 0})
     """Initial action std [normalized action units]."""
-    actor_latent: Literal["mean", "sample"] = "mean"
+    actor_latent: ActorLatent = ActorLatent.mean
     """Latent fed to the actor: mu (exact PPO ratio; ours) or a reparameterised sample."""
-    kl_weight: float = 1e-4
+    kl_weight: float = field(default=1e-4, metadata={"ge": 0})
     """beta, weight of KL(q(z|.) || N(0, I)) (ours; small to avoid posterior collapse: eta's spread over the DR is
     ~0.09, so encoding it to 0.01 costs ~2 nats of KL against ~0.008 of squared error; at 1e-3 the two nearly
     cancel and the first teacher run's decoder stayed at the mean, R^2 < 0)."""
-    reconstruction_weight: float = 1.0
+    reconstruction_weight: float = field(default=1.0, metadata={"ge": 0})
     """Weight of (eta - psi(z))^2 (paper: 1)."""
-    decoder_learning_rate: float | None = 1e-3
+    decoder_learning_rate: float | None = field(default=1e-3, metadata={"gt": 0})
     """Fixed Adam learning rate of the eta decoder (ours; None: the policy's KL-adaptive rate). The decoder is off
     the action path, so a fixed rate cannot move the policy. The encoder is on it (z feeds the actor) and always
     follows the adaptive rate: at a fixed 1e-3 it alone moved the G1 teacher's policy 40-70x past the KL target
@@ -204,7 +213,7 @@ class TeacherCfg:
             "latent_dim": self.latent_dim,
             "encoder_history_steps": self.encoder_history_steps,
             "encoder_obs_normalization": self.obs_normalization,
-            "actor_latent": self.actor_latent,
+            "actor_latent": str(self.actor_latent),
         }
 
     def critic_dict(self) -> dict:
