@@ -144,19 +144,15 @@ def teacher_cfg(section: DictConfig) -> Any:
 def distill_overrides(cfg: DictConfig) -> dict[str, Any]:
     """Return the student's rsl-rl entries (actor, critic, frozen teacher, StudentPPO, obs groups).
 
-    The ``distill`` section is a ``teacher_student.DistillCfg`` (its schema extends the package's dataclass), so
-    its loss weights, curriculum and PPO settings reach ``student_train_entries`` as composed.
+    The ``distill`` section is a ``teacher_student.DistillCfg`` and a ``StudentCfg`` (its schema extends both
+    package dataclasses), so its loss weights, curriculum, PPO settings and TCN reach ``student_train_entries`` as
+    composed.
     """
     from gmloco.train.teacher_student import DistillCfg, StudentCfg, student_train_entries
 
     teacher = teacher_cfg(cfg.train_teacher)
-    student = StudentCfg(
-        actor_hidden_dims=teacher.actor_hidden_dims,
-        history_length=int(cfg.train_teacher.history_length),
-        tcn_channels=tuple(int(c) for c in cfg.distill.tcn_channels),  # type: ignore[arg-type]
-    )
-    distill = OmegaConf.to_object(cfg.distill)
-    assert isinstance(distill, DistillCfg)
+    student = section_as(StudentCfg, cfg.distill)
+    distill = section_as(DistillCfg, cfg.distill)
     return student_train_entries(teacher, student, distill)
 
 

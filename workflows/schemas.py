@@ -4,9 +4,9 @@
 Each ``conf/<group>/*.yaml`` extends its schema through its defaults list (``- base_<group>``), so a typo in
 an override or a YAML file fails at composition with the key's name. Where a package dataclass is the config it is
 used as it is: the PPO settings (``gmloco.train.teacher_student.PpoCfg``), the teacher's networks and losses
-(``teacher_student.TeacherCfg``), the distillation (``teacher_student.DistillCfg``), the training material
-(``gmloco.train.MaterialRangeCfg``) and the MPM evaluation (``gmloco.eval.g1.config.G1EvalCfg``) are extended with
-the stage's fields and defaults, not copied; a stage turns its section back into the package dataclass with
+(``teacher_student.TeacherCfg``), the distillation and the student (``teacher_student.DistillCfg``,
+``StudentCfg``), the training material (``gmloco.train.MaterialRangeCfg``) and the MPM evaluation
+(``gmloco.eval.g1.config.G1EvalCfg``) are extended with the stage's fields and defaults, not copied; a stage turns its section back into the package dataclass with
 ``workflows.section_cfg.section_as``. The train stage's task fields are still read one by one into
 ``GranularTaskCfg`` (``policy_training.py``), whose ``Literal`` fields OmegaConf cannot hold.
 """
@@ -24,7 +24,7 @@ from omegaconf import MISSING, DictConfig, OmegaConf
 from gmloco.eval.g1.config import G1EvalCfg, Scenario
 from gmloco.train.config import MaterialRangeCfg
 from gmloco.train.teacher_student.config import DistillCfg as DistillAlgorithmCfg
-from gmloco.train.teacher_student.config import PpoCfg, TeacherCfg
+from gmloco.train.teacher_student.config import PpoCfg, StudentCfg, TeacherCfg
 from workflows.config_ranges import each, ranged
 from workflows.stage_registry import stage_names
 
@@ -247,19 +247,25 @@ class TrainTeacherCfg(TeacherCfg, PolicyTrainingCfg):
 
 
 @dataclass
-class DistillCfg(DistillAlgorithmCfg, PolicyTrainingCfg):
+class DistillCfg(StudentCfg, DistillAlgorithmCfg, PolicyTrainingCfg):
     """TCN student distilled from the teacher with DAgger + PPO (issue 6).
 
     The stage's training fields plus the package's ``gmloco.train.teacher_student.DistillCfg`` (loss weights, their
-    curriculum, the teacher checkpoint and the PPO settings), all at ``distill.<field>``.
+    curriculum, the teacher checkpoint and the PPO settings) and ``teacher_student.StudentCfg`` (the TCN history
+    encoder and the actor), all at ``distill.<field>``.
     """
 
     out_dir: str = _interp("${run_dir}/distill")
     teacher_dir: str = _interp("${train_teacher.out_dir}")
     """Folder holding the teacher checkpoint (newest ``model_<it>.pt``), unless ``teacher_checkpoint`` names one."""
     max_iterations: int = ranged(2000, ge=1)
-    tcn_channels: list[int] = field(default_factory=lambda: [32, 32, 32], metadata=each(integer=True, ge=1))
-    """Output channels of the student's three 1-D convolutions (``StudentCfg.tcn_channels``, ours)."""
+    actor_hidden_dims: tuple[int, ...] = field(
+        default=_interp("${train_teacher.actor_hidden_dims}"), metadata=each(integer=True, ge=1)
+    )
+    """Student actor MLP widths (``StudentCfg.actor_hidden_dims``); the teacher's, so the student starts from its
+    actor."""
+    history_length: int = ranged(_interp("${train_teacher.history_length}"), integer=True, ge=1)
+    """N, history frames the TCN reads (``StudentCfg.history_length``); the teacher encoder's N."""
 
 
 @dataclass

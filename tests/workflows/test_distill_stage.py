@@ -67,3 +67,30 @@ def test_vanilla_ppo_settings_reach_the_algorithm(
     algorithm = seen["rsl_rl_overrides"]["algorithm"]
     assert algorithm["value_loss_coef"] == 0.5 and algorithm["lam"] == 0.9
     assert algorithm["schedule"] == "adaptive" and type(algorithm["optimizer"]) is str
+
+
+def test_student_fields_reach_the_student_actor(
+    compose: Callable[..., DictConfig], monkeypatch: pytest.MonkeyPatch, tmp_path: Path
+) -> None:
+    """``distill.tcn_channels`` and the other ``StudentCfg`` fields arrive in the student actor's cfg."""
+    seen = _captured(monkeypatch, distill)
+    cfg = compose(
+        "+exp=gm_loco",
+        "distill.tcn_channels=[16,16,8]",
+        "distill.tcn_mlp_hidden_dims=[64]",
+        f"distill.teacher_checkpoint={tmp_path / 'teacher.pt'}",
+    )
+    distill.run(cfg)
+    actor = seen["rsl_rl_overrides"]["actor"]
+    assert actor["tcn_channels"] == (16, 16, 8) and actor["tcn_mlp_hidden_dims"] == (64,)
+
+
+def test_student_defaults_follow_the_teacher(compose: Callable[..., DictConfig]) -> None:
+    """Without overrides the student is ``StudentCfg()`` with the teacher's actor widths and history length N."""
+    from gmloco.train.teacher_student import StudentCfg
+    from workflows.section_cfg import section_as
+
+    assert section_as(StudentCfg, compose("+exp=gm_loco").distill) == StudentCfg()
+    cfg = compose("+exp=gm_loco", "train_teacher.hidden_dims=[64,32]", "train_teacher.history_length=20")
+    student = section_as(StudentCfg, cfg.distill)
+    assert student.actor_hidden_dims == (64, 32) and student.history_length == 20

@@ -247,19 +247,19 @@ class TeacherCfg:
 class StudentCfg:
     """GM-Loco student: temporal-convolution history encoder and an actor over ``[o_t, z_hat]``."""
 
-    actor_hidden_dims: tuple[int, ...] = (512, 256, 128)
+    actor_hidden_dims: tuple[int, ...] = field(default=(512, 256, 128), metadata={"ge": 1, "integer": True})
     """Actor MLP widths; equal to the teacher's so distillation can start from the teacher's actor."""
-    history_length: int = DEFAULT_HISTORY_LENGTH
+    history_length: int = field(default=DEFAULT_HISTORY_LENGTH, metadata={"ge": 1})
     """N, history frames (ours: 50 = 1.0 s at the 50 Hz policy rate)."""
-    history_term_dims: tuple[int, ...] | None = None
+    history_term_dims: tuple[int, ...] | None = field(default=None, metadata={"ge": 1, "integer": True})
     """Per-term frame sizes when the history group is flattened (mjlab term-major), else None."""
-    tcn_channels: tuple[int, int, int] = (32, 32, 32)
+    tcn_channels: tuple[int, int, int] = field(default=(32, 32, 32), metadata={"ge": 1, "integer": True})
     """Output channels of the three 1-D convolutions (ours)."""
-    tcn_kernel_sizes: tuple[int, int, int] = (8, 5, 5)
+    tcn_kernel_sizes: tuple[int, int, int] = field(default=(8, 5, 5), metadata={"ge": 1, "integer": True})
     """Kernel sizes [frames] (ours; N = 50 -> 11 -> 7 -> 3 frames)."""
-    tcn_strides: tuple[int, int, int] = (4, 1, 1)
+    tcn_strides: tuple[int, int, int] = field(default=(4, 1, 1), metadata={"ge": 1, "integer": True})
     """Strides [frames] (ours)."""
-    tcn_mlp_hidden_dims: tuple[int, ...] = (128,)
+    tcn_mlp_hidden_dims: tuple[int, ...] = field(default=(128,), metadata={"ge": 1, "integer": True})
     """Hidden widths of the MLP after the convolutions (ours)."""
     obs_normalization: bool = True
     """Running normalization of o_t (starts from the teacher's statistics)."""
