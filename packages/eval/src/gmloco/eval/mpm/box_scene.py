@@ -83,8 +83,8 @@ class MpmSolverCfg:
     max_iterations: int = field(default=50, metadata={"ge": 1})
     """Rheology solver iterations per step. Without a CUDA graph Newton runs ``max_iterations // 25`` batches of 25
     Gauss-Seidel sweeps, so fewer than 25 means *no* solve at all: no collider acts (issue 5's zero plate force)."""
-    tolerance: float = 1.0e-4
-    """Rheology solver tolerance."""
+    tolerance: float = field(default=1.0e-4, metadata={"gt": 0})
+    """Rheology residual at which a frame's solve stops."""
     grid_type: GridType = GridType.sparse
     """Grid type; ``"fixed"`` allows CUDA graph capture (set ``max_active_cell_count``). Caution: in the box scene
     on CPU, ``"fixed"`` (padding 0 or 4) missed the box's impact and then launched it upwards; use ``"sparse"``."""
