@@ -24,8 +24,10 @@ from __future__ import annotations
 
 import copy
 import csv
+import dataclasses
 import hashlib
 import io
+import json
 import sys
 import time
 from collections.abc import Sequence
@@ -49,6 +51,7 @@ from workflows.run_dir import (
     write_git_state,
 )
 from workflows.schemas import REPO_ROOT
+from workflows.section_cfg import field_values, section_as
 from workflows.stage_runner import PipelineConfigError, resolve_device
 
 __all__ = ["Arm", "main", "markdown_table", "run_ablation", "table_rows"]
@@ -148,18 +151,25 @@ def train_arm(exp: str, root: Path, overrides: Sequence[str], deadline: float | 
 # Evaluation.
 
 
-def eval_settings(cfg: DictConfig) -> dict[str, Any]:
-    """What ``evaluate_policy`` is given besides the policy (smoke scale shortens it)."""
+def eval_cells(cfg: DictConfig) -> Any:
+    """The ``MaterialCellsCfg`` every policy is scored on (smoke scale: the ``smoke_*`` sizes)."""
+    from gmloco.train.evaluation_cells import MaterialCellsCfg
+
     ab = cfg.ablation
     smoke = str(getattr(cfg.scale, "value", cfg.scale)) == "smoke"
+    sizes = {"repeats": int(ab.smoke_repeats), "duration_s": float(ab.smoke_duration_s)} if smoke else {}
+    return section_as(MaterialCellsCfg, ab, **sizes)
+
+
+def eval_settings(cfg: DictConfig) -> dict[str, Any]:
+    """What ``evaluate_policy`` is given besides the policy, as JSON values (smoke scale shortens it)."""
+    ab = cfg.ablation
     model = ab.eval_contact_model
+    cells = json.loads(json.dumps(dataclasses.asdict(eval_cells(cfg))))
     return {
         "contact_model": None if model is None else str(getattr(model, "value", model)),
         "terrain": str(getattr(ab.terrain, "value", ab.terrain)),
-        "materials": [str(m) for m in ab.materials],
-        "speeds": [float(s) for s in ab.speeds],
-        "repeats": int(ab.smoke_repeats if smoke else ab.repeats),
-        "duration_s": float(ab.smoke_duration_s if smoke else ab.duration_s),
+        **cells,
         "seed": int(cfg.seed),
     }
 
@@ -177,14 +187,14 @@ def evaluate_arm(cfg: DictConfig, arm: Arm, root: Path) -> Arm:
     from gmloco.train import EvalCfg, evaluate_policy
 
     assert arm.policy is not None
-    ev = {k: v for k, v in settings.items() if k not in ("materials", "speeds")}
     metrics = evaluate_policy(
         EvalCfg(
+            **field_values(eval_cells(cfg)),
             policy_path=arm.policy,
-            materials=tuple(settings["materials"]),
-            speeds=tuple(settings["speeds"]),
+            contact_model=settings["contact_model"],
+            terrain=settings["terrain"],
+            seed=settings["seed"],
             device=torch_device(str(cfg.device)),
-            **ev,
         )
     )
     atomic_write_json(out, {"policy": arm.policy, "sha256": arm.sha256, "settings": settings, "metrics": metrics})

@@ -5,10 +5,12 @@ Each ``conf/<group>/*.yaml`` extends its schema through its defaults list (``- b
 an override or a YAML file fails at composition with the key's name. Where a package dataclass is the config it is
 used as it is: the PPO settings (``gmloco.train.teacher_student.PpoCfg``), the teacher's networks and losses
 (``teacher_student.TeacherCfg``), the distillation and the student (``teacher_student.DistillCfg``,
-``StudentCfg``), the training material (``gmloco.train.MaterialRangeCfg``) and the MPM evaluation
-(``gmloco.eval.g1.config.G1EvalCfg``) are extended with the stage's fields and defaults, not copied; a stage turns its section back into the package dataclass with
-``workflows.section_cfg.section_as``. The train stage's task fields are still read one by one into
-``GranularTaskCfg`` (``policy_training.py``), whose ``Literal`` fields OmegaConf cannot hold.
+``StudentCfg``), the training material (``gmloco.train.MaterialRangeCfg``), the MPM evaluation
+(``gmloco.eval.g1.config.G1EvalCfg``) and the sweep's and ablation's evaluation cells
+(``gmloco.train.evaluation_cells.MaterialCellsCfg``) are extended with the stage's fields and defaults, not copied;
+a stage turns its section back into the package dataclass with ``workflows.section_cfg.section_as``. The train
+stage's task fields are still read one by one into ``GranularTaskCfg`` (``policy_training.py``), whose ``Literal``
+fields OmegaConf cannot hold.
 """
 
 from __future__ import annotations
@@ -23,6 +25,7 @@ from omegaconf import MISSING, DictConfig, OmegaConf
 
 from gmloco.eval.g1.config import G1EvalCfg, Scenario
 from gmloco.train.config import MaterialRangeCfg
+from gmloco.train.evaluation_cells import MaterialCellsCfg
 from gmloco.train.teacher_student.config import DistillCfg as DistillAlgorithmCfg
 from gmloco.train.teacher_student.config import PpoCfg, StudentCfg, TeacherCfg
 from workflows.config_ranges import each, ranged
@@ -36,6 +39,7 @@ __all__ = [
     "DistillCfg",
     "EvalMpmCfg",
     "ExportCfg",
+    "GranularEvalCfg",
     "JumpMotion",
     "JumpSectionCfg",
     "MismatchCfg",
@@ -352,21 +356,24 @@ class MismatchCfg(StageCfg):
 
 
 @dataclass
-class SweepEvalCfg:
-    """Evaluation of a trial's exported policy in the granular training simulator (``gmloco.train.EvalCfg``)."""
+class GranularEvalCfg(MaterialCellsCfg):
+    """Evaluation of an exported policy in the granular training simulator (``gmloco.train.evaluate_policy``).
 
-    materials: list[str] = field(default_factory=lambda: ["dry_sand", "poppy_seed"])
-    """Material presets (``gmloco.contact.MATERIAL_PRESETS``), fixed for every trial."""
-    speeds: list[float] = field(default_factory=lambda: [1.0], metadata=each(gt=0))
-    """Commanded forward speeds [m/s]."""
+    The package's ``gmloco.train.evaluation_cells.MaterialCellsCfg`` (materials, speeds, repeats, episode duration,
+    failure rules and floor of ``gmloco.train.EvalCfg``) with the pipeline's defaults and its smoke-scale sizes.
+    """
+
     repeats: int = ranged(4, ge=1)
     """Envs per (material, speed) cell."""
-    duration_s: float = ranged(10.0, gt=0)
-    """Episode duration that counts as success [s]."""
     smoke_repeats: int = ranged(1, ge=1)
     """``repeats`` at smoke scale."""
     smoke_duration_s: float = ranged(0.5, gt=0)
     """``duration_s`` at smoke scale [s]."""
+
+
+@dataclass
+class SweepEvalCfg(GranularEvalCfg):
+    """Evaluation of a trial's exported policy (``sweep.eval``), fixed for every trial of a study."""
 
 
 @dataclass
@@ -430,9 +437,14 @@ class AblationSource(str, Enum):
 
 
 @dataclass
-class AblationCfg:
-    """Contact-model ablation of vanilla PPO policies (``workflows/ablation.py``; ``docs/sweeps.md``)."""
+class AblationCfg(GranularEvalCfg):
+    """Contact-model ablation of vanilla PPO policies (``workflows/ablation.py``; ``docs/sweeps.md``).
 
+    Every policy is scored by the same evaluation: the ``GranularEvalCfg`` fields at ``ablation.<field>``.
+    """
+
+    speeds: tuple[float, ...] = field(default=(0.5, 1.0), metadata=each(gt=0))
+    """Commanded forward speeds [m/s]."""
     exps: list[str] = field(default_factory=lambda: ["ppo_rft3d", "ppo_heuristic_rft", "ppo_cone_multi", "ppo_rigid"])
     """Experiments compared (``conf/exp/<name>.yaml``)."""
     source: AblationSource = AblationSource.artifacts
@@ -443,18 +455,6 @@ class AblationCfg:
     """Contact model of the simulator every policy is evaluated in (one ground for all); None: each policy's own."""
     terrain: TerrainName = TerrainName.flat
     """Sand terrain of the evaluation."""
-    materials: list[str] = field(default_factory=lambda: ["dry_sand", "poppy_seed"])
-    """Material presets (``gmloco.contact.MATERIAL_PRESETS``)."""
-    speeds: list[float] = field(default_factory=lambda: [0.5, 1.0], metadata=each(gt=0))
-    """Commanded forward speeds [m/s]."""
-    repeats: int = ranged(4, ge=1)
-    """Envs per (material, speed) cell."""
-    duration_s: float = ranged(10.0, gt=0)
-    """Episode duration that counts as success [s]."""
-    smoke_repeats: int = ranged(1, ge=1)
-    """``repeats`` at smoke scale."""
-    smoke_duration_s: float = ranged(0.5, gt=0)
-    """``duration_s`` at smoke scale [s]."""
 
 
 @dataclass

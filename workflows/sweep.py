@@ -51,6 +51,7 @@ from workflows.run_dir import (
     write_git_state,
 )
 from workflows.schemas import REPO_ROOT
+from workflows.section_cfg import field_values, section_as
 from workflows.stage_registry import StageSpec
 from workflows.stage_runner import PipelineConfigError, resolve_device
 from workflows.sweep_storage import SweepStorage, parse_storage
@@ -241,18 +242,16 @@ class Objective:
     def _evaluate(self, cfg: DictConfig, iteration: int) -> dict[str, float]:
         """Roll out the chunk's exported ``policy.onnx`` on the fixed materials of ``sweep.eval``."""
         from gmloco.train import EvalCfg, evaluate_policy
+        from gmloco.train.evaluation_cells import MaterialCellsCfg
         from workflows.policy_training import torch_device
 
-        section, ev = cfg.train_teacher, cfg.sweep.eval
-        out = Path(section.out_dir)
+        section, out = cfg.train_teacher, Path(cfg.train_teacher.out_dir)
+        cells = section_as(MaterialCellsCfg, cfg.sweep.eval)
         return evaluate_policy(
             EvalCfg(
+                **field_values(cells),
                 policy_path=str(out / "policy.onnx"),
                 terrain=str(section.terrain.value),  # type: ignore[arg-type]
-                materials=tuple(str(m) for m in ev.materials),
-                speeds=tuple(float(s) for s in ev.speeds),
-                repeats=int(ev.repeats),
-                duration_s=float(ev.duration_s),
                 device=torch_device(str(cfg.device)),
                 seed=int(cfg.seed),
                 out_path=str(out / "eval" / f"iteration_{iteration}.json"),

@@ -236,3 +236,16 @@ def test_without_matplotlib_the_tables_are_written_and_the_figure_is_named_missi
     summary = ablation.run_ablation(_cfg(compose, tmp_path, artifacts), arm_overrides=[])
     assert summary["exit_code"] == 0 and summary["figure"].startswith("not drawn: matplotlib is not installed")
     assert (tmp_path / "ablation.md").is_file() and not (tmp_path / "figures" / "ablation.png").exists()
+
+
+def test_eval_cells_are_the_package_material_cells(compose: Callable[..., DictConfig], tmp_path: Path) -> None:
+    """``ablation.<field>`` of ``MaterialCellsCfg`` (failure rules and floor too) reaches the evaluation and its key."""
+    from gmloco.train.evaluation_cells import MaterialCellsCfg
+
+    cfg = _cfg(compose, tmp_path, tmp_path, "ablation.max_tilt=0.5", "ablation.floor.depth_range=[0.2,0.2]")
+    cells = ablation.eval_cells(cfg)
+    assert isinstance(cells, MaterialCellsCfg) and cells.max_tilt == 0.5 and cells.floor.depth_range == (0.2, 0.2)
+    assert (cells.repeats, cells.duration_s, cells.speeds) == (1, 0.5, (0.5, 1.0))  # smoke sizes
+    settings = ablation.eval_settings(cfg)
+    assert settings["max_tilt"] == 0.5 and settings["floor"]["depth_range"] == [0.2, 0.2]
+    assert settings["contact_model"] == "rft3d" and settings["materials"] == ["dry_sand", "poppy_seed"]

@@ -13,42 +13,22 @@ MCAP log schema (:mod:`gmloco.train.recording`), one file per cell, until it fai
 from __future__ import annotations
 
 import json
-import math
-from dataclasses import dataclass, field, replace
+from dataclasses import dataclass, replace
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 import torch
 
-from gmloco.train.config import ContactModelName, SandFloorCfg, TerrainName
+from gmloco.train.config import ContactModelName, TerrainName
+from gmloco.train.evaluation_cells import MaterialCellsCfg, RolloutCriteriaCfg
 from gmloco.train.mdp.commands import hold_twist
 
-__all__ = ["EvalCfg", "RolloutCriteriaCfg", "evaluate_policy"]
+__all__ = ["EvalCfg", "MaterialCellsCfg", "RolloutCriteriaCfg", "evaluate_policy"]
 
 
 @dataclass
-class RolloutCriteriaCfg:
-    """Commands, cells and the paper's failure rules shared by the granular-simulator evaluations."""
-
-    speeds: tuple[float, ...] = (1.0,)
-    """Commanded forward speeds [m/s]."""
-    repeats: int = 2
-    """Envs per (material, speed) cell."""
-    duration_s: float = 10.0
-    """Episode duration that counts as success [s]."""
-    min_base_height: float = 0.2
-    """Failure: pelvis below this height above the sand [m]."""
-    max_tilt: float = math.pi / 4
-    """Failure: |roll| or |pitch| above this [rad]."""
-    floor: SandFloorCfg = field(
-        default_factory=lambda: SandFloorCfg(enabled=False, depth_range=(0.3, 0.3), num_levels=1, curriculum=False)
-    )
-    """Hard floor: off for the feet by default (GM-Loco play terrain), 30 cm down for other bodies."""
-
-
-@dataclass
-class EvalCfg(RolloutCriteriaCfg):
+class EvalCfg(MaterialCellsCfg):
     """Evaluation of one ONNX policy in the granular simulator."""
 
     policy_path: str = "runs/train/ppo_rft3d/policy.onnx"
@@ -57,8 +37,6 @@ class EvalCfg(RolloutCriteriaCfg):
     """Contact model of the simulator; None: the one in the policy metadata (else rft3d)."""
     terrain: TerrainName = "flat"
     """Sand terrain."""
-    materials: tuple[str, ...] = ("dry_sand", "poppy_seed")
-    """Material presets (``gmloco.contact.MATERIAL_PRESETS``)."""
     device: str = "cpu"
     """Torch / Warp device."""
     seed: int = 0
