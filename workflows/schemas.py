@@ -68,12 +68,16 @@ def _interp(expr: str) -> Any:
 
 
 class ContactModelName(str, Enum):
-    """Granular contact models of ``gmloco.contact`` (issue 3)."""
+    """Granular contact models of ``gmloco.contact`` (issue 3): ``gmloco.train.config.ContactModelName``'s names.
+
+    OmegaConf holds no ``Literal``, so the schema's closed choices are enums whose names are the package's
+    (``tests/workflows/test_schemas.py`` checks that they agree).
+    """
 
     rft3d = "rft3d"
     heuristic_rft = "heuristic_rft"
-    cone_single = "cone_single"
     cone_multi = "cone_multi"
+    cone_single = "cone_single"
     rigid = "rigid"
     rft3d_calibrated = "rft3d_calibrated"
 
@@ -144,7 +148,7 @@ class TrainAlgorithm(str, Enum):
 
 
 class FootClearanceForm(str, Enum):
-    """Form of the swing-height term (``gmloco.train.GranularTaskCfg.foot_clearance``)."""
+    """Form of the swing-height term: ``gmloco.train.config.FootClearanceName``'s names."""
 
     penalty = "penalty"
     reward = "reward"
@@ -155,7 +159,7 @@ class FootClearanceForm(str, Enum):
 
 
 class TerrainName(str, Enum):
-    """Sand beds of ``gmloco.train.g1_granular_task``."""
+    """Sand beds of ``gmloco.train.g1_granular_task``: ``gmloco.train.config.TerrainName``'s names."""
 
     flat = "flat"
     rough = "rough"
@@ -163,7 +167,7 @@ class TerrainName(str, Enum):
 
 
 class JumpMotion(str, Enum):
-    """Jump references shipped with ``gmloco.train.tasks.g1_jump`` (``data/jump_<name>.npz``)."""
+    """Jump references of ``gmloco.train.tasks.g1_jump`` (``data/jump_<name>.npz``): ``JumpMotionName``'s names."""
 
     vertical = "vertical"
     forward = "forward"

@@ -20,6 +20,7 @@ from gmloco.train.lazy_exports import lazy_exports
 if TYPE_CHECKING:
     from gmloco.train.config import (
         ContactModelName,
+        FootClearanceName,
         GranularTaskCfg,
         MaterialRangeCfg,
         RobotDrCfg,
@@ -36,6 +37,7 @@ if TYPE_CHECKING:
 
 _EXPORTS: dict[str, str] = {
     "ContactModelName": "gmloco.train.config",
+    "FootClearanceName": "gmloco.train.config",
     "GranularTaskCfg": "gmloco.train.config",
     "MaterialRangeCfg": "gmloco.train.config",
     "RobotDrCfg": "gmloco.train.config",
@@ -58,6 +60,7 @@ _EXPORTS: dict[str, str] = {
 __all__ = [
     "ContactModelName",
     "EvalCfg",
+    "FootClearanceName",
     "GranularTaskCfg",
     "MaterialRangeCfg",
     "RobotDrCfg",

@@ -8,6 +8,7 @@ from typing import Literal
 
 __all__ = [
     "ContactModelName",
+    "FootClearanceName",
     "GranularTaskCfg",
     "MaterialRangeCfg",
     "RobotDrCfg",
@@ -26,6 +27,9 @@ fitted to MPM sand (``GranularTaskCfg.rft_extensions_file``)."""
 
 TerrainName = Literal["flat", "rough", "deep"]
 """Sand bed: flat soft sand, sinusoidal (rough) free surface, or a 30 cm deep loose bed."""
+
+FootClearanceName = Literal["penalty", "reward", "touchdown", "sinkage"]
+"""Form of the swing-height term (``GranularTaskCfg.foot_clearance``)."""
 
 
 @dataclass
@@ -165,7 +169,7 @@ class GranularTaskCfg:
     tens of thousands of iterations; 0.1 fits it into a ~2k-iteration budget (ramp over 1.5k iterations, stages
     at 1k and 1.5k). Below 1, the wide initial tracking kernel (std 1 m/s, where standing still already earns
     ~70 % of the tracking reward) is left before the policy settles on standing."""
-    foot_clearance: Literal["penalty", "reward", "touchdown", "sinkage"] = "penalty"
+    foot_clearance: FootClearanceName = "penalty"
     """Swing-height term. ``"penalty"``: the GM-Loco project page's ``foot_clearance_l2`` (weight -2, zero for
     still feet); ``"reward"``: the public code's exp form (weight +5), which pays its maximum to feet that do not
     move, so a policy that stands still earns it in full (measured: 62 % of the term's maximum at iteration 1,400
