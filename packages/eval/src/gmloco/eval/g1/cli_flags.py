@@ -234,7 +234,8 @@ def flag_args(cfg: G1EvalCfg, flags: tuple[Flag, ...] = FLAGS) -> list[str]:
         if flag.off:
             out += [flag.name] if not value else []
         elif value is not None:
-            out += [flag.name, *(_text(v) for v in value)] if isinstance(value, tuple) else [flag.name, _text(value)]
+            many = isinstance(value, tuple | list)
+            out += [flag.name, *(_text(v) for v in value)] if many else [flag.name, _text(value)]
     return out
 
 
