@@ -46,9 +46,31 @@ def _parse() -> argparse.Namespace:
         "action scale; default: the task's own)",
     )
     p.add_argument("--entropy-coef", type=float, default=None, help="replace the PPO entropy bonus (default: task's)")
+    p.add_argument(
+        "--reward-weight",
+        action="append",
+        default=[],
+        metavar="NAME=WEIGHT",
+        help="replace one reward term's weight (repeatable; the term must exist in the task)",
+    )
     p.add_argument("--device", default="cuda:0")
     p.add_argument("--out", type=Path, default=Path("bench.json"))
     return p.parse_args()
+
+
+def _weights(items: list[str]) -> dict[str, float]:
+    """``NAME=WEIGHT`` items as a dict (exit 2 on a malformed item)."""
+    out: dict[str, float] = {}
+    for item in items:
+        name, sep, value = item.partition("=")
+        try:
+            out[name] = float(value)
+        except ValueError:
+            sep = ""
+        if not sep or not name:
+            print(f"--reward-weight {item!r}: expected NAME=WEIGHT, e.g. action_rate_l2=-0.1", file=sys.stderr)
+            sys.exit(2)
+    return out
 
 
 def _sync() -> None:
@@ -82,6 +104,7 @@ def bench_ppo(
     device: str,
     uniform_action_scale: float | None = None,
     entropy_coef: float | None = None,
+    reward_weights: dict[str, float] | None = None,
 ) -> dict[str, Any]:
     """Build the task's env and runner as mjlab's train script does, then time PPO iterations.
 
@@ -100,6 +123,10 @@ def bench_ppo(
         env_cfg.actions["joint_pos"].scale = uniform_action_scale  # type: ignore[attr-defined]
     if entropy_coef is not None:
         rl_cfg.algorithm.entropy_coef = entropy_coef
+    for name, weight in (reward_weights or {}).items():
+        if name not in env_cfg.rewards:
+            sys.exit(f"--reward-weight {name}: no such reward term in {task}; terms: {sorted(env_cfg.rewards)}")
+        env_cfg.rewards[name].weight = weight
     t_build = time.perf_counter()
     env = ManagerBasedRlEnv(cfg=env_cfg, device=device)
     build_s = time.perf_counter() - t_build
@@ -146,6 +173,7 @@ def bench_ppo(
         "num_steps_per_env": rl_cfg.num_steps_per_env,
         "uniform_action_scale": uniform_action_scale,
         "entropy_coef": rl_cfg.algorithm.entropy_coef,
+        "reward_weights": {name: term.weight for name, term in env_cfg.rewards.items()},
         "curve": curve,
     }
 
@@ -182,6 +210,7 @@ def main() -> None:
             args.device,
             args.uniform_action_scale,
             args.entropy_coef,
+            _weights(args.reward_weight),
         )
         print(json.dumps(results["tasks"][task], indent=1), flush=True)  # type: ignore[index]
         args.out.parent.mkdir(parents=True, exist_ok=True)
