@@ -35,6 +35,16 @@ CASES = [
     (["+exp=gm_loco", "train_teacher.ppo.gamma=1.5"], "train_teacher.ppo.gamma", ["a number in [0, 1]"]),
     (["+exp=gm_loco", "eval_mpm.speeds=[1.0,-2]"], "eval_mpm.speeds", ["element -2.0", "> 0"]),
     (["+exp=ppo_rigid", "seed=-1"], "seed", ["in [0, 4294967295]"]),
+    (
+        ["+exp=jump_rft3d", "train_teacher.jump.assist.initial_scale=1.5"],
+        "train_teacher.jump.assist.initial_scale",
+        ["a number in [0, 1]"],
+    ),
+    (
+        ["+exp=jump_rigid", "train_teacher.jump.assist_scale_step=0.05"],
+        "train_teacher.jump.assist_scale_step",
+        ["assist", "rewards"],
+    ),
     # inputs of the selected stages (workflows/input_checks.py)
     (["+exp=gm_loco", "mismatch.effects=[actuator.dleay]"], "mismatch.effects", ["did you mean 'actuator.delay'"]),
     (["+exp=gm_loco", "mismatch.real=README.md"], "mismatch.real", ["not an MCAP recording"]),

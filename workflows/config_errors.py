@@ -68,6 +68,8 @@ def unknown_key_error(key: str, override: str) -> ConfigInputError:
             msg = f"unknown config key '{key}' in '{override}'. Valid keys under {where}: {_choices(keys)}"
             return ConfigInputError(key, f"{msg}{_did_you_mean(part, keys)}.{extra}")
         node = node._get_node(part)  # keep nodes (not values) so nested configs stay DictConfig
+        if isinstance(node, DictConfig) and node._is_none() and isinstance(node._metadata.ref_type, type):
+            node = OmegaConf.structured(node._metadata.ref_type)  # an optional section left unset: its schema's keys
     return ConfigInputError(key, f"invalid override '{override}'.")
 
 

@@ -18,7 +18,7 @@ from typing import Any
 from omegaconf import DictConfig, OmegaConf
 
 from workflows.pipeline_report import say, stage_bar
-from workflows.section_cfg import section_as
+from workflows.section_cfg import field_values, section_as
 from workflows.stage_registry import StageIncompleteError
 
 __all__ = [
@@ -93,26 +93,14 @@ def material_cfg(node: DictConfig, terrain_material: Any) -> Any:
 
 
 def jump_task_cfg(section: DictConfig) -> Any:
-    """Return the ``JumpTaskCfg`` of a train section whose ``jump`` node is set (contact model, motion, assist)."""
-    from gmloco.train.tasks.g1_jump.config import g1_jump_task
+    """Return the ``JumpTaskCfg`` of a train section whose ``jump`` node is set (contact model, imitation fields)."""
+    from gmloco.train.tasks.g1_jump.config import JumpImitationCfg, g1_jump_task
 
-    jump = section.jump
-    task = g1_jump_task(str(section.contact_model.value), str(jump.motion.value))  # type: ignore[arg-type]
-    assist = replace(
-        task.assist,
-        enabled=float(jump.assist_initial_scale) > 0.0,
-        initial_scale=float(jump.assist_initial_scale),
-        scale_step=float(jump.assist_scale_step),
-        success_threshold=float(jump.assist_success_threshold),
-    )
+    imitation = section_as(JumpImitationCfg, section.jump)
+    motion = str(section.jump.motion.value)
+    task = g1_jump_task(str(section.contact_model.value), motion)  # type: ignore[arg-type]
     base = replace(task.base, policy_history_length=int(section.policy_history_length))
-    return replace(
-        task,
-        base=base,
-        hold_s=float(jump.hold_s),
-        rsi_probability=float(jump.rsi_probability),
-        assist=assist,
-    )
+    return replace(task, **(field_values(imitation) | {"motion": motion, "base": base}))
 
 
 def ppo_cfg(section: DictConfig) -> Any:

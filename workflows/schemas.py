@@ -26,6 +26,7 @@ from omegaconf import MISSING, DictConfig, OmegaConf
 from gmloco.eval.g1.config import G1EvalCfg, Scenario
 from gmloco.train.config import MaterialRangeCfg
 from gmloco.train.evaluation_cells import MaterialCellsCfg
+from gmloco.train.tasks.g1_jump.config import JumpImitationCfg
 from gmloco.train.teacher_student.config import DistillCfg as DistillAlgorithmCfg
 from gmloco.train.teacher_student.config import PpoCfg, StudentCfg, TeacherCfg
 from workflows.config_ranges import each, ranged
@@ -174,21 +175,15 @@ class JumpMotion(str, Enum):
 
 
 @dataclass
-class JumpSectionCfg:
-    """The jump imitation task of the train stage (``gmloco.train.tasks.g1_jump.JumpTaskCfg``, issue 39)."""
+class JumpSectionCfg(JumpImitationCfg):
+    """The jump imitation task of the train stage: the package's ``JumpImitationCfg`` (issue 39).
 
-    motion: JumpMotion = JumpMotion.vertical
-    """Reference motion: 8 cm vertical jump or 10 cm forward jump."""
-    hold_s: float = ranged(1.0, ge=0)
-    """Time the episode runs on after the reference ends, holding its standing frame [s]."""
-    rsi_probability: float = ranged(0.8, ge=0, le=1)
-    """Probability that a reset starts at a random time of the reference (reference state initialization)."""
-    assist_initial_scale: float = ranged(1.0, ge=0, le=1)
-    """Scale of the assistive base wrench at the start of training (ZEST, Sleiman et al. 2026); 0 disables it."""
-    assist_scale_step: float = ranged(0.02, gt=0, le=1)
-    """Scale removed each time the moving success rate clears ``assist_success_threshold``."""
-    assist_success_threshold: float = ranged(0.8, gt=0, le=1)
-    """Moving fraction of episodes ending without a failure above which the assist scale drops."""
+    ``train_teacher.jump.rewards.*`` and ``train_teacher.jump.assist.*`` are the package's ``JumpRewardCfg`` and
+    ``JumpAssistCfg``; an assist ``initial_scale`` of 0 (or ``enabled: false``) trains without the wrench.
+    """
+
+    motion: JumpMotion = JumpMotion.vertical  # type: ignore[assignment]  # OmegaConf holds an Enum, not a Literal
+    """Reference motion: 8 cm vertical jump or 10 cm forward jump (``JumpMotionName``'s names)."""
 
 
 @dataclass

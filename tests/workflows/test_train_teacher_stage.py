@@ -53,11 +53,24 @@ def test_jump_exps_train_the_jump_task(
 ) -> None:
     """``+exp=jump_*`` hands a ``JumpTaskCfg`` with its contact model, vanilla PPO settings and no ONNX export."""
     seen = _captured(monkeypatch)
-    train_teacher.run(compose(f"+exp={exp}", "train_teacher.jump.assist_scale_step=0.05"))
+    train_teacher.run(compose(f"+exp={exp}", "train_teacher.jump.assist.scale_step=0.05"))
     jump = seen["jump"]
     assert jump.base.contact_model == contact_model and jump.motion == "vertical"
     assert jump.assist.enabled and jump.assist.initial_scale == 1.0 and jump.assist.scale_step == 0.05
     assert seen["export_onnx"] is False and seen["rsl_rl_overrides"]["algorithm"]["entropy_coef"] == 0.005
+
+
+def test_jump_section_reaches_every_imitation_field(
+    compose: Callable[..., DictConfig], monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """The ``jump`` section is the package's JumpImitationCfg: rewards, episode and assist fields reach the task."""
+    seen = _captured(monkeypatch)
+    overrides = ("train_teacher.jump.motion=forward", "train_teacher.jump.rewards.base_pos_weight=2.5",
+                 "train_teacher.jump.max_base_pos_error=0.5", "train_teacher.jump.assist.enabled=false")  # fmt: skip
+    train_teacher.run(compose("+exp=jump_rft3d", *overrides))
+    jump = seen["jump"]
+    assert jump.motion == "forward" and isinstance(jump.motion, str)
+    assert jump.rewards.base_pos_weight == 2.5 and jump.max_base_pos_error == 0.5 and not jump.assist.enabled
 
 
 def test_jump_exps_differ_only_in_the_contact_model(compose: Callable[..., DictConfig]) -> None:

@@ -10,6 +10,7 @@ from gmloco.train.config import ContactModelName, GranularTaskCfg, SandFloorCfg,
 
 __all__ = [
     "JumpAssistCfg",
+    "JumpImitationCfg",
     "JumpMotionName",
     "JumpRewardCfg",
     "JumpTaskCfg",
@@ -44,11 +45,11 @@ class JumpAssistCfg:
     """Cap on |force| [N] (twice the G1's weight)."""
     max_torque: float = 150.0
     """Cap on |torque| [N m]."""
-    initial_scale: float = 1.0
+    initial_scale: float = field(default=1.0, metadata={"ge": 0, "le": 1})
     """Scale at the start of training [-]."""
-    scale_step: float = 0.02
+    scale_step: float = field(default=0.02, metadata={"gt": 0, "le": 1})
     """Scale removed each time the success rate clears ``success_threshold`` [-]."""
-    success_threshold: float = 0.8
+    success_threshold: float = field(default=0.8, metadata={"gt": 0, "le": 1})
     """Moving-average fraction of episodes ending without a failure above which the scale drops [-]."""
     success_ema: float = 0.05
     """Weight of each reset batch in the moving average of the success rate [-]."""
@@ -100,25 +101,31 @@ class JumpRewardCfg:
 
 
 @dataclass
-class JumpTaskCfg:
-    """Everything that selects one G1 jump task; ``make_g1_jump_env_cfg`` builds it."""
+class JumpImitationCfg:
+    """The imitation side of a jump task: reference, episode, rewards and assist (the pipeline's ``jump`` section)."""
 
-    base: GranularTaskCfg = field(default_factory=GranularTaskCfg)
-    """Contact model, sand material DR, robot DR, action scale, noise, play mode (velocity-task fields that the
-    jump does not use are ignored: commands, velocity rewards, floor curriculum)."""
     motion: JumpMotionName = "vertical"
     """Reference motion."""
-    hold_s: float = 1.0
+    hold_s: float = field(default=1.0, metadata={"ge": 0})
     """Time the episode runs on after the reference ends, holding its last (standing) frame [s]."""
-    rsi_probability: float = 0.8
+    rsi_probability: float = field(default=0.8, metadata={"ge": 0, "le": 1})
     """Probability that a reset starts at a random time of the reference (reference state initialization,
     Peng et al. 2018) instead of its first frame."""
-    max_base_pos_error: float = 0.35
+    max_base_pos_error: float = field(default=0.35, metadata={"gt": 0})
     """Base position error that ends the episode as a failure [m]."""
     rewards: JumpRewardCfg = field(default_factory=JumpRewardCfg)
     """Tracking rewards."""
     assist: JumpAssistCfg = field(default_factory=JumpAssistCfg)
     """Assistive wrench and its curriculum."""
+
+
+@dataclass
+class JumpTaskCfg(JumpImitationCfg):
+    """Everything that selects one G1 jump task; ``make_g1_jump_env_cfg`` builds it."""
+
+    base: GranularTaskCfg = field(default_factory=GranularTaskCfg)
+    """Contact model, sand material DR, robot DR, action scale, noise, play mode (velocity-task fields that the
+    jump does not use are ignored: commands, velocity rewards, floor curriculum)."""
 
 
 def jump_terrain(contact_model: ContactModelName) -> SandTerrainCfg:
