@@ -183,7 +183,7 @@ def _convergence(by_voxel: dict[str, dict[str, Any]], cfg: VoxelStudyCfg) -> dic
         changes = [finest["weight_depth_rel_change"], *finest["force_rel_change_at_depth"].values()]
         known = [abs(c) for c in changes if c is not None]
         out["finest_pair"] = f"{keys[1]}_vs_{keys[0]}"
-        out["finest_pair_converged"] = bool(known and max(known) <= cfg.converged_change) if known else None
+        out["finest_pair_converged"] = bool(max(known) <= cfg.converged_change) if known else None
     return out
 
 
