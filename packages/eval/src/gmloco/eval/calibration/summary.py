@@ -38,7 +38,7 @@ from gmloco.eval.calibration.fit import SandFitCfg, dataset_material, replay_for
 from gmloco.eval.calibration.protocol import SoleRecord, run_experiment
 from gmloco.eval.calibration.rft_sand import centred_sole_collider, rft_sole_sand
 
-__all__ = ["NOT_FROM_SOLE_DATA", "SUMMARY_KEYS", "SummaryCfg", "build_summary", "stance_depth"]
+__all__ = ["NOT_FROM_SOLE_DATA", "SUMMARY_KEYS", "SummaryCfg", "build_summary", "depth_at_force", "stance_depth"]
 
 SUMMARY_KEYS: tuple[str, ...] = (
     "force_error_before",
@@ -115,17 +115,27 @@ def _datasets(reports: dict[str, dict[str, Any]], paths: list[str] | None) -> di
     return out
 
 
-def _depth_at_load(rec: SoleRecord, load: float) -> float | None:
-    """Return the depth [m] where the first (press) phase's F_z first reaches ``load`` [N], linear between frames."""
-    fz, depth = rec.force[rec.phase == 0, 2], rec.depth[rec.phase == 0]
-    hit = np.nonzero(fz >= load)[0]
+def depth_at_force(depth: np.ndarray, force_z: np.ndarray, load: float) -> float | None:
+    """Return the depth [m] where ``force_z`` [N] [T] first reaches ``load`` [N], linear between frames, or None.
+
+    Args:
+        depth: Depth of the sole's lowest point below the nominal bed top [m], [T].
+        force_z: Vertical sand force on the sole [N], [T].
+        load: Force to reach [N]; a first frame already at it returns that frame's depth.
+    """
+    hit = np.nonzero(force_z >= load)[0]
     if not len(hit):
         return None
     i = int(hit[0])
     if i == 0:
         return float(depth[0])
-    w = (load - fz[i - 1]) / (fz[i] - fz[i - 1])
+    w = (load - force_z[i - 1]) / (force_z[i] - force_z[i - 1])
     return float(depth[i - 1] + w * (depth[i] - depth[i - 1]))
+
+
+def _depth_at_load(rec: SoleRecord, load: float) -> float | None:
+    """Return the depth [m] where the first (press) phase's F_z first reaches ``load`` [N], linear between frames."""
+    return depth_at_force(rec.depth[rec.phase == 0], rec.force[rec.phase == 0, 2], load)
 
 
 def _model_press(ds: CalibrationDataset, ext: RftExtensionsCfg, fit: SandFitCfg) -> SoleRecord:
