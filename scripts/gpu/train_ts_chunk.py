@@ -105,6 +105,14 @@ def _parse(argv: list[str] | None) -> argparse.Namespace:
         "foot box, so a buried swinging foot meets sand; pass the same value to every chunk of a run",
     )
     p.add_argument(
+        "--floor-promotion",
+        choices=["distance", "survival"],
+        default=None,
+        help="SandFloorCfg.promotion of the floor-depth curriculum (default: the task's, 'distance'); 'survival' "
+        "lowers the floor after an episode that ran to its time limit and raises it after a fall; pass the same "
+        "value to every chunk of a run",
+    )
+    p.add_argument(
         "--allow-changed",
         action="append",
         default=[],
@@ -263,6 +271,9 @@ def _task(args: argparse.Namespace) -> Any:
         task = replace(task, foot_clearance=args.foot_clearance)
     if args.foot_faces is not None:
         task = replace(task, foot_faces=args.foot_faces)
+    if args.floor_promotion is not None:
+        floor = replace(task.terrain.floor, promotion=args.floor_promotion)
+        task = replace(task, terrain=replace(task.terrain, floor=floor))
     weights = reward_weights(args.reward_weight)
     if weights:
         task = replace(task, reward_weights=weights)

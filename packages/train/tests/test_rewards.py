@@ -6,9 +6,10 @@ from __future__ import annotations
 import math
 
 import numpy as np
+import pytest
 import torch
 
-from gmloco.train.mdp.curriculums import _level_moves
+from gmloco.train.mdp.curriculums import _level_moves, _survival_moves
 from gmloco.train.mdp.rewards import (
     _clearance,
     _exp_kernel,
@@ -77,6 +78,12 @@ def test_level_moves() -> None:
     """Walked 5 m of 4 needed -> +1; walked 1 m of 10 m commanded -> -1; 3 m of 4 m commanded -> 0."""
     moves = _level_moves(torch.tensor([5.0, 1.0, 3.0]), torch.tensor([20.0, 10.0, 4.0]), 4.0)
     np.testing.assert_array_equal(moves, [1, -1, 0])
+
+
+def test_survival_moves() -> None:
+    """Timed out -> +1; failed -> -1; neither (a reset without an ending) -> 0; a time out wins over a failure."""
+    moves = _survival_moves(torch.tensor([True, False, False, True]), torch.tensor([False, True, False, True]))
+    np.testing.assert_array_equal(moves, [1, -1, 0, 1])
 
 
 def test_curriculum_scale_compresses_stages_and_ramps() -> None:
@@ -148,3 +155,28 @@ def test_swing_height_is_paid_once_per_touchdown_clipped_and_only_when_moving() 
     np.testing.assert_allclose(apex.numpy(), [0.04, 0.03], atol=1e-7)  # a sunk apex pays 0, not a penalty
     commands.zero_()
     assert swing_height_at_touchdown(env, 0.12, "twist").abs().sum().item() == 0.0
+
+
+def test_sand_floor_levels_survival_rule(monkeypatch: pytest.MonkeyPatch) -> None:
+    """``promotion="survival"``: timed-out envs go one level deeper, failed ones one shallower, clamped to the range."""
+    from dataclasses import replace
+    from types import SimpleNamespace
+
+    from gmloco.train.config import SandFloorCfg, SandTerrainCfg
+    from gmloco.train.mdp import curriculums
+
+    floor = replace(SandFloorCfg(), promotion="survival", num_levels=3)
+    sand = SimpleNamespace(
+        task=SimpleNamespace(terrain=SandTerrainCfg(floor=floor)),
+        floor_level=torch.tensor([0, 1, 2, 0, 1]),
+        floor_depth=torch.zeros(5),
+    )
+    monkeypatch.setattr(curriculums, "get_sand", lambda env: sand)
+    terms = SimpleNamespace(
+        time_outs=torch.tensor([True, True, True, False, False]),
+        terminated=torch.tensor([False, False, False, True, False]),
+    )
+    env = SimpleNamespace(common_step_counter=10, termination_manager=terms)
+    out = curriculums.sand_floor_levels(env, torch.tensor([0, 1, 2, 3]), command_name="twist")  # type: ignore[arg-type]
+    np.testing.assert_array_equal(sand.floor_level, [1, 2, 2, 0, 1])  # env 4 was not reset
+    assert float(out["max"]) == 2.0

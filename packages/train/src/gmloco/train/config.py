@@ -8,6 +8,7 @@ from typing import Literal
 
 __all__ = [
     "ContactModelName",
+    "FloorPromotionName",
     "FootClearanceName",
     "GranularTaskCfg",
     "MaterialRangeCfg",
@@ -29,6 +30,8 @@ TerrainName = Literal["flat", "rough", "deep"]
 """Sand bed: flat soft sand, sinusoidal (rough) free surface, or a 30 cm deep loose bed."""
 
 FootClearanceName = Literal["penalty", "reward", "touchdown", "sinkage"]
+FloorPromotionName = Literal["distance", "survival"]
+"""Rules of the floor-depth curriculum (``SandFloorCfg.promotion``)."""
 """Form of the swing-height term (``GranularTaskCfg.foot_clearance``)."""
 
 
@@ -70,7 +73,12 @@ class SandFloorCfg:
     max_init_level: int = 0
     """Highest level an env may start at (uniform in [0, max_init_level])."""
     curriculum: bool = True
-    """Move envs up a level when they walk far, down when they walk less than half the command."""
+    """Move envs between levels at each reset, by the ``promotion`` rule."""
+    promotion: FloorPromotionName = "distance"
+    """``"distance"`` (GM-Loco's and mjlab's terrain rule): deeper after walking farther than 4 m from the env
+    origin, shallower after covering less than half the commanded distance; under turning commands the straight
+    distance falls short of the path, so turning envs are sent back. ``"survival"``: deeper after an episode that
+    ran to its time limit, shallower after a failure (fall, base too low)."""
 
 
 @dataclass

@@ -26,10 +26,19 @@ def _level_moves(distance: torch.Tensor, commanded: torch.Tensor, promote_distan
     return up.long() - down.long()
 
 
+def _survival_moves(time_out: torch.Tensor, failed: torch.Tensor) -> torch.Tensor:
+    """Return +1 (episode ran to its time limit), -1 (ended by a failure) or 0 (neither, e.g. a manual reset)."""
+    up = time_out.bool()
+    down = failed.bool() & ~up
+    return up.long() - down.long()
+
+
 def sand_floor_levels(
     env: ManagerBasedRlEnv, env_ids: torch.Tensor, command_name: str, promote_distance: float = 4.0
 ) -> dict[str, torch.Tensor]:
-    """Lower the floor under envs that walked far and raise it under envs that lagged.
+    """Lower the floor under envs that walked far (or survived) and raise it under envs that lagged (or fell).
+
+    The rule is the floor's ``promotion`` (:class:`~gmloco.train.config.SandFloorCfg`).
 
     Runs at reset, before the :class:`~gmloco.train.sand.SandContact` event places the floors.
 
@@ -45,14 +54,18 @@ def sand_floor_levels(
     sand = get_sand(env)
     floor = sand.task.terrain.floor
     if floor.curriculum and env.common_step_counter > 0 and len(env_ids) > 0:
-        robot = env.scene["robot"]
-        distance = torch.linalg.vector_norm(
-            robot.data.root_link_pos_w[env_ids, :2] - env.scene.env_origins[env_ids, :2], dim=1
-        )
-        command = env.command_manager.get_command(command_name)
-        assert command is not None
-        commanded = torch.linalg.vector_norm(command[env_ids, :2], dim=1) * env.max_episode_length_s
-        moves = _level_moves(distance, commanded, promote_distance)
+        if floor.promotion == "survival":
+            terms = env.termination_manager
+            moves = _survival_moves(terms.time_outs[env_ids], terms.terminated[env_ids])
+        else:
+            robot = env.scene["robot"]
+            distance = torch.linalg.vector_norm(
+                robot.data.root_link_pos_w[env_ids, :2] - env.scene.env_origins[env_ids, :2], dim=1
+            )
+            command = env.command_manager.get_command(command_name)
+            assert command is not None
+            commanded = torch.linalg.vector_norm(command[env_ids, :2], dim=1) * env.max_episode_length_s
+            moves = _level_moves(distance, commanded, promote_distance)
         levels = sand.floor_level[env_ids] + moves
         sand.floor_level[env_ids] = levels.clamp(0, floor.num_levels - 1)
     levels = sand.floor_level.float()
