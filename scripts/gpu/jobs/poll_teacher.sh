@@ -16,5 +16,5 @@ if [ -e ~/chunks/DONE ]; then
 fi
 ck=$(ls -t ~/src/runs/gpu/"$run"/model_*.pt 2>/dev/null | head -1)
 [ -n "$ck" ] && python3 scripts/gpu/slim_checkpoint.py "$ck" "$OUT/$(basename "$ck")"
-tar czf "$OUT/logs.tgz" -C ~/chunks --exclude='*.npz' job.log $(cd ~/chunks && ls -d calib* lr_ab 2>/dev/null)
+tar czf "$OUT/logs.tgz" -C ~/chunks --exclude='*.npz' job.log $(cd ~/chunks && ls -d calib* lr_ab reward_ab 2>/dev/null)
 echo "still running at $(date +%T)"; exit 3
