@@ -11,7 +11,13 @@ import torch
 from rsl_rl.env import VecEnv
 
 from gmloco.train.teacher_student import ObsGroupsCfg, TeacherCfg, TeacherPPO
-from gmloco.train.teacher_student.kl_probe import grad_norms_by_loss, kl_stepping_only, param_groups, zero_step_kls
+from gmloco.train.teacher_student.kl_probe import (
+    grad_norms_by_loss,
+    kl_stepping_only,
+    param_groups,
+    std_gradients_by_loss,
+    zero_step_kls,
+)
 from gmloco.train.teacher_student.kl_probe_cli import main
 
 
@@ -47,6 +53,17 @@ def test_grad_norms_reach_only_the_groups_each_loss_feeds(filled: TeacherPPO) ->
     assert norms["value"]["critic"] > 0 and norms["value"]["policy"] == 0
     assert norms["vae"]["encoder"] > 0 and norms["vae"]["decoder"] > 0 and norms["vae"]["policy"] == 0
     assert all(p.grad is None or not p.grad.any() for ps in param_groups(filled).values() for p in ps)
+
+
+def test_std_gradient_of_the_entropy_bonus_is_analytic(filled: TeacherPPO) -> None:
+    """d(-c H)/d sigma = -c / sigma per action dim (H sums ln sigma over dims); the value loss does not reach sigma."""
+    grads = std_gradients_by_loss(filled)
+    (name, param), *_ = filled.actor.distribution.named_parameters()  # type: ignore[union-attr]
+    assert name == "std_param"  # std_type "scalar": sigma itself is the parameter
+    c = filled.policy_loss_weight() * filled.entropy_coef
+    assert grads["entropy_bonus"][name] == pytest.approx(-c * float((1.0 / param.detach()).mean()), rel=1e-5)
+    assert grads["value"][name] == 0.0 and grads["surrogate"][name] != 0.0
+    assert param.grad is None or not param.grad.any()
 
 
 def test_stepping_only_the_decoder_leaves_the_policy(filled: TeacherPPO) -> None:

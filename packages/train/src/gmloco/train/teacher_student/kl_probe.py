@@ -90,6 +90,28 @@ def grad_norms_by_loss(alg: TeacherPPO, batch: RolloutStorage.Batch) -> dict[str
     return out
 
 
+def std_gradients_by_loss(alg: TeacherPPO) -> dict[str, dict[str, float]]:
+    """Return ``{loss term: {distribution parameter: mean d loss / d parameter}}`` over every mini-batch.
+
+    Signed, averaged over the action dimensions and the mini-batches of one epoch, before clipping. The optimizer
+    steps against the gradient, so a negative value on the std parameter pushes the action std up: with the
+    entropy bonus always negative there, the std falls only where the surrogate's positive gradient outweighs it.
+    """
+    named = dict(alg.actor.distribution.named_parameters())  # type: ignore[union-attr]
+    sums: dict[str, dict[str, float]] = {}
+    batches = _batches(alg)
+    for batch in batches:
+        for term, loss in _losses(alg, batch).items():
+            alg.optimizer.zero_grad()
+            loss.backward(retain_graph=True)
+            row = sums.setdefault(term, dict.fromkeys(named, 0.0))
+            for name, param in named.items():
+                if param.grad is not None:
+                    row[name] += float(param.grad.mean()) / len(batches)
+    alg.optimizer.zero_grad()
+    return sums
+
+
 @contextmanager
 def _restored(alg: TeacherPPO) -> Iterator[None]:
     """Restore actor, critic and optimizer state (and the adaptive rate) on exit."""

@@ -123,7 +123,12 @@ def _batch_kl(alg: Any, batch: Any) -> float:
 
 def main(argv: Sequence[str] | None = None) -> dict[str, Any]:
     """Run the probes and print them as JSON; return the result."""
-    from gmloco.train.teacher_student.kl_probe import grad_norms_by_loss, kl_stepping_only, zero_step_kls
+    from gmloco.train.teacher_student.kl_probe import (
+        grad_norms_by_loss,
+        kl_stepping_only,
+        std_gradients_by_loss,
+        zero_step_kls,
+    )
 
     args = _parse(argv)
     tc = _train_cfg(args.artifact)
@@ -140,6 +145,7 @@ def main(argv: Sequence[str] | None = None) -> dict[str, Any]:
         "warm_iterations": warm,
         "zero_step_kl": zero_step_kls(alg),
         "grad_norms_first_minibatch": grad_norms_by_loss(alg, first),
+        "std_gradient_by_loss": std_gradients_by_loss(alg),
         "kl_stepping_only": {
             f"lr={lr:g} {'+'.join(sel)}": kl_stepping_only(alg, sel, lr, args.probe_steps)
             for lr in args.lrs
