@@ -114,6 +114,16 @@ def test_upgrade_refuses_a_missing_task_field_then_writes_the_document(tmp_path:
     assert json.loads((tmp_path / "policy.json").read_text()) == meta.to_dict()
 
 
+def test_task_saved_before_the_floor_rule_reads_as_the_distance_rule() -> None:
+    """A train_cfg task without ``terrain.floor.promotion`` (saved before the field) is read with its only rule then."""
+    from gmloco.train.tasks.g1_granular.upgrade_metadata import task_from_dict
+
+    task = asdict(replace(g1_granular_task(), foot_faces="box"))
+    del task["terrain"]["floor"]["promotion"]
+    rebuilt = task_from_dict(json.loads(json.dumps(task)))
+    assert rebuilt.terrain.floor.promotion == "distance" and rebuilt.foot_faces == "box"
+
+
 def test_upgrade_refuses_disagreeing_facts(tmp_path: Path) -> None:
     """A file whose history length differs from its train_cfg.json is not upgraded."""
     _v1_policy(tmp_path, history=40)

@@ -46,6 +46,11 @@ _NESTED: dict[str, type] = {"terrain": SandTerrainCfg, "floor": SandFloorCfg, "m
 """Dataclass-valued fields of the task config."""
 
 
+_ADDED_LATER: dict[str, Any] = {"task.terrain.floor.promotion": "distance"}
+"""Task fields added after runs were saved, with the value that reproduces every run saved without them (the only
+behaviour there was): such a field is filled in, never guessed for any other key."""
+
+
 def _tuples(value: Any) -> Any:
     """JSON lists back to tuples (the config's range fields)."""
     return tuple(_tuples(v) for v in value) if isinstance(value, list) else value
@@ -54,6 +59,7 @@ def _tuples(value: Any) -> Any:
 def _build(cls: type, doc: Mapping[str, Any], where: str) -> Any:
     """Build ``cls`` from ``doc``; every field must be present."""
     names = [f.name for f in fields(cls)]
+    doc = {**{n: _ADDED_LATER[f"{where}{n}"] for n in names if f"{where}{n}" in _ADDED_LATER}, **doc}
     missing = [f"{where}{n}" for n in names if n not in doc]
     if missing:
         raise ValueError(f"train_cfg.json lacks {missing}; give each with --set key=value if the repository says it.")
