@@ -272,7 +272,9 @@ def _task(args: argparse.Namespace) -> Any:
     if args.foot_faces is not None:
         task = replace(task, foot_faces=args.foot_faces)
     if args.floor_promotion is not None:
-        floor = replace(task.terrain.floor, promotion=args.floor_promotion)
+        from gmloco.train.config import FloorPromotion
+
+        floor = replace(task.terrain.floor, promotion=FloorPromotion(args.floor_promotion))
         task = replace(task, terrain=replace(task.terrain, floor=floor))
     weights = reward_weights(args.reward_weight)
     if weights:

@@ -162,10 +162,10 @@ def test_sand_floor_levels_survival_rule(monkeypatch: pytest.MonkeyPatch) -> Non
     from dataclasses import replace
     from types import SimpleNamespace
 
-    from gmloco.train.config import SandFloorCfg, SandTerrainCfg
+    from gmloco.train.config import FloorPromotion, SandFloorCfg, SandTerrainCfg
     from gmloco.train.mdp import curriculums
 
-    floor = replace(SandFloorCfg(), promotion="survival", num_levels=3)
+    floor = replace(SandFloorCfg(), promotion=FloorPromotion.survival, num_levels=3)
     sand = SimpleNamespace(
         task=SimpleNamespace(terrain=SandTerrainCfg(floor=floor)),
         floor_level=torch.tensor([0, 1, 2, 0, 1]),

@@ -4,11 +4,12 @@
 from __future__ import annotations
 
 from dataclasses import dataclass, field
+from enum import StrEnum
 from typing import Literal
 
 __all__ = [
     "ContactModelName",
-    "FloorPromotionName",
+    "FloorPromotion",
     "FootClearanceName",
     "GranularTaskCfg",
     "MaterialRangeCfg",
@@ -30,8 +31,15 @@ TerrainName = Literal["flat", "rough", "deep"]
 """Sand bed: flat soft sand, sinusoidal (rough) free surface, or a 30 cm deep loose bed."""
 
 FootClearanceName = Literal["penalty", "reward", "touchdown", "sinkage"]
-FloorPromotionName = Literal["distance", "survival"]
-"""Rules of the floor-depth curriculum (``SandFloorCfg.promotion``)."""
+
+
+class FloorPromotion(StrEnum):
+    """Rules of the floor-depth curriculum (``SandFloorCfg.promotion``; an Enum, so Hydra configs can hold it)."""
+
+    distance = "distance"
+    survival = "survival"
+
+
 """Form of the swing-height term (``GranularTaskCfg.foot_clearance``)."""
 
 
@@ -74,7 +82,7 @@ class SandFloorCfg:
     """Highest level an env may start at (uniform in [0, max_init_level])."""
     curriculum: bool = True
     """Move envs between levels at each reset, by the ``promotion`` rule."""
-    promotion: FloorPromotionName = "distance"
+    promotion: FloorPromotion = FloorPromotion.distance
     """``"distance"`` (GM-Loco's and mjlab's terrain rule): deeper after walking farther than 4 m from the env
     origin, shallower after covering less than half the commanded distance; under turning commands the straight
     distance falls short of the path, so turning envs are sent back. ``"survival"``: deeper after an episode that
