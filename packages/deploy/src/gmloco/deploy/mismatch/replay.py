@@ -289,7 +289,8 @@ class Replayer:
             cfg = replace(cfg, sim=replace(cfg.sim, fixed_base=True, ground="plane"))
         self.cfg = cfg
         self.rec = rec
-        self.model = build_model(self.cfg.sim)
+        # Visual meshes never collide, but their BVH costs mj_collision more than the rest of a step.
+        self.model = build_model(replace(self.cfg.sim, visual_meshes=False))
         self._jq = slice(0 if self.fixed else 7, None)  # joint coordinates in qpos
         self._jv = slice(0 if self.fixed else 6, None)  # joint dofs in qvel and the dof_* arrays
         self.data = mujoco.MjData(self.model)
@@ -304,6 +305,7 @@ class Replayer:
         self._feet = [m.body(f"{s}_ankle_roll_link").id for s in ("left", "right")]
         self._w = G1_EFFORT_LIMIT / _REF_EFFORT
         self.offsets = np.arange(self.cfg.stride, self.cfg.horizon + 1, self.cfg.stride)
+        self._dt = rec.dt  # a median over the log: taken once, not per segment
         self._base_cache: dict[tuple, BaseTrajectory] = {}
         self._sink_cache: dict[tuple, float] = {}
         self._crater_cache: dict[tuple, np.ndarray] = {}
@@ -472,7 +474,7 @@ class Replayer:
     def _commands(self, k0: int, delay: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """Commands applied at samples ``k0..k0+H``, delayed by linear interpolation, shapes [H+1, 29]."""
         r = self.rec
-        s = np.arange(k0, k0 + self.cfg.horizon + 1) - delay / r.dt
+        s = np.arange(k0, k0 + self.cfg.horizon + 1) - delay / self._dt
         i0 = np.clip(np.floor(s).astype(int), 0, r.n - 1)
         i1 = np.clip(i0 + 1, 0, r.n - 1)
         w = np.clip(s - np.floor(s), 0.0, 1.0)[:, None]
@@ -527,20 +529,58 @@ class Replayer:
         """Replay the segments one after the other in one ``MjData`` (plane or welded pelvis); fills ``out``.
 
         Without sand no force couples the segments, so each one runs its whole horizon before the next starts.
-        The arithmetic is that of the side-by-side loop, bit for bit, but one ``MjData`` stays in the CPU cache:
-        stepping hundreds of them in turn (each touches ~1 MB) made ``mj_step1`` cost 2-4x its lone cost.
+        The arithmetic is that of the side-by-side loop (:meth:`_seg_pre`, :meth:`_seg_post`), bit for bit, but
+        one ``MjData`` stays in the CPU cache (stepping hundreds of them in turn made ``mj_step1`` cost 2-4x its
+        lone cost), and the loop reads the model and data through views made once, sets the per-step damping and
+        the welded pelvis once per step and once per segment, and takes each segment's gains as row slices.
         """
-        d = self._datas(1)[0]
-        n_cmp = len(self.offsets)
+        import mujoco
+
+        m, r, d = self.model, self.rec, self._datas(1)[0]
+        step1, step2, terrain = mujoco.mj_step1, mujoco.mj_step2, not self.fixed and h.terrain.active()
+        horizon, substeps, n_cmp = self.cfg.horizon, self.cfg.substeps, len(self.offsets)
+        # Views into the MjModel / MjData buffers (mj_resetData keeps them in place).
+        qpos, qvel, qfrc, damping = (
+            d.qpos[self._jq],
+            d.qvel[self._jv],
+            d.qfrc_applied[self._jv],
+            m.dof_damping[self._jv],
+        )
+        gain, offset, droop, lim, neg_lim = h.gain, h.offset, h.droop, h.lim, -h.lim
+        half = 0.5 * h.backlash
+        neg_half = -half
         for s, k0 in enumerate(starts):
             seg = self._seg_start(h, base, s, int(k0), d)
+            if seg.pelvis_quat is not None:
+                m.body_quat[self._pelvis] = seg.pelvis_quat
+            rows = slice(seg.k0, seg.k0 + horizon + 1)
+            kp, kd, gkd = r.kp[rows], r.kd[rows], gain * r.kd[rows]
+            qc, dqc, tff, damp = seg.qc, seg.dqc, seg.tff, seg.damping
             p = 0
-            for j in range(self.cfg.horizon + 1):
-                for sub in range(self.cfg.substeps):
+            for j in range(horizon + 1):
+                for sub in range(substeps):
                     at_compare = sub == 0 and p < n_cmp and j == self.offsets[p]
-                    self._seg_pre(h, seg, j, at_compare)
-                    self._ground(h, [d], reset=j == 0 and sub == 0)
-                    self._seg_post(h, seg, j, out[s, p] if at_compare else None)
+                    damping[:] = damp[j]
+                    step1(m, d)
+                    if at_compare and not self.fixed:
+                        seg.w_imu = d.qvel[3:6].copy()
+                    qm = qpos + offset
+                    err = qc[j] - qm
+                    if h.has_backlash:  # np.clip's value, without its Python dispatch
+                        err = err - np.minimum(np.maximum(err, neg_half), half)
+                    tau = gain * (kp[j] * err + kd[j] * (dqc[j] - qvel)) + tff[j]
+                    if droop == 0.0:
+                        tau = np.minimum(np.maximum(tau, neg_lim), lim)
+                    else:
+                        lj = lim * np.clip(1.0 - droop * np.abs(qvel), 0.0, None)
+                        tau = np.minimum(np.maximum(tau, -lj), lj)
+                    qfrc[:] = tau + gkd[j] * qvel
+                    if terrain:
+                        self._terrain(h.terrain, d)
+                    step2(m, d)
+                    if at_compare:
+                        seg.qm, seg.tau = qm, tau
+                        self._observe(h, seg, out[s, p])
                     p += int(at_compare)
         return out
 
@@ -593,8 +633,12 @@ class Replayer:
         m, d = self.model, seg.d
         m.dof_damping[self._jv] = seg.damping[j]
         mujoco.mj_step2(m, d)
-        if out is None:
-            return
+        if out is not None:
+            self._observe(h, seg, out)
+
+    def _observe(self, h: _Hyp, seg: _Seg, out: np.ndarray) -> None:
+        """Write the simulated measurements of a segment after its physics step into ``out`` [N_CHANNELS]."""
+        m, d = self.model, seg.d
         rmis_t = h.rmis_t
         out[:29] = seg.qm
         out[29:58] = d.qvel[self._jv]
