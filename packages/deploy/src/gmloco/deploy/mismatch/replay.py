@@ -199,6 +199,10 @@ class _Hyp:
     """Whether any backlash width is non-zero."""
     lim: np.ndarray
     """Static torque limit of each joint [N*m], shape [29]."""
+    neg_lim: np.ndarray
+    """``-lim`` [N*m], shape [29]."""
+    half_backlash: np.ndarray
+    """Half the backlash width of each joint [rad], shape [29]."""
 
 
 _BACKLASH_INDEX = np.array(
@@ -221,6 +225,8 @@ def _unpack(params: dict[str, np.ndarray]) -> _Hyp:
     off = np.zeros(29)
     off[:12] = p["sensor.encoder_offset"]["offset"]
     limit = 1.0 - float(p["actuator.torque_limit"]["limit_loss"][0])
+    lim = G1_EFFORT_LIMIT if limit == 1.0 else limit * G1_EFFORT_LIMIT
+    backlash = _leg(p["actuator.backlash"]["width"][_BACKLASH_INDEX])
     return _Hyp(
         delay=float(p["actuator.delay"]["delay"][0]),
         gain=1.0 + float(p["actuator.gain_scale"]["kp_scale"][0]),
@@ -230,7 +236,7 @@ def _unpack(params: dict[str, np.ndarray]) -> _Hyp:
         b=float(p["joint.viscous_damping"]["b"][0]),
         tau_c_leg=_leg(p["joint.coulomb_friction_leg"]["tau_c"]),
         b_leg=_leg(p["joint.viscous_damping_leg"]["b"]),
-        backlash=_leg(p["actuator.backlash"]["width"][_BACKLASH_INDEX]),
+        backlash=backlash,
         limb_mass=p["body.limb_mass"]["delta_mass"],
         arm_scale=float(p["joint.armature"]["scale"][0]),
         offset=off,
@@ -245,7 +251,9 @@ def _unpack(params: dict[str, np.ndarray]) -> _Hyp:
         ),
         rmis_t=quat_to_mat(quat_from_roll_pitch(*(float(a) for a in p["imu.misalignment"]["angle"]))).T,
         has_backlash=bool(p["actuator.backlash"]["width"].any()),
-        lim=G1_EFFORT_LIMIT if limit == 1.0 else limit * G1_EFFORT_LIMIT,
+        lim=lim,
+        neg_lim=-lim,
+        half_backlash=0.5 * backlash,
     )
 
 
@@ -265,6 +273,18 @@ class _Seg:
     """Delayed velocity commands [rad/s], shape [H+1, 29]."""
     tff: np.ndarray
     """Delayed feed-forward torques [N*m], shape [H+1, 29]."""
+    kp: np.ndarray
+    """Logged position gains of each step [N*m/rad], shape [H+1, 29]."""
+    kd: np.ndarray
+    """Logged velocity gains of each step [N*m*s/rad], shape [H+1, 29]."""
+    gkd: np.ndarray
+    """Realised velocity gains (gain scale times ``kd``) [N*m*s/rad], shape [H+1, 29]."""
+    qpos: np.ndarray
+    """View of the joint coordinates in ``d.qpos`` [rad], shape [29]."""
+    qvel: np.ndarray
+    """View of the joint velocities in ``d.qvel`` [rad/s], shape [29]."""
+    qfrc: np.ndarray
+    """View of the joint entries of ``d.qfrc_applied`` [N*m], shape [29]."""
     qm: np.ndarray = field(default_factory=lambda: np.zeros(29))
     """Encoder reading of the current step [rad]."""
     tau: np.ndarray = field(default_factory=lambda: np.zeros(29))
@@ -531,55 +551,31 @@ class Replayer:
         Without sand no force couples the segments, so each one runs its whole horizon before the next starts.
         The arithmetic is that of the side-by-side loop (:meth:`_seg_pre`, :meth:`_seg_post`), bit for bit, but
         one ``MjData`` stays in the CPU cache (stepping hundreds of them in turn made ``mj_step1`` cost 2-4x its
-        lone cost), and the loop reads the model and data through views made once, sets the per-step damping and
-        the welded pelvis once per step and once per segment, and takes each segment's gains as row slices.
+        lone cost), and it sets the per-step damping once per step and the welded pelvis once per segment.
         """
         import mujoco
 
-        m, r, d = self.model, self.rec, self._datas(1)[0]
+        m, d = self.model, self._datas(1)[0]
         step1, step2, terrain = mujoco.mj_step1, mujoco.mj_step2, not self.fixed and h.terrain.active()
         horizon, substeps, n_cmp = self.cfg.horizon, self.cfg.substeps, len(self.offsets)
-        # Views into the MjModel / MjData buffers (mj_resetData keeps them in place).
-        qpos, qvel, qfrc, damping = (
-            d.qpos[self._jq],
-            d.qvel[self._jv],
-            d.qfrc_applied[self._jv],
-            m.dof_damping[self._jv],
-        )
-        gain, offset, droop, lim, neg_lim = h.gain, h.offset, h.droop, h.lim, -h.lim
-        half = 0.5 * h.backlash
-        neg_half = -half
+        damping = m.dof_damping[self._jv]  # a view: mj_setConst and the effects keep the buffer in place
         for s, k0 in enumerate(starts):
             seg = self._seg_start(h, base, s, int(k0), d)
             if seg.pelvis_quat is not None:
                 m.body_quat[self._pelvis] = seg.pelvis_quat
-            rows = slice(seg.k0, seg.k0 + horizon + 1)
-            kp, kd, gkd = r.kp[rows], r.kd[rows], gain * r.kd[rows]
-            qc, dqc, tff, damp = seg.qc, seg.dqc, seg.tff, seg.damping
             p = 0
             for j in range(horizon + 1):
                 for sub in range(substeps):
                     at_compare = sub == 0 and p < n_cmp and j == self.offsets[p]
-                    damping[:] = damp[j]
+                    damping[:] = seg.damping[j]
                     step1(m, d)
                     if at_compare and not self.fixed:
                         seg.w_imu = d.qvel[3:6].copy()
-                    qm = qpos + offset
-                    err = qc[j] - qm
-                    if h.has_backlash:  # np.clip's value, without its Python dispatch
-                        err = err - np.minimum(np.maximum(err, neg_half), half)
-                    tau = gain * (kp[j] * err + kd[j] * (dqc[j] - qvel)) + tff[j]
-                    if droop == 0.0:
-                        tau = np.minimum(np.maximum(tau, neg_lim), lim)
-                    else:
-                        lj = lim * np.clip(1.0 - droop * np.abs(qvel), 0.0, None)
-                        tau = np.minimum(np.maximum(tau, -lj), lj)
-                    qfrc[:] = tau + gkd[j] * qvel
+                    self._torque(h, seg, j)
                     if terrain:
                         self._terrain(h.terrain, d)
                     step2(m, d)
                     if at_compare:
-                        seg.qm, seg.tau = qm, tau
                         self._observe(h, seg, out[s, p])
                     p += int(at_compare)
         return out
@@ -598,16 +594,18 @@ class Replayer:
         d.qpos[self._jq] = r.q[k0] - h.offset
         d.qvel[self._jv] = r.dq[k0]
         qc, dqc, tff = self._commands(k0, h.delay)
-        damping = h.gain * r.kd[k0 : k0 + self.cfg.horizon + 1] + h.b * self._w + h.b_leg
-        return _Seg(d, k0, damping, qc, dqc, tff, pelvis_quat=base.quat[s] if self.fixed else None)
+        rows = slice(k0, k0 + self.cfg.horizon + 1)
+        kp, kd = r.kp[rows], r.kd[rows]
+        damping = h.gain * kd + h.b * self._w + h.b_leg
+        views = d.qpos[self._jq], d.qvel[self._jv], d.qfrc_applied[self._jv]
+        pelvis = base.quat[s] if self.fixed else None
+        return _Seg(d, k0, damping, qc, dqc, tff, kp, kd, h.gain * kd, *views, pelvis_quat=pelvis)
 
     def _seg_pre(self, h: _Hyp, seg: _Seg, j: int, at_compare: bool) -> None:
         """First half of a physics step of one segment: kinematics, motor torques (PD on the encoders)."""
         import mujoco
 
-        m, d, r = self.model, seg.d, self.rec
-        k = seg.k0 + j
-        kp, kd = r.kp[k], r.kd[k]
+        m, d = self.model, seg.d
         # Damping enters qfrc_passive in mj_step1 and the implicit Euler update in mj_step2: set it first.
         m.dof_damping[self._jv] = seg.damping[j]
         if seg.pelvis_quat is not None:  # segments share the model: put this segment's welded pelvis in place
@@ -615,16 +613,24 @@ class Replayer:
         mujoco.mj_step1(m, d)
         if at_compare and not self.fixed:
             seg.w_imu = d.qvel[3:6].copy()  # angular velocity the gyro sensor saw
-        seg.qm = d.qpos[self._jq] + h.offset
-        v = d.qvel[self._jv]
+        self._torque(h, seg, j)
+
+    @staticmethod
+    def _torque(h: _Hyp, seg: _Seg, j: int) -> None:
+        """Motor torques of step ``j`` (PD on the encoders) into ``seg.tau``, and the applied joint forces."""
+        seg.qm = seg.qpos + h.offset
+        v = seg.qvel
         err = seg.qc[j] - seg.qm
         if h.has_backlash:  # dead band of the position loop; at zero width the error passes unchanged
-            err = err - np.clip(err, -0.5 * h.backlash, 0.5 * h.backlash)
-        tau = h.gain * (kp * err + kd * (seg.dqc[j] - v)) + seg.tff[j]
-        lim = h.lim if h.droop == 0.0 else h.lim * np.clip(1.0 - h.droop * np.abs(v), 0.0, None)
-        seg.tau = np.minimum(np.maximum(tau, -lim), lim)  # np.clip, without its Python dispatch
+            err = err - np.minimum(np.maximum(err, -h.half_backlash), h.half_backlash)  # np.clip, no dispatch
+        tau = h.gain * (seg.kp[j] * err + seg.kd[j] * (seg.dqc[j] - v)) + seg.tff[j]
+        if h.droop == 0.0:
+            seg.tau = np.minimum(np.maximum(tau, h.neg_lim), h.lim)
+        else:
+            lim = h.lim * np.clip(1.0 - h.droop * np.abs(v), 0.0, None)
+            seg.tau = np.minimum(np.maximum(tau, -lim), lim)
         # The -kd*dq part is integrated implicitly through dof_damping (Euler integrator), so add it back.
-        d.qfrc_applied[self._jv] = seg.tau + h.gain * kd * v
+        seg.qfrc[:] = seg.tau + seg.gkd[j] * v
 
     def _seg_post(self, h: _Hyp, seg: _Seg, j: int, out: np.ndarray | None) -> None:
         """Second half of the physics step; write the simulated measurements into ``out`` [N_CHANNELS] if given."""
