@@ -22,6 +22,7 @@ from gmloco.deploy.mismatch.baseest import BaseEstCfg, BaseTrajectory, estimate_
 from gmloco.deploy.mismatch.effects import BACKLASH_GROUPS, EFFECTS, LIMB_LINKS, effect
 from gmloco.deploy.mismatch.frames import quat_conj, quat_from_roll_pitch, quat_mul, quat_to_mat
 from gmloco.deploy.mismatch.g1model import G1_ARMATURE, G1_EFFORT_LIMIT, SOLE_POINTS, G1SimCfg, build_model
+from gmloco.deploy.mismatch.memo import SegmentMemo, params_key
 from gmloco.deploy.mismatch.recording import Recording
 from gmloco.deploy.mismatch.sand import SandCfg, SoleRFT
 from gmloco.deploy.mismatch.terrain import TerrainCfg, TerrainParams, sand_effect_forces, sole_forces
@@ -111,6 +112,9 @@ class ReplayCfg:
     """Terrain effect constants."""
     attitude_half_window: int = 8
     """Half window of the gyro-vs-attitude-rate channel [samples] (16 ms at 500 Hz)."""
+    memo_bytes: int = 64 * 2**20
+    """Simulated segments kept for reuse on the plane and for a welded pelvis [bytes] (:mod:`.memo`; the same
+    bits as a new replay); 0 keeps none."""
 
 
 PLANE_STEP_S = 0.002
@@ -331,6 +335,7 @@ class Replayer:
         self._crater_cache: dict[tuple, np.ndarray] = {}
         self._zmax0: np.ndarray | None = None
         self._pool: list = []
+        self._memo = SegmentMemo(self.cfg.memo_bytes)
         self.sand = SoleRFT(self.cfg.sim.sand) if self.cfg.sim.ground == "sand" else None
         """Nominal 3D-RFT sand on the soles (None on the plane ground)."""
         self.gyro_att = attitude_rate_residual(rec.imu_quat, rec.imu_gyro, rec.dt, self.cfg.attitude_half_window)
@@ -520,14 +525,32 @@ class Replayer:
             params: ``{effect_id: flat parameter vector}``; missing ids are nominal.
             starts: Segment start samples, shape [S].
         """
+        if self.sand is None:
+            return self._simulate_remembered(params, starts)
         h = _unpack(params)
         self._set_model(h)
         base = self.base(params, starts)
         out = np.zeros((len(starts), len(self.offsets), N_CHANNELS))
-        if self.sand is None:
-            return self._simulate_serial(h, base, starts, out)
         self._zmax0 = self.crater_memory(params)[starts].reshape(-1)
         return self._simulate_side_by_side(h, base, starts, out)
+
+    def _simulate_remembered(self, params: dict[str, np.ndarray], starts: np.ndarray) -> np.ndarray:
+        """Serial replay of the segments the memory does not hold; the others come from it."""
+        key = params_key(params)
+        out = np.zeros((len(starts), len(self.offsets), N_CHANNELS))
+        new = np.ones(len(starts), bool)
+        for i, k0 in enumerate(starts):
+            y = self._memo.get(key, int(k0))
+            if y is not None:
+                out[i], new[i] = y, False
+        if new.any():
+            h = _unpack(params)
+            self._set_model(h)
+            todo = starts[new]
+            out[new] = self._simulate_serial(h, self.base(params, todo), todo, out[new])
+            for k0, y in zip(todo, out[new], strict=True):
+                self._memo.put(key, int(k0), y)
+        return out
 
     def _simulate_side_by_side(self, h: _Hyp, base: BaseTrajectory, starts: np.ndarray, out: np.ndarray) -> np.ndarray:
         """Step all segments together, one ``MjData`` each, so the ground forces take one call per step."""
