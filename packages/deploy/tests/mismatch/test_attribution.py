@@ -3,6 +3,8 @@
 
 from __future__ import annotations
 
+from functools import partial
+
 import numpy as np
 
 from gmloco.deploy.mismatch.attribution import AttributionCfg
@@ -157,7 +159,9 @@ def test_workers_do_not_change_the_answer(delay_rec: object) -> None:
     for workers in (1, 2):
         cfg = AttributionCfg(effects=("actuator.delay", "joint.armature", "imu.gyro_bias"), workers=workers, top_k=2)
         hyps = screen(pb, r0, y0, n_eff, cfg)
-        ranked = confirm(pb, hyps, r0, cfg)
+        ticks: list[int] = []
+        ranked = confirm(pb, hyps, r0, cfg, partial(ticks.append, 1))
+        assert len(ticks) == len(ranked) == 2  # one progress tick per finished fit
         out.append(([h.sens for h in hyps], [(h.spec.id, h.theta, h.ci, h.dbic) for h in ranked]))
     for a, b in zip(out[0][0], out[1][0], strict=True):
         np.testing.assert_array_equal(a, b)
@@ -165,3 +169,13 @@ def test_workers_do_not_change_the_answer(delay_rec: object) -> None:
         assert ia == ib and da == db
         np.testing.assert_array_equal(ta, tb)
         np.testing.assert_array_equal(ca, cb)
+
+
+def test_progress_advances_per_fit_and_never_goes_back(delay_rec: Recording) -> None:
+    """The progress callback names each stage, counts the fits, and its fraction only grows to 1."""
+    seen: list[tuple[str, float]] = []
+    analyze(delay_rec, _cfg(), lambda msg, frac: seen.append((msg, frac)))
+    fracs = [f for _, f in seen]
+    assert fracs == sorted(fracs) and fracs[-1] == 1.0
+    msgs = [m for m, _ in seen]
+    assert [m for m in msgs if m.startswith("confirmatory fits")] == [f"confirmatory fits ({i}/3)" for i in range(4)]

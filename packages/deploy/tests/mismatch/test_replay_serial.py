@@ -18,6 +18,12 @@ _PARAMS = [
     {"actuator.backlash": np.array([0.01, 0.02, 0.01]), "body.limb_mass": np.array([0.5, 0.0, 0.0, 0.3])},
     {"terrain.rate_drag": np.array([2000.0]), "terrain.cohesion": np.array([500.0])},
     {"actuator.torque_speed": np.array([0.05]), "imu.misalignment": np.array([0.01, -0.02])},
+    {
+        "actuator.torque_limit": np.array([0.4]),
+        "actuator.gain_scale": np.array([0.1]),
+        "sensor.encoder_offset": np.full(12, 0.01),
+        "joint.viscous_damping_leg": np.full(12, 0.5),
+    },
 ]
 
 
@@ -29,7 +35,9 @@ def _side_by_side(rp: Replayer, params: dict[str, np.ndarray], starts: np.ndarra
     return rp._simulate_side_by_side(h, rp.base(params, starts), starts, out)
 
 
-@pytest.mark.parametrize("params", _PARAMS, ids=["nominal", "delay_friction", "backlash_limbs", "terrain", "droop"])
+@pytest.mark.parametrize(
+    "params", _PARAMS, ids=["nominal", "delay_friction", "backlash_limbs", "terrain", "droop", "limit_gain_offset"]
+)
 def test_serial_replay_is_bit_identical_on_the_plane(null_rec: Recording, params: dict[str, np.ndarray]) -> None:
     """Segments share no force on the plane, so replaying them one by one changes no bit of the output."""
     rp = Replayer(null_rec)

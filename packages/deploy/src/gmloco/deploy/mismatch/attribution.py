@@ -168,17 +168,31 @@ def _forked_fit(i: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     return _lm(_FORKED, cand[i], cfg)
 
 
-def _fit_all(pb: Problem, cand: list[Hypothesis], cfg: AttributionCfg) -> list[tuple[np.ndarray, ...]]:
-    """Nonlinear fits of every candidate, one forked process per fit when ``cfg.workers`` > 1 (same results)."""
+def _fit_all(
+    pb: Problem, cand: list[Hypothesis], cfg: AttributionCfg, progress: Any = None
+) -> list[tuple[np.ndarray, ...]]:
+    """Nonlinear fits of every candidate, one forked process per fit when ``cfg.workers`` > 1 (same results).
+
+    ``progress`` is called once per finished fit, in candidate order.
+    """
     global _FORKED, _FORKED_FITS
+    tick = progress or (lambda: None)
     if cfg.workers <= 1 or len(cand) < 2:
-        return [_lm(pb, h, cfg) for h in cand]
+        out = []
+        for h in cand:
+            out.append(_lm(pb, h, cfg))
+            tick()
+        return out
     import multiprocessing
 
     _FORKED, _FORKED_FITS = pb, (cand, replace(cfg, workers=1))
     try:
         with multiprocessing.get_context("fork").Pool(min(cfg.workers, len(cand))) as pool:
-            return pool.map(_forked_fit, range(len(cand)), chunksize=1)
+            out = []
+            for fit in pool.imap(_forked_fit, range(len(cand)), chunksize=1):
+                out.append(fit)
+                tick()
+            return out
     finally:
         _FORKED, _FORKED_FITS = None, None
 
@@ -471,12 +485,15 @@ def confirm(
     progress: Any = None,
     candidates: list[Hypothesis] | None = None,
 ) -> list[Hypothesis]:
-    """Fit the top-k testable effects (or ``candidates``) and score them on held-out segments; return them ranked."""
+    """Fit the top-k testable effects (or ``candidates``) and score them on held-out segments; return them ranked.
+
+    ``progress`` is called once per finished fit.
+    """
     rng = np.random.default_rng(cfg.seed)
     cand = candidates if candidates is not None else sorted([h for h in hyps if h.testable], key=lambda h: -h.dbic_lin)
     cand = cand[: cfg.top_k] if candidates is None else cand
     e0_seg = np.sum(r0[pb.held] ** 2, axis=(1, 2))
-    for hyp, (theta, r, J) in zip(cand, _fit_all(pb, cand, cfg), strict=True):
+    for hyp, (theta, r, J) in zip(cand, _fit_all(pb, cand, cfg, progress), strict=True):
         n, k = r.size, hyp.spec.size
         rss0, rss1 = float(np.sum(r0[pb.train] ** 2)), float(r @ r)
         n_eff = effective_samples(r.reshape(r0[pb.train].shape))
@@ -513,8 +530,6 @@ def confirm(
             and ci_excl
             and big
         )
-        if progress:
-            progress()
     return sorted(cand, key=lambda h: (not h.passed, -h.heldout_gain))
 
 

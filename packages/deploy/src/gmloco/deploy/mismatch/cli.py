@@ -87,7 +87,7 @@ def main(argv: list[str] | None = None) -> int:
     _one_blas_thread()
     from rich.console import Console
     from rich.markup import escape
-    from rich.progress import Progress
+    from rich.progress import Progress, TimeElapsedColumn
 
     from gmloco.deploy.mismatch.effects import check_effect_ids
     from gmloco.deploy.mismatch.io import read_recording
@@ -133,7 +133,7 @@ def main(argv: list[str] | None = None) -> int:
     cfg = AnalysisCfg(replay=replay)
     cfg.attribution.effects = effects
     cfg.attribution.workers = args.workers
-    with Progress(console=console) as prog:
+    with Progress(*Progress.get_default_columns(), TimeElapsedColumn(), console=console) as prog:
         task = prog.add_task("mismatch", total=1.0)
         res = analyze_many(recs, cfg, lambda msg, f: prog.update(task, completed=f, description=msg))
     write_report(res, args.out, plots=not args.no_plots)

@@ -28,6 +28,7 @@ __all__ = [
     "SOLE_POINTS",
     "G1SimCfg",
     "build_model",
+    "drop_visual_meshes",
     "g1_mjcf_path",
 ]
 
@@ -74,9 +75,34 @@ class G1SimCfg:
     ``qvel`` hold the 29 joints only, the pelvis hangs at ``FIXED_BASE_HEIGHT`` (its pose is
     ``model.body_pos`` / ``body_quat`` of the pelvis, settable between steps) and the feet touch nothing."""
 
+    visual_meshes: bool = True
+    """Keep the MJCF's visual mesh geoms. They never collide (contype and conaffinity 0) and the bodies carry
+    explicit inertials, so dropping them leaves the dynamics bit for bit unchanged, but their mesh BVH made
+    ``mj_collision`` two thirds of ``mj_step1`` (the replay drops them, :func:`drop_visual_meshes`)."""
+
 
 FIXED_BASE_HEIGHT = 1.5
 """Pelvis height of a fixed-base model [m]: the extended legs (0.75 m) clear the floor with any tilt."""
+
+
+def drop_visual_meshes(spec: Any) -> None:
+    """Delete every mesh geom that cannot collide, and every mesh left unused, from a ``mujoco.MjSpec``.
+
+    Raises:
+        ValueError: a mesh geom that can collide (nonzero contype or conaffinity) or that has no explicit
+            body inertial behind it would change the dynamics if dropped.
+    """
+    import mujoco
+
+    for g in [g for g in spec.geoms if g.type == mujoco.mjtGeom.mjGEOM_MESH]:
+        if g.contype or g.conaffinity:
+            raise ValueError(f"mesh geom {g.name!r} can collide; only visual meshes may be dropped")
+        if not g.parent.explicitinertial:
+            raise ValueError(f"body {g.parent.name!r} takes its inertia from geoms; its meshes must stay")
+        spec.delete(g)
+    used = {g.meshname for g in spec.geoms if g.type == mujoco.mjtGeom.mjGEOM_MESH}
+    for mesh in [m for m in spec.meshes if m.name not in used]:
+        spec.delete(mesh)
 
 
 def build_model(cfg: G1SimCfg | None = None, spec_edit: Any = None) -> Any:
@@ -113,6 +139,8 @@ def build_model(cfg: G1SimCfg | None = None, spec_edit: Any = None) -> Any:
         spec.body("pelvis").pos = [0.0, 0.0, FIXED_BASE_HEIGHT]
     if spec_edit is not None:
         spec_edit(spec)
+    if not cfg.visual_meshes:
+        drop_visual_meshes(spec)
     model = spec.compile()
     names = tuple(model.joint(i).name for i in range(0 if cfg.fixed_base else 1, model.njnt))
     if names != G1_JOINT_NAMES:

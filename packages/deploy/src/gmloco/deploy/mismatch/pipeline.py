@@ -129,6 +129,18 @@ class Attribution:
     """Verdict and its evidence (:func:`decide`)."""
 
 
+def _fit_ticks(say: Callable[[str, float], None], stage: str, lo: float, hi: float, n: int) -> Callable[[], None]:
+    """Progress of ``n`` fits between the fractions ``lo`` and ``hi``: announce the stage now, tick per fit."""
+    done = [0]
+    say(f"{stage} (0/{n})", lo)
+
+    def tick() -> None:
+        done[0] += 1
+        say(f"{stage} ({done[0]}/{n})", lo + (hi - lo) * done[0] / max(n, 1))
+
+    return tick
+
+
 def attribute(pb: Problem, cfg: AnalysisCfg, say: Callable[[str, float], None]) -> Attribution:
     """Nominal replay, screening, confirmatory fits (and a second round if unexplained), and the verdict."""
     y0 = pb.simulate({})
@@ -143,12 +155,12 @@ def attribute(pb: Problem, cfg: AnalysisCfg, say: Callable[[str, float], None]) 
         say("screening effects", 0.1 + 0.5 * done[0] / ncols)
 
     hyps = screen(pb, r0, y0, n_eff, cfg.attribution, tick)
-    say("confirmatory fits", 0.6)
-    ranked = confirm(pb, hyps, r0, cfg.attribution, lambda: say("confirmatory fits", 0.8))
+    n_fits = min(cfg.attribution.top_k, sum(h.testable for h in hyps))
+    ranked = confirm(pb, hyps, r0, cfg.attribution, _fit_ticks(say, "confirmatory fits", 0.6, 0.8, n_fits))
     decision = decide(pb, r0, ranked, cfg.attribution)
     if decision["verdict"] == "unexplained" and cfg.attribution.top_k_extra > 0:
-        say("second-round fits", 0.8)
-        extra = confirm(pb, hyps, r0, cfg.attribution, candidates=second_round(hyps, ranked, cfg.attribution))
+        more = second_round(hyps, ranked, cfg.attribution)
+        extra = confirm(pb, hyps, r0, cfg.attribution, _fit_ticks(say, "second-round fits", 0.8, 0.9, len(more)), more)
         ranked = sorted(ranked + extra, key=lambda h: (not h.passed, -h.heldout_gain))
         decision = decide(pb, r0, ranked, cfg.attribution)
     return Attribution(y0, r0, n_eff, hyps, ranked, decision)

@@ -22,6 +22,7 @@ from gmloco.deploy.mismatch.baseest import BaseEstCfg, BaseTrajectory, estimate_
 from gmloco.deploy.mismatch.effects import BACKLASH_GROUPS, EFFECTS, LIMB_LINKS, effect
 from gmloco.deploy.mismatch.frames import quat_conj, quat_from_roll_pitch, quat_mul, quat_to_mat
 from gmloco.deploy.mismatch.g1model import G1_ARMATURE, G1_EFFORT_LIMIT, SOLE_POINTS, G1SimCfg, build_model
+from gmloco.deploy.mismatch.memo import SegmentMemo, params_key
 from gmloco.deploy.mismatch.recording import Recording
 from gmloco.deploy.mismatch.sand import SandCfg, SoleRFT
 from gmloco.deploy.mismatch.terrain import TerrainCfg, TerrainParams, sand_effect_forces, sole_forces
@@ -111,6 +112,9 @@ class ReplayCfg:
     """Terrain effect constants."""
     attitude_half_window: int = 8
     """Half window of the gyro-vs-attitude-rate channel [samples] (16 ms at 500 Hz)."""
+    memo_bytes: int = 64 * 2**20
+    """Simulated segments kept for reuse on the plane and for a welded pelvis [bytes] (:mod:`.memo`; the same
+    bits as a new replay); 0 keeps none."""
 
 
 PLANE_STEP_S = 0.002
@@ -199,6 +203,10 @@ class _Hyp:
     """Whether any backlash width is non-zero."""
     lim: np.ndarray
     """Static torque limit of each joint [N*m], shape [29]."""
+    neg_lim: np.ndarray
+    """``-lim`` [N*m], shape [29]."""
+    half_backlash: np.ndarray
+    """Half the backlash width of each joint [rad], shape [29]."""
 
 
 _BACKLASH_INDEX = np.array(
@@ -221,6 +229,8 @@ def _unpack(params: dict[str, np.ndarray]) -> _Hyp:
     off = np.zeros(29)
     off[:12] = p["sensor.encoder_offset"]["offset"]
     limit = 1.0 - float(p["actuator.torque_limit"]["limit_loss"][0])
+    lim = G1_EFFORT_LIMIT if limit == 1.0 else limit * G1_EFFORT_LIMIT
+    backlash = _leg(p["actuator.backlash"]["width"][_BACKLASH_INDEX])
     return _Hyp(
         delay=float(p["actuator.delay"]["delay"][0]),
         gain=1.0 + float(p["actuator.gain_scale"]["kp_scale"][0]),
@@ -230,7 +240,7 @@ def _unpack(params: dict[str, np.ndarray]) -> _Hyp:
         b=float(p["joint.viscous_damping"]["b"][0]),
         tau_c_leg=_leg(p["joint.coulomb_friction_leg"]["tau_c"]),
         b_leg=_leg(p["joint.viscous_damping_leg"]["b"]),
-        backlash=_leg(p["actuator.backlash"]["width"][_BACKLASH_INDEX]),
+        backlash=backlash,
         limb_mass=p["body.limb_mass"]["delta_mass"],
         arm_scale=float(p["joint.armature"]["scale"][0]),
         offset=off,
@@ -245,7 +255,9 @@ def _unpack(params: dict[str, np.ndarray]) -> _Hyp:
         ),
         rmis_t=quat_to_mat(quat_from_roll_pitch(*(float(a) for a in p["imu.misalignment"]["angle"]))).T,
         has_backlash=bool(p["actuator.backlash"]["width"].any()),
-        lim=G1_EFFORT_LIMIT if limit == 1.0 else limit * G1_EFFORT_LIMIT,
+        lim=lim,
+        neg_lim=-lim,
+        half_backlash=0.5 * backlash,
     )
 
 
@@ -265,6 +277,18 @@ class _Seg:
     """Delayed velocity commands [rad/s], shape [H+1, 29]."""
     tff: np.ndarray
     """Delayed feed-forward torques [N*m], shape [H+1, 29]."""
+    kp: np.ndarray
+    """Logged position gains of each step [N*m/rad], shape [H+1, 29]."""
+    kd: np.ndarray
+    """Logged velocity gains of each step [N*m*s/rad], shape [H+1, 29]."""
+    gkd: np.ndarray
+    """Realised velocity gains (gain scale times ``kd``) [N*m*s/rad], shape [H+1, 29]."""
+    qpos: np.ndarray
+    """View of the joint coordinates in ``d.qpos`` [rad], shape [29]."""
+    qvel: np.ndarray
+    """View of the joint velocities in ``d.qvel`` [rad/s], shape [29]."""
+    qfrc: np.ndarray
+    """View of the joint entries of ``d.qfrc_applied`` [N*m], shape [29]."""
     qm: np.ndarray = field(default_factory=lambda: np.zeros(29))
     """Encoder reading of the current step [rad]."""
     tau: np.ndarray = field(default_factory=lambda: np.zeros(29))
@@ -289,7 +313,8 @@ class Replayer:
             cfg = replace(cfg, sim=replace(cfg.sim, fixed_base=True, ground="plane"))
         self.cfg = cfg
         self.rec = rec
-        self.model = build_model(self.cfg.sim)
+        # Visual meshes never collide, but their BVH costs mj_collision more than the rest of a step.
+        self.model = build_model(replace(self.cfg.sim, visual_meshes=False))
         self._jq = slice(0 if self.fixed else 7, None)  # joint coordinates in qpos
         self._jv = slice(0 if self.fixed else 6, None)  # joint dofs in qvel and the dof_* arrays
         self.data = mujoco.MjData(self.model)
@@ -304,11 +329,13 @@ class Replayer:
         self._feet = [m.body(f"{s}_ankle_roll_link").id for s in ("left", "right")]
         self._w = G1_EFFORT_LIMIT / _REF_EFFORT
         self.offsets = np.arange(self.cfg.stride, self.cfg.horizon + 1, self.cfg.stride)
+        self._dt = rec.dt  # a median over the log: taken once, not per segment
         self._base_cache: dict[tuple, BaseTrajectory] = {}
         self._sink_cache: dict[tuple, float] = {}
         self._crater_cache: dict[tuple, np.ndarray] = {}
         self._zmax0: np.ndarray | None = None
         self._pool: list = []
+        self._memo = SegmentMemo(self.cfg.memo_bytes)
         self.sand = SoleRFT(self.cfg.sim.sand) if self.cfg.sim.ground == "sand" else None
         """Nominal 3D-RFT sand on the soles (None on the plane ground)."""
         self.gyro_att = attitude_rate_residual(rec.imu_quat, rec.imu_gyro, rec.dt, self.cfg.attitude_half_window)
@@ -472,7 +499,7 @@ class Replayer:
     def _commands(self, k0: int, delay: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """Commands applied at samples ``k0..k0+H``, delayed by linear interpolation, shapes [H+1, 29]."""
         r = self.rec
-        s = np.arange(k0, k0 + self.cfg.horizon + 1) - delay / r.dt
+        s = np.arange(k0, k0 + self.cfg.horizon + 1) - delay / self._dt
         i0 = np.clip(np.floor(s).astype(int), 0, r.n - 1)
         i1 = np.clip(i0 + 1, 0, r.n - 1)
         w = np.clip(s - np.floor(s), 0.0, 1.0)[:, None]
@@ -498,14 +525,32 @@ class Replayer:
             params: ``{effect_id: flat parameter vector}``; missing ids are nominal.
             starts: Segment start samples, shape [S].
         """
+        if self.sand is None:
+            return self._simulate_remembered(params, starts)
         h = _unpack(params)
         self._set_model(h)
         base = self.base(params, starts)
         out = np.zeros((len(starts), len(self.offsets), N_CHANNELS))
-        if self.sand is None:
-            return self._simulate_serial(h, base, starts, out)
         self._zmax0 = self.crater_memory(params)[starts].reshape(-1)
         return self._simulate_side_by_side(h, base, starts, out)
+
+    def _simulate_remembered(self, params: dict[str, np.ndarray], starts: np.ndarray) -> np.ndarray:
+        """Serial replay of the segments the memory does not hold; the others come from it."""
+        key = params_key(params)
+        out = np.zeros((len(starts), len(self.offsets), N_CHANNELS))
+        new = np.ones(len(starts), bool)
+        for i, k0 in enumerate(starts):
+            y = self._memo.get(key, int(k0))
+            if y is not None:
+                out[i], new[i] = y, False
+        if new.any():
+            h = _unpack(params)
+            self._set_model(h)
+            todo = starts[new]
+            out[new] = self._simulate_serial(h, self.base(params, todo), todo, out[new])
+            for k0, y in zip(todo, out[new], strict=True):
+                self._memo.put(key, int(k0), y)
+        return out
 
     def _simulate_side_by_side(self, h: _Hyp, base: BaseTrajectory, starts: np.ndarray, out: np.ndarray) -> np.ndarray:
         """Step all segments together, one ``MjData`` each, so the ground forces take one call per step."""
@@ -527,20 +572,34 @@ class Replayer:
         """Replay the segments one after the other in one ``MjData`` (plane or welded pelvis); fills ``out``.
 
         Without sand no force couples the segments, so each one runs its whole horizon before the next starts.
-        The arithmetic is that of the side-by-side loop, bit for bit, but one ``MjData`` stays in the CPU cache:
-        stepping hundreds of them in turn (each touches ~1 MB) made ``mj_step1`` cost 2-4x its lone cost.
+        The arithmetic is that of the side-by-side loop (:meth:`_seg_pre`, :meth:`_seg_post`), bit for bit, but
+        one ``MjData`` stays in the CPU cache (stepping hundreds of them in turn made ``mj_step1`` cost 2-4x its
+        lone cost), and it sets the per-step damping once per step and the welded pelvis once per segment.
         """
-        d = self._datas(1)[0]
-        n_cmp = len(self.offsets)
+        import mujoco
+
+        m, d = self.model, self._datas(1)[0]
+        step1, step2, terrain = mujoco.mj_step1, mujoco.mj_step2, not self.fixed and h.terrain.active()
+        horizon, substeps, n_cmp = self.cfg.horizon, self.cfg.substeps, len(self.offsets)
+        damping = m.dof_damping[self._jv]  # a view: mj_setConst and the effects keep the buffer in place
         for s, k0 in enumerate(starts):
             seg = self._seg_start(h, base, s, int(k0), d)
+            if seg.pelvis_quat is not None:
+                m.body_quat[self._pelvis] = seg.pelvis_quat
             p = 0
-            for j in range(self.cfg.horizon + 1):
-                for sub in range(self.cfg.substeps):
+            for j in range(horizon + 1):
+                for sub in range(substeps):
                     at_compare = sub == 0 and p < n_cmp and j == self.offsets[p]
-                    self._seg_pre(h, seg, j, at_compare)
-                    self._ground(h, [d], reset=j == 0 and sub == 0)
-                    self._seg_post(h, seg, j, out[s, p] if at_compare else None)
+                    damping[:] = seg.damping[j]
+                    step1(m, d)
+                    if at_compare and not self.fixed:
+                        seg.w_imu = d.qvel[3:6].copy()
+                    self._torque(h, seg, j)
+                    if terrain:
+                        self._terrain(h.terrain, d)
+                    step2(m, d)
+                    if at_compare:
+                        self._observe(h, seg, out[s, p])
                     p += int(at_compare)
         return out
 
@@ -558,16 +617,18 @@ class Replayer:
         d.qpos[self._jq] = r.q[k0] - h.offset
         d.qvel[self._jv] = r.dq[k0]
         qc, dqc, tff = self._commands(k0, h.delay)
-        damping = h.gain * r.kd[k0 : k0 + self.cfg.horizon + 1] + h.b * self._w + h.b_leg
-        return _Seg(d, k0, damping, qc, dqc, tff, pelvis_quat=base.quat[s] if self.fixed else None)
+        rows = slice(k0, k0 + self.cfg.horizon + 1)
+        kp, kd = r.kp[rows], r.kd[rows]
+        damping = h.gain * kd + h.b * self._w + h.b_leg
+        views = d.qpos[self._jq], d.qvel[self._jv], d.qfrc_applied[self._jv]
+        pelvis = base.quat[s] if self.fixed else None
+        return _Seg(d, k0, damping, qc, dqc, tff, kp, kd, h.gain * kd, *views, pelvis_quat=pelvis)
 
     def _seg_pre(self, h: _Hyp, seg: _Seg, j: int, at_compare: bool) -> None:
         """First half of a physics step of one segment: kinematics, motor torques (PD on the encoders)."""
         import mujoco
 
-        m, d, r = self.model, seg.d, self.rec
-        k = seg.k0 + j
-        kp, kd = r.kp[k], r.kd[k]
+        m, d = self.model, seg.d
         # Damping enters qfrc_passive in mj_step1 and the implicit Euler update in mj_step2: set it first.
         m.dof_damping[self._jv] = seg.damping[j]
         if seg.pelvis_quat is not None:  # segments share the model: put this segment's welded pelvis in place
@@ -575,16 +636,24 @@ class Replayer:
         mujoco.mj_step1(m, d)
         if at_compare and not self.fixed:
             seg.w_imu = d.qvel[3:6].copy()  # angular velocity the gyro sensor saw
-        seg.qm = d.qpos[self._jq] + h.offset
-        v = d.qvel[self._jv]
+        self._torque(h, seg, j)
+
+    @staticmethod
+    def _torque(h: _Hyp, seg: _Seg, j: int) -> None:
+        """Motor torques of step ``j`` (PD on the encoders) into ``seg.tau``, and the applied joint forces."""
+        seg.qm = seg.qpos + h.offset
+        v = seg.qvel
         err = seg.qc[j] - seg.qm
         if h.has_backlash:  # dead band of the position loop; at zero width the error passes unchanged
-            err = err - np.clip(err, -0.5 * h.backlash, 0.5 * h.backlash)
-        tau = h.gain * (kp * err + kd * (seg.dqc[j] - v)) + seg.tff[j]
-        lim = h.lim if h.droop == 0.0 else h.lim * np.clip(1.0 - h.droop * np.abs(v), 0.0, None)
-        seg.tau = np.minimum(np.maximum(tau, -lim), lim)  # np.clip, without its Python dispatch
+            err = err - np.minimum(np.maximum(err, -h.half_backlash), h.half_backlash)  # np.clip, no dispatch
+        tau = h.gain * (seg.kp[j] * err + seg.kd[j] * (seg.dqc[j] - v)) + seg.tff[j]
+        if h.droop == 0.0:
+            seg.tau = np.minimum(np.maximum(tau, h.neg_lim), h.lim)
+        else:
+            lim = h.lim * np.clip(1.0 - h.droop * np.abs(v), 0.0, None)
+            seg.tau = np.minimum(np.maximum(tau, -lim), lim)
         # The -kd*dq part is integrated implicitly through dof_damping (Euler integrator), so add it back.
-        d.qfrc_applied[self._jv] = seg.tau + h.gain * kd * v
+        seg.qfrc[:] = seg.tau + seg.gkd[j] * v
 
     def _seg_post(self, h: _Hyp, seg: _Seg, j: int, out: np.ndarray | None) -> None:
         """Second half of the physics step; write the simulated measurements into ``out`` [N_CHANNELS] if given."""
@@ -593,8 +662,12 @@ class Replayer:
         m, d = self.model, seg.d
         m.dof_damping[self._jv] = seg.damping[j]
         mujoco.mj_step2(m, d)
-        if out is None:
-            return
+        if out is not None:
+            self._observe(h, seg, out)
+
+    def _observe(self, h: _Hyp, seg: _Seg, out: np.ndarray) -> None:
+        """Write the simulated measurements of a segment after its physics step into ``out`` [N_CHANNELS]."""
+        m, d = self.model, seg.d
         rmis_t = h.rmis_t
         out[:29] = seg.qm
         out[29:58] = d.qvel[self._jv]

@@ -168,9 +168,27 @@ def _write_json(path: Path, obj: dict) -> None:
     tmp.replace(path)
 
 
+def _run_all(args: list[tuple], workers: int, suite: str) -> list[dict]:
+    """Run the episodes in ``workers`` processes, in order, with a progress bar on stderr; return their rows."""
+    from rich.console import Console
+    from rich.progress import Progress, TimeElapsedColumn
+
+    from gmloco.deploy.mismatch.benchmark.sweep import _star
+
+    done = []
+    columns = (*Progress.get_default_columns(), TimeElapsedColumn())
+    with Pool(workers) as pool, Progress(*columns, console=Console(stderr=True)) as prog:
+        task = prog.add_task(f"{suite}: {len(args)} episodes", total=len(args))
+        for row in pool.imap(_star, args, chunksize=1):
+            done.append(row)
+            outcome = row.get("verdict") or ("error" if "error" in row else "skipped")
+            prog.update(task, advance=1, description=f"{suite}: {row['name']} {outcome}")
+    return done
+
+
 def main(argv: list[str] | None = None) -> int:
     """Run (part of) one suite, then score it and the pool; exit 2 on bad arguments."""
-    from gmloco.deploy.mismatch.benchmark.sweep import _git_commit, _part, _star
+    from gmloco.deploy.mismatch.benchmark.sweep import _git_commit, _part
 
     p = argparse.ArgumentParser(prog="mismatch-benchmark-v5", description=__doc__)
     p.add_argument("--out", type=Path, required=True, help="v5 results directory (suites go to OUT/<suite>)")
@@ -202,8 +220,7 @@ def main(argv: list[str] | None = None) -> int:
         t0 = time.time()
         deadline = None if a.deadline_s is None else t0 + a.deadline_s
         args = [(e, str(out), e["duration"], None, None, deadline) for e in todo]
-        with Pool(a.workers) as pool:
-            done = pool.map(_star, args, chunksize=1)
+        done = _run_all(args, a.workers, a.suite)
         run = {"suite": a.suite, "argv": argv if argv is not None else sys.argv[1:], "ran": [r["name"] for r in done
                if "skipped" not in r], "wall_s": time.time() - t0, "cpus": os.cpu_count(), "git": _git_commit()}  # fmt: skip
         (out / "runs").mkdir(exist_ok=True)
