@@ -12,20 +12,11 @@ end=$1
 run=gm_loco_teacher_calibrated
 cd ~/src
 source scripts/gpu/env.sh
-mkdir -p ~/chunks/teacher ~/chunks/reward_ab "artifacts/$run" results/sand_calibration
+mkdir -p ~/chunks/teacher "artifacts/$run" results/sand_calibration
 cp .devsrc/checkpoint.pt "artifacts/$run/checkpoint.pt"
 cp .devsrc/rft3d_calibrated.json results/sand_calibration/rft3d_calibrated.json
 nvidia-smi --query-gpu=name,memory.total --format=csv > ~/chunks/gpu.txt 2>&1
-ab() {  # NAME, then bench_tasks.py arguments
-  local name=$1; shift
-  ( WARP_CACHE_PATH=$HOME/.wc_ab_$name timeout "$(( end - $(date +%s) - 60 ))" python3 scripts/gpu/bench_tasks.py \
-      --tasks Gmloco-Velocity-Rigid-Flat-G1 --import gmloco.train.tasks.registry --num-envs 4096 \
-      --iterations 150 --sim-steps 50 "$@" --out ~/chunks/reward_ab/$name.json > ~/chunks/reward_ab/$name.log 2>&1
-    echo "rc $?" >> ~/chunks/reward_ab/$name.log ) &
-}
-ab default
-ab action_rate --reward-weight action_rate_lower_l2=-0.1 --reward-weight action_rate_upper_l2=-0.1
-ab no_termination --reward-weight termination_penalty=0
+REWARD_AB_ITERATIONS=150 REWARD_AB_NESTED=1 bash scripts/gpu/jobs/reward_ab.sh "$end" &
 mins=$(python3 -c "import time; print(round(($end - time.time())/60 - 0.6, 2))")
 echo "teacher chunk: max-minutes $mins" > ~/chunks/job.log
 python3 scripts/gpu/train_ts_chunk.py --stage teacher --run "$run" --contact-model rft3d_calibrated \
