@@ -125,7 +125,11 @@ def bench_ppo(
         rl_cfg.algorithm.entropy_coef = entropy_coef
     for name, weight in (reward_weights or {}).items():
         if name not in env_cfg.rewards:
-            sys.exit(f"--reward-weight {name}: no such reward term in {task}; terms: {sorted(env_cfg.rewards)}")
+            print(
+                f"--reward-weight {name}: no such reward term in {task}; terms: {sorted(env_cfg.rewards)}",
+                file=sys.stderr,
+            )
+            sys.exit(2)
         env_cfg.rewards[name].weight = weight
     t_build = time.perf_counter()
     env = ManagerBasedRlEnv(cfg=env_cfg, device=device)
