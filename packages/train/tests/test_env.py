@@ -91,3 +91,19 @@ def test_rough_and_deep_terrains_step(make_env, terrain: str) -> None:  # noqa: 
     if terrain == "deep":
         np.testing.assert_allclose(floor_z, -0.30, atol=1e-6)
     assert env.sand.task.terrain.kind == terrain
+
+
+def test_diverged_world_is_reset_before_its_nans_reach_the_policy(make_env) -> None:  # noqa: ANN001
+    """A world whose physics state turns NaN ends by ``physics_diverged`` and restarts finite; its neighbour runs on."""
+    env = make_env(g1_granular_task("rft3d"), num_envs=2)
+    env.reset()
+    env.step(torch.zeros(2, NUM_JOINTS))
+    env.sim.data.qvel[1] = float("nan")
+    obs, _, terminated, truncated, _ = env.step(torch.zeros(2, NUM_JOINTS))
+    assert env.termination_manager.get_term("physics_diverged").tolist() == [False, True]
+    assert terminated.tolist() == [False, True] and not truncated.any()
+    assert torch.isfinite(obs["actor"]).all() and torch.isfinite(obs["critic"]).all()
+    assert torch.isfinite(env.sim.data.qpos[:]).all() and torch.isfinite(env.sim.data.qvel[:]).all()
+    for _ in range(3):
+        obs, reward, terminated, *_ = env.step(torch.zeros(2, NUM_JOINTS))
+        assert torch.isfinite(obs["critic"]).all() and torch.isfinite(reward).all() and not terminated.any()

@@ -112,9 +112,14 @@ class FootContactTracker:
         return self
 
     def reset(self, env_ids: torch.Tensor) -> None:
-        """Clear the timers of ``env_ids`` (episode start)."""
+        """Clear the timers and this step's signals of ``env_ids`` (episode start).
+
+        The signals were refreshed from the state the episode ended in, which is non-finite when its physics
+        diverged; the observations of the reset step read them, so they restart at zero until the next step.
+        """
         for buf in (self.air_time, self.contact_time, self.last_air_time, self.landing_force, self.swing_peak,
-                    self.stance_low, self.last_swing_apex, self.last_swing_lift):  # fmt: skip
+                    self.stance_low, self.last_swing_apex, self.last_swing_lift, self.force_w, self.force_norm,
+                    self.height, self.vel_w, self.slip_speed, self.roll, self.pitch):  # fmt: skip
             buf[env_ids] = 0.0
         self.in_contact[env_ids] = False
         self.first_contact[env_ids] = False

@@ -10,6 +10,7 @@ from functools import partial
 from mjlab.asset_zoo.robots import get_g1_robot_cfg
 from mjlab.envs import ManagerBasedRlEnvCfg
 from mjlab.envs.mdp.actions import JointPositionActionCfg
+from mjlab.envs.mdp.terminations import nan_detection
 from mjlab.managers.termination_manager import TerminationTermCfg
 from mjlab.scene import SceneCfg
 from mjlab.sensor import ContactMatch, ContactSensorCfg
@@ -112,12 +113,22 @@ def _command(task: GranularTaskCfg) -> UniformVelocityCommandCfg:
     )
 
 
+NJMAX = 400
+"""Constraint rows per world. On the deep sand floor a stance foot, a shin and a falling torso can need 300-360 rows;
+a world past this drops its rows (MuJoCo Warp's "nefc overflow") and may blow up, which ``physics_diverged`` catches."""
+
+
 def _terminations(task: GranularTaskCfg) -> dict[str, TerminationTermCfg]:
-    """Time out, falling over (70 deg) or the pelvis sinking below 0.3 m above the sand."""
+    """Time out, falling over (70 deg), the pelvis sinking below 0.3 m above the sand, or a non-finite physics state.
+
+    The last resets a world whose simulation diverged before its NaNs reach the observations (and through the
+    observation normalizer, every parameter of the policy).
+    """
     return {
         "time_out": TerminationTermCfg(func=vel_mdp.time_out, time_out=True),
         "fell_over": TerminationTermCfg(func=vel_mdp.bad_orientation, params={"limit_angle": math.radians(70.0)}),
         "base_too_low": TerminationTermCfg(func=mdp.base_height_below, params={"min_height": 0.3}),
+        "physics_diverged": TerminationTermCfg(func=nan_detection),
     }
 
 
@@ -150,7 +161,7 @@ def make_g1_granular_env_cfg(
             distance=3.0,
         ),
         sim=SimulationCfg(
-            njmax=300,
+            njmax=NJMAX,
             contact_sensor_maxmatch=64,
             mujoco=MujocoCfg(timestep=0.005, iterations=10, ls_iterations=20, ccd_iterations=50),
         ),

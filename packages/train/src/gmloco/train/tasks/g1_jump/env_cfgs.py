@@ -7,6 +7,7 @@ import math
 
 from mjlab.envs import ManagerBasedRlEnvCfg
 from mjlab.envs import mdp as envs_mdp
+from mjlab.envs.mdp.terminations import nan_detection
 from mjlab.managers.curriculum_manager import CurriculumTermCfg
 from mjlab.managers.event_manager import EventTermCfg
 from mjlab.managers.observation_manager import ObservationGroupCfg, ObservationTermCfg
@@ -17,7 +18,7 @@ from mjlab.tasks.velocity import mdp as vel_mdp
 from mjlab.viewer import ViewerConfig
 
 from gmloco.train import mdp as granular_mdp
-from gmloco.train.tasks.g1_granular.env_cfgs import _scene
+from gmloco.train.tasks.g1_granular.env_cfgs import NJMAX, _scene
 from gmloco.train.tasks.g1_granular.events_cfg import make_events_cfg
 from gmloco.train.tasks.g1_granular.observations_cfg import _noise
 from gmloco.train.tasks.g1_jump import mdp
@@ -94,12 +95,13 @@ def _rewards(task: JumpTaskCfg) -> dict[str, RewardTermCfg]:
 
 
 def _terminations(task: JumpTaskCfg) -> dict[str, TerminationTermCfg]:
-    """The walk task's failure rules (70 deg tilt, pelvis 0.3 m above the sand) plus losing the reference."""
+    """The walk task's failure rules (70 deg tilt, pelvis 0.3 m above the sand) plus losing the reference or a non-finite physics state."""
     return {
         "time_out": TerminationTermCfg(func=vel_mdp.time_out, time_out=True),
         "fell_over": TerminationTermCfg(func=vel_mdp.bad_orientation, params={"limit_angle": math.radians(70.0)}),
         "base_too_low": TerminationTermCfg(func=granular_mdp.base_height_below, params={"min_height": 0.3}),
         "tracking_lost": TerminationTermCfg(func=mdp.tracking_lost, params={"max_error": task.max_base_pos_error}),
+        "physics_diverged": TerminationTermCfg(func=nan_detection),
     }
 
 
@@ -137,7 +139,7 @@ def make_g1_jump_env_cfg(task: JumpTaskCfg, num_envs: int = 4096) -> ManagerBase
             origin_type=ViewerConfig.OriginType.ASSET_BODY, entity_name="robot", body_name="torso_link", distance=3.0
         ),
         sim=SimulationCfg(
-            njmax=300,
+            njmax=NJMAX,
             contact_sensor_maxmatch=64,
             mujoco=MujocoCfg(timestep=0.005, iterations=10, ls_iterations=20, ccd_iterations=50),
         ),
