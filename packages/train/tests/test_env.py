@@ -107,3 +107,14 @@ def test_diverged_world_is_reset_before_its_nans_reach_the_policy(make_env) -> N
     for _ in range(3):
         obs, reward, terminated, *_ = env.step(torch.zeros(2, NUM_JOINTS))
         assert torch.isfinite(obs["critic"]).all() and torch.isfinite(reward).all() and not terminated.any()
+
+
+def test_world_that_blows_up_without_nans_is_reset(make_env) -> None:  # noqa: ANN001
+    """A world moving faster than any G1 motion (a finite blow-up) ends by ``physics_diverged`` as a NaN one does."""
+    env = make_env(g1_granular_task("rft3d"), num_envs=2)
+    env.reset()
+    env.step(torch.zeros(2, NUM_JOINTS))
+    env.sim.data.qvel[0, 8] = 1e6
+    *_, terminated, _, _ = env.step(torch.zeros(2, NUM_JOINTS))
+    assert env.termination_manager.get_term("physics_diverged").tolist() == [True, False]
+    assert terminated.tolist() == [True, False]

@@ -40,7 +40,7 @@ from gmloco.train.mdp.rewards import (
     undesired_contacts,
     variable_posture_l1,
 )
-from gmloco.train.mdp.terminations import base_height_below, roll_pitch_exceeds
+from gmloco.train.mdp.terminations import base_height_below, physics_diverged, roll_pitch_exceeds
 
 __all__ = [
     "action_rate_l2",
@@ -69,6 +69,7 @@ __all__ = [
     "joint_vel_l2",
     "lin_vel_z_l2",
     "no_fly",
+    "physics_diverged",
     "reward_ramp",
     "roll_pitch_exceeds",
     "sand_floor_levels",

@@ -7,13 +7,29 @@ from typing import TYPE_CHECKING
 
 import torch
 from mjlab.managers.scene_entity_config import SceneEntityCfg
+from mjlab.utils.nan_guard import NanGuard
 
 from gmloco.train.sand import get_sand
 
 if TYPE_CHECKING:
     from mjlab.envs import ManagerBasedRlEnv
 
-__all__ = ["base_height_below", "roll_pitch_exceeds"]
+__all__ = ["MAX_PHYSICAL_SPEED", "base_height_below", "physics_diverged", "roll_pitch_exceeds"]
+
+MAX_PHYSICAL_SPEED = 200.0
+"""Largest |qvel| component of a G1 world whose simulation has not diverged [rad/s or m/s]: over 5x the fastest
+joint's velocity limit (37 rad/s); a fall stays far below it."""
+
+
+def physics_diverged(env: ManagerBasedRlEnv, max_speed: float = MAX_PHYSICAL_SPEED) -> torch.Tensor:
+    """True where the physics state is non-finite or any generalized velocity exceeds ``max_speed``.
+
+    A world that overflows its constraint rows can blow up without turning NaN at once; its rewards (joint
+    acceleration, energy) then reach 1e10 and wreck the critic. Ending it here resets it before its next observation.
+    """
+    data = env.sim.data
+    return NanGuard.detect_nans(data) | (torch.abs(data.qvel) > max_speed).any(dim=-1)
+
 
 _ROBOT = SceneEntityCfg("robot")
 

@@ -21,6 +21,16 @@ __all__ = ["CHECKPOINT_PATTERN", "GmlocoOnPolicyRunner", "latest_checkpoint"]
 CHECKPOINT_PATTERN = re.compile(r"^model_(\d+)\.pt$")
 """File names of checkpoints: ``model_<iteration>.pt``."""
 
+STEP_REWARD_LIMIT = 100.0
+"""Bound on one env step's reward (the reward manager's weighted sum, already x step dt). A healthy step stays
+within +-20 (the -200 termination penalty is -4); a world whose simulation blew up can reach -1e10 in the step
+before ``physics_diverged`` resets it, which would wreck the critic."""
+
+
+def bounded_step_reward(rewards: torch.Tensor, limit: float = STEP_REWARD_LIMIT) -> torch.Tensor:
+    """Clamp each env's step reward to [-limit, limit] (non-finite values are zeroed by mjlab's reward manager)."""
+    return rewards.clamp(-limit, limit)
+
 
 def latest_checkpoint(run_dir: str | Path) -> Path | None:
     """Return the checkpoint with the highest iteration in ``run_dir`` (None if there is none)."""
@@ -90,6 +100,7 @@ class GmlocoOnPolicyRunner(MjlabOnPolicyRunner):
                 actions = self.alg.act(obs)
                 obs, rewards, dones, extras = self.env.step(actions.to(self.env.device))
                 obs, rewards, dones = obs.to(self.device), rewards.to(self.device), dones.to(self.device)
+                rewards = bounded_step_reward(rewards)
                 self.alg.process_env_step(obs, rewards, dones, extras)
                 self.logger.process_env_step(rewards, dones, extras, None)
             collect_time = time.time() - start

@@ -10,7 +10,6 @@ from functools import partial
 from mjlab.asset_zoo.robots import get_g1_robot_cfg
 from mjlab.envs import ManagerBasedRlEnvCfg
 from mjlab.envs.mdp.actions import JointPositionActionCfg
-from mjlab.envs.mdp.terminations import nan_detection
 from mjlab.managers.termination_manager import TerminationTermCfg
 from mjlab.scene import SceneCfg
 from mjlab.sensor import ContactMatch, ContactSensorCfg
@@ -119,16 +118,16 @@ a world past this drops its rows (MuJoCo Warp's "nefc overflow") and may blow up
 
 
 def _terminations(task: GranularTaskCfg) -> dict[str, TerminationTermCfg]:
-    """Time out, falling over (70 deg), the pelvis sinking below 0.3 m above the sand, or a non-finite physics state.
+    """Time out, falling over (70 deg), the pelvis sinking below 0.3 m above the sand, or diverged physics.
 
-    The last resets a world whose simulation diverged before its NaNs reach the observations (and through the
-    observation normalizer, every parameter of the policy).
+    The last resets a world whose simulation blew up (non-finite, or faster than any G1 motion) before its state
+    reaches the observations (and through the observation normalizer, every parameter of the policy).
     """
     return {
         "time_out": TerminationTermCfg(func=vel_mdp.time_out, time_out=True),
         "fell_over": TerminationTermCfg(func=vel_mdp.bad_orientation, params={"limit_angle": math.radians(70.0)}),
         "base_too_low": TerminationTermCfg(func=mdp.base_height_below, params={"min_height": 0.3}),
-        "physics_diverged": TerminationTermCfg(func=nan_detection),
+        "physics_diverged": TerminationTermCfg(func=mdp.physics_diverged),
     }
 
 

@@ -7,7 +7,6 @@ import math
 
 from mjlab.envs import ManagerBasedRlEnvCfg
 from mjlab.envs import mdp as envs_mdp
-from mjlab.envs.mdp.terminations import nan_detection
 from mjlab.managers.curriculum_manager import CurriculumTermCfg
 from mjlab.managers.event_manager import EventTermCfg
 from mjlab.managers.observation_manager import ObservationGroupCfg, ObservationTermCfg
@@ -95,13 +94,13 @@ def _rewards(task: JumpTaskCfg) -> dict[str, RewardTermCfg]:
 
 
 def _terminations(task: JumpTaskCfg) -> dict[str, TerminationTermCfg]:
-    """The walk task's failure rules (70 deg tilt, pelvis 0.3 m above the sand) plus losing the reference or a non-finite physics state."""
+    """The walk task's failure rules (70 deg tilt, pelvis 0.3 m above the sand) plus losing the reference or diverged physics."""
     return {
         "time_out": TerminationTermCfg(func=vel_mdp.time_out, time_out=True),
         "fell_over": TerminationTermCfg(func=vel_mdp.bad_orientation, params={"limit_angle": math.radians(70.0)}),
         "base_too_low": TerminationTermCfg(func=granular_mdp.base_height_below, params={"min_height": 0.3}),
         "tracking_lost": TerminationTermCfg(func=mdp.tracking_lost, params={"max_error": task.max_base_pos_error}),
-        "physics_diverged": TerminationTermCfg(func=nan_detection),
+        "physics_diverged": TerminationTermCfg(func=granular_mdp.physics_diverged),
     }
 
 
