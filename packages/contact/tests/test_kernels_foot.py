@@ -1,4 +1,6 @@
 # SPDX-License-Identifier: Apache-2.0
+# Warp kernel DSL (``wp.tid()`` unpacking, array stores) is not typeable; see the pyright ``exclude`` note.
+# pyright: reportIndexIssue=false, reportAssignmentType=false, reportGeneralTypeIssues=false
 """The per-element kernels' opening block (``kernels_foot``): read a foot, and leave an element of a bad one."""
 
 from __future__ import annotations
