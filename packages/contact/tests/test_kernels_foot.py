@@ -57,7 +57,8 @@ def test_a_bad_foot_skips_its_elements_and_leaves_the_others(cfg: ContactModelCf
         model = make_contact_model(cfg, W, F, device)
         model.fused = False
         wrench = wp.zeros((W, F), dtype=wp.spatial_vector, device=device)  # type: ignore[arg-type]
-        model.compute(*_feet(bad), wrench)
+        pos, rot, lin_vel, ang_vel, com = _feet(bad)
+        model.compute(pos, rot, lin_vel, ang_vel, com, wrench)
         outputs.append([model.point_force.numpy(), model.point_depth.numpy(), model.point_vel.numpy()])
         assert model.nan_count.numpy()[0] == (model.num_points if bad else 0)
     clean, dirty = outputs
