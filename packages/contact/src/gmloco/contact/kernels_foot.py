@@ -26,7 +26,7 @@ def read_foot_state(  # noqa: ANN201 (returns the tuple vec3, mat33, vec3, vec3,
 ):
     """Return foot [w, f]'s position [m], rotation, linear [m/s] and angular [rad/s] velocity, and whether all are finite.
 
-    The four reads and the check open every per-element kernel and the fused 3D-RFT kernel.
+    The four reads and the check open every per-element kernel, the fused 3D-RFT kernel and the state update.
     """
     pos = foot_pos_in[w, f]
     rot = foot_mat_in[w, f]
