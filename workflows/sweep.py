@@ -30,15 +30,16 @@ import math
 import sys
 import time
 from collections.abc import Mapping, Sequence
-from dataclasses import dataclass, fields, is_dataclass, replace
+from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
-from omegaconf import DictConfig, OmegaConf
+from omegaconf import DictConfig, ListConfig, OmegaConf
 
 if not __package__:  # run as ``python workflows/<name>.py``: the checkout root makes ``workflows`` importable
     sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
+from workflows.config_paths import dataclass_from_node, dataclass_node, path_problem
 from workflows.manifest import StageStatus
 from workflows.pipeline_report import console
 from workflows.pipeline_run import EXIT_FAILED, EXIT_INCOMPLETE, EXIT_OK, run_pipeline
@@ -141,63 +142,40 @@ def parse_space(params: Mapping[str, Any]) -> list[SearchParam]:
     return space
 
 
-def _coerce(current: Any, value: Any) -> Any:
-    """Give ``value`` the type of the field it replaces (float fields accept ints, tuples accept lists)."""
-    if isinstance(current, bool) or current is None:
-        return value
-    if isinstance(current, float) and isinstance(value, int | float):
-        return float(value)
-    if isinstance(current, int) and isinstance(value, float) and value.is_integer():
-        return int(value)
-    if isinstance(current, tuple) and isinstance(value, list | tuple):
-        return tuple(value)
-    return value
+def _bad_path(node: Any, path: str, key: str, prefix: str = "") -> None:
+    """Raise when ``path`` names no key of ``node``; the message lists the valid keys of the section it left."""
+    if (problem := path_problem(node, path, prefix)) is not None:
+        raise _bad(key, problem)
 
 
-def _set_path(obj: Any, parts: Sequence[str], value: Any, key: str) -> Any:
-    """Return a copy of ``obj`` (dataclass or tuple) with the field at ``parts`` set to ``value``."""
-    head, rest = parts[0], parts[1:]
-    if isinstance(obj, tuple):
-        if not head.isdigit() or int(head) >= len(obj):
-            raise _bad(key, f"'{head}' is not an index of a {len(obj)}-tuple.")
-        items = list(obj)
-        items[int(head)] = _set_path(items[int(head)], rest, value, key) if rest else _coerce(items[int(head)], value)
-        return tuple(items)
-    names = [f.name for f in fields(obj)] if is_dataclass(obj) and not isinstance(obj, type) else []
-    if head not in names or isinstance(obj, type):
-        raise _bad(key, f"no field '{head}' in {type(obj).__name__}; valid: {', '.join(names) or '(none)'}.")
-    current = getattr(obj, head)
-    new = _set_path(current, rest, value, key) if rest else _coerce(current, value)
-    return replace(obj, **{head: new})
-
-
-def _check_ranges(task: Any, keys: Sequence[str]) -> None:
+def _check_ranges(node: DictConfig, keys: Sequence[str]) -> None:
     """Raise when a range whose end was set has low > high."""
     for key in keys:
-        parts = key.removeprefix(TASK_PREFIX).split(".")
-        if not parts[-1].isdigit():
-            continue
-        node = task
-        for part in parts[:-1]:
-            node = node[int(part)] if isinstance(node, tuple) else getattr(node, part)
-        if len(node) == 2 and node[0] > node[1]:
-            raise _bad(key, f"can make the range {list(node)} empty (low > high); narrow its bounds.")
+        parent, _, end = key.removeprefix(TASK_PREFIX).rpartition(".")
+        pair = OmegaConf.select(node, parent) if end.isdigit() else None
+        if isinstance(pair, ListConfig) and len(pair) == 2 and pair[0] > pair[1]:
+            raise _bad(key, f"can make the range {list(pair)} empty (low > high); narrow its bounds.")
 
 
 def apply_task_overrides(task: Any, overrides: Mapping[str, Any]) -> Any:
-    """Return ``task`` (a ``GranularTaskCfg``) with ``task.<path>`` values set; range ends are checked."""
+    """Return ``task`` (a ``GranularTaskCfg``) with ``task.<path>`` values set; range ends are checked.
+
+    Each path is OmegaConf's (``OmegaConf.update`` on the task as a node), as for the ``train_teacher.*`` keys.
+    """
+    node = dataclass_node(task)
     for key, value in overrides.items():
-        task = _set_path(task, key.removeprefix(TASK_PREFIX).split("."), value, key)
-    _check_ranges(task, list(overrides))
-    return task
+        path = key.removeprefix(TASK_PREFIX)
+        _bad_path(node, path, key, TASK_PREFIX)
+        OmegaConf.update(node, path, value, merge=True)
+    _check_ranges(node, list(overrides))
+    return dataclass_from_node(task, node)
 
 
 def check_space(cfg: DictConfig, space: Sequence[SearchParam], fixed: Mapping[str, Any]) -> None:
     """Check every key before the first trial: config keys exist; task paths exist; no range can become empty."""
-    missing = object()
     for p in space:
-        if p.key.startswith(CONFIG_PREFIX) and OmegaConf.select(cfg, p.key, default=missing) is missing:
-            raise _bad(f"sweep.params.{p.key}", "not a key of the config.")
+        if p.key.startswith(CONFIG_PREFIX):
+            _bad_path(cfg, p.key, f"sweep.params.{p.key}")
     task_params = [p for p in space if p.key.startswith(TASK_PREFIX)]
     if not task_params and not fixed:
         return
@@ -262,19 +240,6 @@ class Objective:
 # One trial.
 
 
-def _train_kwargs(section: DictConfig, task: Any) -> dict[str, Any]:
-    """``TrainRunCfg`` fields of the train stage, as ``train_teacher.run`` builds them, with the trial's task."""
-    from workflows.policy_training import teacher_cfg, vanilla_ppo_overrides
-
-    kwargs: dict[str, Any] = {"task": task, "hidden_dims": tuple(int(d) for d in section.hidden_dims)}
-    if section.algorithm.value == "ppo":
-        return kwargs | {"rsl_rl_overrides": vanilla_ppo_overrides(section), "export_onnx": True}
-    from gmloco.train.teacher_student import ObsGroupsCfg
-
-    overrides = teacher_cfg(section).to_rsl_rl(ObsGroupsCfg())
-    return kwargs | {"rsl_rl_overrides": overrides, "history_length": int(section.history_length), "export_onnx": False}
-
-
 def chunk_ends(total: int, chunks: int) -> list[int]:
     """Iteration counts at which the objective is reported: ``chunks`` near-equal parts of ``total``."""
     n = max(1, min(int(chunks), int(total)))
@@ -293,7 +258,8 @@ class TrialStage:
 
     def __call__(self, cfg: DictConfig) -> dict[str, Any]:
         """Train chunk by chunk (``StageRunner`` passes ``resume`` and ``max_minutes``); return the metrics."""
-        from workflows.policy_training import newest_checkpoint, run_training, task_cfg
+        from workflows import train_teacher
+        from workflows.policy_training import newest_checkpoint, task_cfg
 
         section = cfg.train_teacher
         task = apply_task_overrides(task_cfg(section), self.task_overrides)
@@ -309,7 +275,7 @@ class TrialStage:
             chunk.train_teacher.resume = bool(section.resume) or k > 0
             if deadline is not None:
                 chunk.train_teacher.max_minutes = max(0.0, (deadline - time.monotonic()) / 60.0)
-            metrics = run_training(chunk, "train_teacher", **_train_kwargs(section, task))
+            metrics = train_teacher.run(chunk, task)
             value = self.objective.value(chunk, metrics)
             if value is not None:
                 self.trial.report(value, int(metrics["iteration"]))
@@ -351,7 +317,7 @@ def _trial_cfg(cfg: DictConfig, trial: Any, trial_dir: Path, deadline: float | N
         if key.startswith(TASK_PREFIX):
             task[key] = value
         else:
-            OmegaConf.update(tcfg, key, value, merge=False)
+            OmegaConf.update(tcfg, key, value, merge=True)
     tcfg.sweep.trial_params = {"number": trial.number, "params": dict(trial.params), "task_overrides": task}
     if deadline is not None:
         tcfg.max_minutes = max(0.0, (deadline - time.monotonic()) / 60.0)
@@ -510,6 +476,8 @@ def _space(cfg: DictConfig) -> list[SearchParam]:
 def _setup(cfg: DictConfig) -> tuple[Path, Objective, list[SearchParam], dict[str, Any]]:
     """Check the objective and search space, then seed and write the sweep's resolved config and git state."""
     objective = Objective.parse(str(cfg.sweep.metric))
+    if cfg.train_teacher.get("jump") is not None:
+        raise _bad("train_teacher.jump", "the sweep searches the velocity task (GranularTaskCfg), not the jump task.")
     if objective.source == "eval" and cfg.train_teacher.algorithm.value != "ppo":
         raise _bad(
             "sweep.metric", "eval/<key> objectives need a policy.onnx: only train_teacher.algorithm=ppo exports one."

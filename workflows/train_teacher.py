@@ -38,10 +38,14 @@ from workflows.policy_training import jump_task_cfg, run_training, task_cfg, tea
 __all__ = ["main", "run"]
 
 
-def run(cfg: DictConfig) -> dict[str, float | None]:
-    """Train (or resume) the stage's policy and return its metrics."""
+def run(cfg: DictConfig, task: Any = None) -> dict[str, float | None]:
+    """Train (or resume) the stage's policy and return its metrics.
+
+    ``task``: the velocity task (``GranularTaskCfg``) to train instead of the section's, e.g. a sweep trial's.
+    """
     section = cfg.train_teacher
-    run_cfg: dict[str, Any] = {"task": task_cfg(section), "hidden_dims": tuple(int(d) for d in section.hidden_dims)}
+    task = task_cfg(section) if task is None else task
+    run_cfg: dict[str, Any] = {"task": task, "hidden_dims": tuple(int(d) for d in section.hidden_dims)}
     if section.get("jump") is not None:
         if section.algorithm.value != "ppo":
             raise ValueError(

@@ -2,7 +2,7 @@
 """``workflows/sweep.py``'s command with the training replaced by a cheap deterministic function (sweep tests).
 
 Run as ``python tests/workflows/sweep_fake_worker.py <the sweep's overrides>``: the same Hydra entry, study,
-trial folders, chunked reports and pruner as the real command; only ``policy_training.run_training`` (seconds
+trial folders, chunked reports and pruner as the real command; only ``train_teacher.run_training`` (seconds
 to hours of PPO) becomes ``mean_reward = mu_int low end x iteration`` and the task factory skips mjlab.
 """
 
@@ -16,7 +16,7 @@ from omegaconf import DictConfig
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[2]))
 
-from workflows import policy_training, sweep
+from workflows import policy_training, sweep, train_teacher
 
 
 def fake_run_training(cfg: DictConfig, name: str, **kwargs: Any) -> dict[str, float]:
@@ -38,7 +38,7 @@ def _granular_task(section: DictConfig) -> Any:
 
 def _install() -> None:
     """Replace the training and the task factory in this process."""
-    policy_training.run_training = fake_run_training
+    train_teacher.run_training = fake_run_training
     policy_training.task_cfg = _granular_task
 
 

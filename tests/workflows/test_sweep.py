@@ -16,7 +16,7 @@ import pytest
 from omegaconf import DictConfig, OmegaConf
 
 from tests.pipeline_helpers import run_cli
-from workflows import policy_training, sweep
+from workflows import policy_training, sweep, train_teacher
 from workflows.stage_registry import StageIncompleteError
 from workflows.stage_runner import PipelineConfigError
 
@@ -27,7 +27,7 @@ LR_KEY = "train_teacher.ppo.learning_rate"
 
 
 class FakeTraining:
-    """Stand-in for ``policy_training.run_training``: writes a checkpoint; mean_reward = mu_int low end x iteration."""
+    """Stand-in for ``train_teacher.run_training``: writes a checkpoint; mean_reward = mu_int low end x iteration."""
 
     def __init__(self, interrupt_trial: int | None = None) -> None:
         """``interrupt_trial``: trial number whose first call stops at its time box (after one checkpoint)."""
@@ -72,7 +72,7 @@ def fake_training(monkeypatch: pytest.MonkeyPatch) -> Callable[..., FakeTraining
 
     def install(**kwargs: Any) -> FakeTraining:
         fake = FakeTraining(**kwargs)
-        monkeypatch.setattr(policy_training, "run_training", fake)
+        monkeypatch.setattr(train_teacher, "run_training", fake)
         return fake
 
     return install
@@ -144,16 +144,30 @@ def test_apply_task_overrides_sets_nested_fields_and_range_ends() -> None:
     assert task.terrain.floor.depth_range == (0.0, 0.2) and task.terrain.floor.num_levels == 7
     assert task.command_curriculum is False
     assert base.material.mu_int == (0.2, 0.9) and base.command_curriculum is True
+    assert sweep.apply_task_overrides(base, {}) == base
+
+
+def test_apply_task_overrides_round_trips_the_real_task() -> None:
+    """The mjlab task of an experiment comes back equal, field for field, when no path is set."""
+    from gmloco.train import g1_granular_task
+
+    task = g1_granular_task("rft3d", "deep")
+    assert sweep.apply_task_overrides(task, {}) == task
+    changed = sweep.apply_task_overrides(task, {"task.terrain.floor.num_levels": 7.0})
+    assert changed.terrain.floor.num_levels == 7 and isinstance(changed.terrain.floor.num_levels, int)
 
 
 def test_apply_task_overrides_refuses_unknown_fields_and_empty_ranges() -> None:
-    """A typo names the valid fields; a range end that crosses the other end is refused."""
+    """A typo names the wrong key, its section and the section's valid keys; a crossing range end is refused."""
     from gmloco.train.config import GranularTaskCfg
 
-    with pytest.raises(PipelineConfigError, match=r"no field 'mu_intt'.*mu_int"):
+    with pytest.raises(PipelineConfigError, match=r"no key 'mu_intt' in task\.material; valid keys: .*mu_int") as info:
         sweep.apply_task_overrides(GranularTaskCfg(), {"task.material.mu_intt.0": 0.3})
-    with pytest.raises(PipelineConfigError, match="not an index"):
+    assert info.value.key == "task.material.mu_intt.0"
+    with pytest.raises(PipelineConfigError, match=r"no key '2' in task\.material\.mu_int; valid keys: 0, 1\."):
         sweep.apply_task_overrides(GranularTaskCfg(), {"task.material.mu_int.2": 0.3})
+    with pytest.raises(PipelineConfigError, match=r"no key 'x' in task\.episode_length_s; valid keys: \(none"):
+        sweep.apply_task_overrides(GranularTaskCfg(), {"task.episode_length_s.x": 0.3})
     with pytest.raises(PipelineConfigError, match="low > high"):
         sweep.apply_task_overrides(GranularTaskCfg(), {"task.material.mu_int.0": 0.95})
 
@@ -170,7 +184,9 @@ def test_check_space_catches_ranges_that_only_some_samples_empty(compose: Callab
         with pytest.raises(PipelineConfigError, match="low > high"):
             sweep.check_space(cfg, space, {})
         sweep.check_space(cfg, sweep.parse_space({MU_KEY: {"type": "float", "low": 0.1, "high": 0.9}}), {})
-        with pytest.raises(PipelineConfigError, match="not a key"):
+        with pytest.raises(
+            PipelineConfigError, match=r"no key 'lr' in train_teacher\.ppo; valid keys: .*learning_rate"
+        ):
             sweep.check_space(
                 cfg, sweep.parse_space({"train_teacher.ppo.lr": {"type": "float", "low": 0, "high": 1}}), {}
             )
@@ -304,6 +320,7 @@ def test_importances_rank_the_parameter_that_matters(compose: Callable[..., Dict
         ([], "sweep"),
         (["+sweep=optuna_teacher", "sweep.storage=study.db"], "sweep.storage"),
         (["+sweep=optuna_teacher", "sweep.gpus=[0]", "device=cpu"], "sweep.gpus"),
+        (["+sweep=optuna_teacher", "sweep.task_overrides={task.material.mu_intt.0: 0.3}"], "task.material.mu_intt.0"),
     ],
 )
 def test_bad_sweep_input_exits_2(tmp_path: Path, args: list[str], key: str) -> None:
@@ -419,7 +436,7 @@ def test_eval_objective_scores_each_chunk_on_the_fixed_evaluation(
     import gmloco.train
 
     fake_training()
-    monkeypatch.setattr(policy_training, "vanilla_ppo_overrides", lambda section: {})
+    monkeypatch.setattr(train_teacher, "vanilla_ppo_overrides", lambda section: {})
     calls: list[Any] = []
 
     def fake_evaluate(cfg: Any) -> dict[str, float]:
@@ -463,6 +480,14 @@ def test_eval_objective_is_refused_for_the_vae_teacher(compose: Callable[..., Di
     with pytest.raises(PipelineConfigError) as info:
         sweep.run_sweep(cfg)
     assert info.value.key == "sweep.metric" and not (tmp_path / "config.yaml").exists()
+
+
+def test_the_jump_task_is_refused(compose: Callable[..., DictConfig], tmp_path: Path) -> None:
+    """``task.*`` paths address the velocity task, so a sweep of the jump task is bad input naming its key."""
+    cfg = compose("+exp=jump_rft3d", "+sweep=optuna_teacher", f"run_dir={tmp_path}", "device=cpu")
+    with pytest.raises(PipelineConfigError) as info:
+        sweep.run_sweep(cfg)
+    assert info.value.key == "train_teacher.jump" and not (tmp_path / "config.yaml").exists()
 
 
 def test_trial_whose_training_finished_before_a_kill_reports_its_saved_metrics(

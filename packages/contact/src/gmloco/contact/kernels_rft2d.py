@@ -7,10 +7,10 @@ from typing import Any
 
 import warp as wp
 
+from gmloco.contact.kernels_foot import read_foot_state, skip_element
 from gmloco.contact.kernels_geometry import (
     TerrainData,
     element_kinematics,
-    foot_inputs_finite,
     media_scaling,
     point_material,
     write_element,
@@ -107,13 +107,11 @@ def heuristic_point_force_kernel(
 ) -> None:
     """Compute one element's Heuristic-RFT force (no leading-edge mask; F_z >= 0 before Coulomb)."""
     w, f, p = wp.tid()
-    pos = foot_pos_in[w, f]
-    rot = foot_mat_in[w, f]
-    lin_vel = foot_lin_vel_in[w, f]
-    ang_vel = foot_ang_vel_in[w, f]
-    if not foot_inputs_finite(pos, rot, lin_vel, ang_vel):
-        wp.atomic_add(nan_count_out, 0, 1)
-        write_element(wp.vec3(0.0), 0.0, wp.vec3(0.0), point_force_out, point_depth_out, point_vel_out, w, f, p)
+    pos, rot, lin_vel, ang_vel, finite = read_foot_state(
+        foot_pos_in, foot_mat_in, foot_lin_vel_in, foot_ang_vel_in, w, f
+    )
+    if not finite:
+        skip_element(point_force_out, point_depth_out, point_vel_out, nan_count_out, w, f, p)
         return
     kin, depth = element_kinematics(terrain, pos, rot, lin_vel, ang_vel, points_b[p], normals_b[p])
     x = kin[0]

@@ -7,10 +7,10 @@ from typing import Any
 
 import warp as wp
 
+from gmloco.contact.kernels_foot import read_foot_state, skip_element
 from gmloco.contact.kernels_geometry import (
     TerrainData,
     element_kinematics,
-    foot_inputs_finite,
     foot_point_kinematics,
     foot_wrench_block_sum,
     media_scaling,
@@ -357,22 +357,17 @@ def _rft3d_point_kernel(ext: bool) -> wp.Kernel:
     ) -> None:
         """Compute one element's 3D-RFT force, depth and velocity for [world, foot, point] (reference path)."""
         w, f, p = wp.tid()
-        pos = foot_pos_in[w, f]
-        rot = foot_mat_in[w, f]
-        lin_vel = foot_lin_vel_in[w, f]
-        ang_vel = foot_ang_vel_in[w, f]
-        force = wp.vec3(0.0)
-        depth = 0.0
-        v = wp.vec3(0.0)
-        if foot_inputs_finite(pos, rot, lin_vel, ang_vel):
-            if wp.static(ext):
-                force, depth, kin = rft3d_element_ext(coeffs, model, state_in, pos, rot, lin_vel, ang_vel, w, f, p)
-            else:
-                force, depth, kin = rft3d_element(coeffs, model, state_in, pos, rot, lin_vel, ang_vel, w, f, p)
-            v = kin[2]
+        pos, rot, lin_vel, ang_vel, finite = read_foot_state(
+            foot_pos_in, foot_mat_in, foot_lin_vel_in, foot_ang_vel_in, w, f
+        )
+        if not finite:
+            skip_element(point_force_out, point_depth_out, point_vel_out, nan_count_out, w, f, p)
+            return
+        if wp.static(ext):
+            force, depth, kin = rft3d_element_ext(coeffs, model, state_in, pos, rot, lin_vel, ang_vel, w, f, p)
         else:
-            wp.atomic_add(nan_count_out, 0, 1)
-        write_element(force, depth, v, point_force_out, point_depth_out, point_vel_out, w, f, p)
+            force, depth, kin = rft3d_element(coeffs, model, state_in, pos, rot, lin_vel, ang_vel, w, f, p)
+        write_element(force, depth, kin[2], point_force_out, point_depth_out, point_vel_out, w, f, p)
 
     return rft3d_point_force_kernel
 
@@ -459,12 +454,10 @@ def _rft3d_foot_wrench_kernel(
         lane + block_dim, ...), and no other thread reads or writes it.
         """
         w, f, lane = wp.tid()
-        pos = foot_pos_in[w, f]
-        rot = foot_mat_in[w, f]
-        lin_vel = foot_lin_vel_in[w, f]
-        ang_vel = foot_ang_vel_in[w, f]
+        pos, rot, lin_vel, ang_vel, finite = read_foot_state(
+            foot_pos_in, foot_mat_in, foot_lin_vel_in, foot_ang_vel_in, w, f
+        )
         com = foot_com_in[w, f]
-        finite = foot_inputs_finite(pos, rot, lin_vel, ang_vel)
         force_sum = wp.vec3(0.0)
         torque_sum = wp.vec3(0.0)
         for p in range(lane, model.points_b.shape[0], wp.block_dim()):

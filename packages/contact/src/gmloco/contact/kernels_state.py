@@ -11,7 +11,8 @@ from typing import Any
 
 import warp as wp
 
-from gmloco.contact.kernels_geometry import TerrainData, foot_inputs_finite, foot_point_kinematics, terrain_height
+from gmloco.contact.kernels_foot import read_foot_state
+from gmloco.contact.kernels_geometry import TerrainData, foot_point_kinematics, terrain_height
 
 __all__ = [
     "AT_REST_CODES",
@@ -298,15 +299,14 @@ def state_update_kernel(
     anchors are not rewritten.
     """
     w, f, p = wp.tid()
-    pos = foot_pos_in[w, f]
-    rot = foot_mat_in[w, f]
-    lin_vel = foot_lin_vel_in[w, f]
-    ang_vel = foot_ang_vel_in[w, f]
+    pos, rot, lin_vel, ang_vel, finite = read_foot_state(
+        foot_pos_in, foot_mat_in, foot_lin_vel_in, foot_ang_vel_in, w, f
+    )
     depth = 0.0
     x = wp.vec3(0.0)
     n = wp.vec3(0.0)
     vel = wp.vec3(0.0)
-    if foot_inputs_finite(pos, rot, lin_vel, ang_vel):
+    if finite:
         kin = foot_point_kinematics(pos, rot, lin_vel, ang_vel, points_b[p], normals_b[p])
         x = kin[0]
         n = kin[1]

@@ -12,8 +12,6 @@ about two gait cycles of the G1 at walking cadence. The history holds the curren
 
 from __future__ import annotations
 
-import copy
-
 import torch
 import torch.nn as nn
 from rsl_rl.models import MLPModel
@@ -155,10 +153,8 @@ class _StudentExport(LatentActorExport):
 
     def __init__(self, model: StudentActor) -> None:
         """Deep-copy every module on the action path (encoder included), the history normalizer and the decoder."""
-        super().__init__(model)
-        self.history_normalizer = copy.deepcopy(model.history_normalizer)
-        self.history_length = model.history_length
-        self.history_frame_dim = model.history_frame_dim
+        shape = (model.history_length, model.history_frame_dim)
+        super().__init__(model, model.history_normalizer, "history", shape)
 
     def forward(self, obs: torch.Tensor, history: torch.Tensor) -> torch.Tensor:
         """Return the deterministic action ``[B, A]``."""
@@ -166,17 +162,8 @@ class _StudentExport(LatentActorExport):
 
     def _act(self, obs: torch.Tensor, history: torch.Tensor) -> tuple[torch.Tensor, torch.Tensor]:
         """Return ``(actions [B, A], z_hat [B, latent_dim])``."""
-        z_hat = self.encoder(self.history_normalizer(history))
+        z_hat = self.encode(history)
         return self.act(obs, z_hat), z_hat
-
-    def get_dummy_inputs(self) -> tuple[torch.Tensor, torch.Tensor]:
-        """Return zero inputs of batch 1 for tracing."""
-        return torch.zeros(1, self.obs_dim), torch.zeros(1, self.history_length, self.history_frame_dim)
-
-    @property
-    def input_names(self) -> list[str]:
-        """Return the ONNX input names."""
-        return ["obs", "history"]
 
 
 class _StudentOnnxExport(_StudentExport):

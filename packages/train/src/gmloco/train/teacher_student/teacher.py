@@ -9,7 +9,6 @@ eta = xi / xi_max, and the actor sees o_t and z_t. Selected in rsl-rl with
 
 from __future__ import annotations
 
-import copy
 from typing import Literal
 
 import torch
@@ -137,20 +136,9 @@ class _TeacherExport(LatentActorExport):
 
     def __init__(self, model: TeacherActor) -> None:
         """Deep-copy every module on the action path, the encoder and its input normalizer included."""
-        super().__init__(model)
-        self.encoder_normalizer = copy.deepcopy(model.encoder_normalizer)
-        self.encoder_obs_dim = model.encoder_obs_dim
+        super().__init__(model, model.encoder_normalizer, "encoder_obs", (model.encoder_obs_dim,))
 
     def forward(self, obs: torch.Tensor, encoder_obs: torch.Tensor) -> torch.Tensor:
         """Return the deterministic action, using the latent mean."""
-        mu, _ = self.encoder(self.encoder_normalizer(encoder_obs))
+        mu, _ = self.encode(encoder_obs)
         return self.act(obs, mu)
-
-    def get_dummy_inputs(self) -> tuple[torch.Tensor, torch.Tensor]:
-        """Return zero inputs of batch 1 for tracing."""
-        return torch.zeros(1, self.obs_dim), torch.zeros(1, self.encoder_obs_dim)
-
-    @property
-    def input_names(self) -> list[str]:
-        """Return the ONNX input names."""
-        return ["obs", "encoder_obs"]
