@@ -10,7 +10,14 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from gmloco.train.learning_curves import chunk_starts, fig_learning_curves, main, merge_curves, read_curve
+from gmloco.train.learning_curves import (
+    chunk_starts,
+    fig_learning_curves,
+    main,
+    merge_curves,
+    read_curve,
+    robust_ylim,
+)
 
 
 @pytest.fixture
@@ -65,3 +72,13 @@ def test_cli_bad_source_exits_2(tmp_path: Path, capsys: pytest.CaptureFixture[st
     """A folder without a curve is refused with exit code 2 and a message naming it."""
     assert main([str(tmp_path), "--out", str(tmp_path / "x.png")]) == 2
     assert "neither curve.csv nor summary.json" in capsys.readouterr().err
+
+
+def test_robust_ylim_keeps_one_blown_up_point_off_scale() -> None:
+    """A -1.8e11 reward among rewards of 0-100 is left off the axis and counted; a clean curve autoscales."""
+    rewards = np.linspace(0.0, 100.0, 200)
+    assert robust_ylim(rewards) is None
+    blown = rewards.copy()
+    blown[150] = -1.8e11
+    low, high, outside = robust_ylim(blown)  # type: ignore[misc]
+    assert outside == 1 and -400.0 < low < 0.0 and 100.0 < high < 500.0

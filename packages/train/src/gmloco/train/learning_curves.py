@@ -22,7 +22,7 @@ from pathlib import Path
 
 import numpy as np
 
-__all__ = ["PANELS", "chunk_starts", "fig_learning_curves", "merge_curves", "read_curve"]
+__all__ = ["PANELS", "chunk_starts", "fig_learning_curves", "merge_curves", "read_curve", "robust_ylim"]
 
 Curve = dict[str, np.ndarray]
 """Column name -> values by row; ``iteration`` is sorted and unique."""
@@ -96,6 +96,22 @@ def chunk_starts(manifest: str | Path) -> list[float]:
     return sorted({float(c["resumed_from_iteration"]) for c in chunks if c.get("resumed_from_iteration")})
 
 
+def robust_ylim(values: np.ndarray, spread: float = 3.0) -> tuple[float, float, int] | None:
+    """Y limits that keep a few blown-up points (a diverged iteration's -1e11 reward) from flattening a panel.
+
+    The limits are the 1st-99th percentile range widened by ``spread`` times its width on each side. Returns
+    ``(low, high, points outside)``, or None when every finite value lies inside (the axis then autoscales).
+    """
+    finite = values[np.isfinite(values)]
+    if finite.size < 10:
+        return None
+    lo, hi = np.percentile(finite, [1.0, 99.0])
+    width = max(hi - lo, 1e-12)
+    low, high = lo - spread * width, hi + spread * width
+    outside = int(np.count_nonzero((finite < low) | (finite > high)))
+    return (float(low), float(high), outside) if outside else None
+
+
 def fig_learning_curves(curve: Curve, path: str | Path, title: str, starts: Sequence[float] = ()) -> list[str]:
     """Draw the panels of :data:`PANELS` the curve has against iteration; dashed lines at chunk ``starts``.
 
@@ -124,6 +140,10 @@ def fig_learning_curves(curve: Curve, path: str | Path, title: str, starts: Sequ
             ok = np.isfinite(curve[c])
             ax.plot(it[ok], curve[c][ok], lw=0.8, label=c if len(cols) > 1 else None)
         ax.set(xlabel="iteration", ylabel=label, yscale="log" if log else "linear")
+        limits = None if log else robust_ylim(np.concatenate([curve[c] for c in cols]))
+        if limits is not None:
+            ax.set_ylim(limits[0], limits[1])
+            ax.text(0.02, 0.03, f"{limits[2]} point(s) off scale", transform=ax.transAxes, fontsize=6, color="C3")
         if len(cols) > 1:
             ax.legend(fontsize=6)
         for x in starts:
