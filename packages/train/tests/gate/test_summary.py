@@ -79,3 +79,30 @@ def test_no_decoded_eta_fails_eta_key() -> None:
     assert m["eta_r2_heldout"] is None
     assert not gate_pass(m, GateThresholdsCfg(), ("basalt", "poppy_seed"))["eta_r2_heldout"]
     assert math.isclose(m["circle_dtw_m"]["basalt"], 0.04)
+
+
+def test_failures_and_stance_sinkage_say_why_episodes_ended() -> None:
+    """Each failed forward episode is listed with its term and time; stance depths average per cell, in cm."""
+    rows = _rows(0.16)
+    rows[2] |= {"failed": True, "failure": "base_too_low", "fail_s": 3.5}
+    for r in rows[:4]:
+        r["stance_sink_m"] = 0.04
+    m = gate_metrics(_cfg(), rows)
+    assert m["failures"]["basalt"] == {"0.5": [], "1": ["base_too_low at 3.50 s"]}
+    assert m["failures"]["poppy_seed"] == {"0.5": [], "1": []}
+    np.testing.assert_allclose(m["stance_sink_cm"]["basalt"]["1"], 4.0)
+    assert m["stance_sink_cm"]["poppy_seed"]["1"] is None  # rows without the read-out
+
+
+def test_failure_is_the_first_term_that_fired() -> None:
+    """Of two terms the earlier one ends the episode; an episode no term ended survived."""
+    from gmloco.train.gate.rollout import _failure
+
+    steps, dt = 10, 0.02
+    tilt, low = np.zeros((steps, 2)), np.zeros((steps, 2))
+    tilt[6, 0], low[4, 0] = 1.0, 1.0
+    raw = {"ended_tilt": tilt, "ended_base_too_low": low}
+    name, when = _failure(raw, 0, dt)
+    assert name == "base_too_low" and math.isclose(when, 5 * dt)
+    name, when = _failure(raw, 1, dt)
+    assert name is None and math.isnan(when)

@@ -182,8 +182,9 @@ def _rollout(env: Any, act: Actor, commands: torch.Tensor, steps: int) -> dict[s
 
     Returns:
         ``[T, W]`` traces after each step (``x``, ``y`` [m], ``yaw`` [rad], ``wz`` world yaw rate [rad/s],
-        ``vx``/``vy`` yaw-frame velocity [m/s], ``alive``, ``eta_true``, ``eta_decoded``), ``[T, W, 2]`` feet
-        ``height`` [m] and ``contact``, and the start pose ``x0``/``y0``/``yaw0`` ``[W]``.
+        ``vx``/``vy`` yaw-frame velocity [m/s], ``alive``, ``eta_true``, ``eta_decoded``, ``base_height`` pelvis
+        above the sand surface [m], ``ended_<term>`` 1 where a failure term fired), ``[T, W, 2]`` feet ``height``
+        [m] and ``contact``, and the start pose ``x0``/``y0``/``yaw0`` ``[W]``.
     """
     from mjlab.utils.lab_api.math import quat_apply_inverse, yaw_quat
 
@@ -194,11 +195,14 @@ def _rollout(env: Any, act: Actor, commands: torch.Tensor, steps: int) -> dict[s
     start = {"x0": data.root_link_pos_w[:, 0], "y0": data.root_link_pos_w[:, 1], "yaw0": data.heading_w}
     out: dict[str, np.ndarray] = {k: v.cpu().numpy().copy() for k, v in start.items()}
     trace: dict[str, list[torch.Tensor]] = {}
+    terms = env.termination_manager
     for _ in range(steps):
         actions, eta = act(obs)
         obs, _, terminated, _, _ = env.step(actions)
+        ended = {f"ended_{name}": terms.get_term(name) & alive for name in terms.active_terms}
         alive &= ~terminated
         feet.update()
+        pelvis = data.root_link_pos_w
         v_yaw = quat_apply_inverse(yaw_quat(data.root_link_quat_w), data.root_link_lin_vel_w)
         step = {
             "x": data.root_link_pos_w[:, 0],
@@ -211,6 +215,8 @@ def _rollout(env: Any, act: Actor, commands: torch.Tensor, steps: int) -> dict[s
             "eta_true": env.sand.eta,
             "height": feet.height,
             "contact": feet.in_contact.float(),
+            "base_height": pelvis[:, 2] - env.sand.surface_height(pelvis[:, 0], pelvis[:, 1]),
+            **{k: v.float() for k, v in ended.items()},
         }
         if eta is not None:
             step["eta_decoded"] = eta
@@ -219,13 +225,25 @@ def _rollout(env: Any, act: Actor, commands: torch.Tensor, steps: int) -> dict[s
     return out | {k: torch.stack(v).cpu().numpy() for k, v in trace.items()}
 
 
+def _failure(raw: dict[str, np.ndarray], w: int, dt: float) -> tuple[str | None, float]:
+    """The failure term that ended episode ``w`` first and when [s]; (None, nan) when it survived."""
+    ended = {k.removeprefix("ended_"): np.flatnonzero(v[:, w] > 0.5) for k, v in raw.items() if k.startswith("ended_")}
+    first = {name: int(steps[0]) for name, steps in ended.items() if steps.size}
+    if not first:
+        return None, float("nan")
+    name = min(first, key=first.__getitem__)
+    return name, (first[name] + 1) * dt
+
+
 def episode_rows(cfg: GateCfg, cells: list[GateCell], raw: dict[str, np.ndarray], dt: float) -> list[dict[str, Any]]:
     """Reduce a batch's traces to one row per episode (env), for the cells of the batch.
 
     Each row: ``failed``; ``vel_error`` (mean |v_xy - v_cmd| [m/s] over alive steps after ``settle_s``);
     ``yaw_rate`` (mean world w_z [rad/s], same steps); ``drift_deg`` (heading change over the episode, survivors
     only); ``dtw_m`` (circle cells: DTW error of the pelvis path against the commanded circle over the alive
-    steps); ``apex_m`` (swing apexes of both feet); ``eta`` (decoded and true eta after ``eta_warmup_s``).
+    steps); ``apex_m`` (swing apexes of both feet); ``eta`` (decoded and true eta after ``eta_warmup_s``);
+    ``failure`` (the failure term that ended the episode, None for a survivor) and ``fail_s`` (when [s]);
+    ``stance_sink_m`` (mean depth of a foot in contact below the surface over the alive steps [m]).
     """
     settle, warm = round(cfg.settle_s / dt), round(cfg.eta_warmup_s / dt)
     stride = max(1, round(1.0 / (cfg.dtw_hz * dt)))
@@ -236,9 +254,15 @@ def episode_rows(cfg: GateCfg, cells: list[GateCell], raw: dict[str, np.ndarray]
         tracked[:settle] = False
         cmd = np.asarray(cell.command)
         verr = np.hypot(raw["vx"][:, w] - cmd[0], raw["vy"][:, w] - cmd[1])
+        failure, fail_s = _failure(raw, w, dt)
+        in_contact = (raw["contact"][:, w] > 0.5) & alive[:, None]
+        sink = np.maximum(-raw["height"][:, w], 0.0)[in_contact]
         row: dict[str, Any] = {
             "cell": cell,
             "failed": not bool(alive[-1]),
+            "failure": failure,
+            "fail_s": fail_s,
+            "stance_sink_m": float(sink.mean()) if sink.size else float("nan"),
             "vel_error": float(verr[tracked].mean()) if tracked.any() else float("nan"),
             "yaw_rate": float(raw["wz"][tracked, w].mean()) if tracked.any() else float("nan"),
             "drift_deg": heading_drift_deg(raw["yaw0"][w], raw["yaw"][-1, w]) if alive[-1] else float("nan"),
