@@ -52,6 +52,7 @@ TERRAIN_NAMES = ("basalt", "dry_sand", "poppy_seed", "dry_sand_rough", "dry_sand
 
 def terrain_cfg(name: str, depth: float = 0.15) -> TerrainCfg:
     """Return a named terrain: a preset medium (flat), ``<medium>_rough``, ``<medium>_deep`` or ``transition``."""
+    # here, not at the top: gmloco.contact pulls Warp; this module imports with numpy alone
     from gmloco.contact import MATERIAL_PRESETS
 
     if name == "transition":
@@ -70,6 +71,7 @@ def terrain_cfg(name: str, depth: float = 0.15) -> TerrainCfg:
 
 def terrain_materials(cfg: TerrainCfg) -> list[MpmMaterialCfg]:
     """MPM parameters of each medium of the terrain (``mu_int`` override applied)."""
+    # here, not at the top: gmloco.contact pulls Warp; this module imports with numpy alone
     from gmloco.contact import MATERIAL_PRESETS
 
     mats = [mpm_material(MATERIAL_PRESETS[m]) for m in cfg.materials]
