@@ -261,7 +261,7 @@ def fig_adaptation(
         recordings: Recorded transition walks (``recordings/transition__*.mcap``), any number.
         path: Output PNG.
         label: Policy label for the title.
-        terrain: The course (``window_terrain.TerrainCfg``; default ``terrain_cfg("transition")``).
+        terrain: The course (``window_terrain.MpmTerrainCfg``; default ``terrain_cfg("transition")``).
     """
     from gmloco.eval.mpm.window_terrain import terrain_cfg
     from gmloco.eval.report.tables_mpm import table_transition
