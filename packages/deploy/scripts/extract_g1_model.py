@@ -8,28 +8,20 @@ Menagerie's ``unitree_g1``, BSD-3-Clause). Run: ``uv run python packages/deploy/
 
 from __future__ import annotations
 
-import importlib.util
 import json
 from pathlib import Path
 
 import mujoco
 import numpy as np
 
-from gmloco.deploy.g1 import G1_FEET, G1_JOINT_NAMES, G1_LEG_JOINTS
+from gmloco.deploy.g1 import G1_FEET, G1_JOINT_NAMES, G1_LEG_JOINTS, g1_mjcf_path
 
 OUT = Path(__file__).resolve().parents[1] / "src/gmloco/deploy/logs/g1_model.json"
 
 
-def g1_xml() -> Path:
-    """Return the path of the G1 MJCF shipped with mjlab (found without importing mjlab)."""
-    spec = importlib.util.find_spec("mjlab")
-    assert spec is not None and spec.origin is not None, "mjlab is not installed"
-    return Path(spec.origin).parent / "asset_zoo/robots/unitree_g1/xmls/g1.xml"
-
-
 def main() -> None:
     """Write the JSON file."""
-    m = mujoco.MjModel.from_xml_path(str(g1_xml()))
+    m = mujoco.MjModel.from_xml_path(str(g1_mjcf_path()))
     ranges = {m.joint(i).name: m.jnt_range[i].tolist() for i in range(1, m.njnt)}
     assert tuple(m.joint(i).name for i in range(1, m.njnt)) == G1_JOINT_NAMES, "MJCF joint order changed"
     legs = {}

@@ -4,6 +4,8 @@
 from __future__ import annotations
 
 import re
+import subprocess
+import sys
 
 import numpy as np
 import pytest
@@ -22,6 +24,7 @@ from gmloco.deploy.g1 import (
     G1_STIFFNESS,
     G1_VELOCITY_LIMIT,
     g1_actuator,
+    g1_mjcf_path,
     joint_index,
 )
 
@@ -73,13 +76,21 @@ def test_velocity_limits_match_mjlab() -> None:
         np.testing.assert_allclose(G1_ACTUATORS[key].armature, scale * motor.reflected_inertia, rtol=1e-12)
 
 
+def test_mjcf_path_is_found_without_importing_mjlab() -> None:
+    """g1_mjcf_path names mjlab's G1 MJCF file and leaves mjlab (torch, Warp) unimported."""
+    pytest.importorskip("mjlab")
+    code = "import sys; from gmloco.deploy.g1 import g1_mjcf_path as f; print(f().is_file(), 'mjlab' in sys.modules)"
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True).stdout.split()
+    assert out == ["True", "False"]
+    assert g1_mjcf_path().parts[-5:] == ("asset_zoo", "robots", "unitree_g1", "xmls", "g1.xml")
+
+
 def test_joint_order_and_feet_match_the_mjcf() -> None:
     """The MJCF shipped with mjlab lists the joints in canonical order and has both foot bodies."""
     mujoco = pytest.importorskip("mujoco")
-    from gmloco.deploy.logs.sim.scene import g1_xml_path
 
     try:
-        path = g1_xml_path()
+        path = g1_mjcf_path()
     except ImportError:
         pytest.skip("mjlab is not installed")
     model = mujoco.MjModel.from_xml_path(str(path))
@@ -96,10 +107,9 @@ def test_sole_sites_and_box_match_the_foot_capsules() -> None:
     capsules' x span [-0.054, 0.132] m widened by 2 mm).
     """
     mujoco = pytest.importorskip("mujoco")
-    from gmloco.deploy.logs.sim.scene import g1_xml_path
 
     try:
-        path = g1_xml_path()
+        path = g1_mjcf_path()
     except ImportError:
         pytest.skip("mjlab is not installed")
     model = mujoco.MjModel.from_xml_path(str(path))

@@ -7,16 +7,13 @@ granular model): whatever wrench it writes must reach the feet exactly as ``xfrc
 
 from __future__ import annotations
 
-import importlib.util
-from pathlib import Path
-
 import mujoco
 import numpy as np
 import pytest
 import torch
 import warp as wp
 
-from gmloco.deploy.g1 import G1_FOOT_BODIES
+from gmloco.deploy.g1 import G1_FOOT_BODIES, g1_mjcf_path
 from gmloco.train.contact_coupling import ContactCoupling
 
 FEET = G1_FOOT_BODIES
@@ -49,9 +46,7 @@ class ConstantWrench:
 
 def _g1_model(gravity: float) -> mujoco.MjModel:
     """Return mjlab's G1 MJCF (free-floating, no floor) with rigid contact off."""
-    origin = importlib.util.find_spec("mjlab").origin  # type: ignore[union-attr]
-    xml = Path(origin).parent / "asset_zoo" / "robots" / "unitree_g1" / "xmls" / "g1.xml"  # type: ignore[arg-type]
-    model = mujoco.MjModel.from_xml_path(str(xml))
+    model = mujoco.MjModel.from_xml_path(str(g1_mjcf_path()))
     model.opt.gravity[:] = (0.0, 0.0, -gravity)
     model.opt.disableflags |= mujoco.mjtDisableBit.mjDSBL_CONTACT
     return model

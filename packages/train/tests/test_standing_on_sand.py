@@ -14,10 +14,8 @@ over ``ramp`` seconds (the robot is lowered onto the sand quasi-statically), the
 
 from __future__ import annotations
 
-import importlib.util
 import re
 from dataclasses import dataclass
-from pathlib import Path
 
 import mujoco
 import numpy as np
@@ -26,7 +24,7 @@ import warp as wp
 
 from gmloco.contact import MATERIAL_PRESETS, ContactRFT3DCfg, g1_foot_box_cfg, g1_foot_collider, make_contact_model
 from gmloco.contact.reference import rft3d_generic
-from gmloco.deploy.g1 import G1_FOOT_BODIES
+from gmloco.deploy.g1 import G1_FOOT_BODIES, g1_mjcf_path
 
 DT = 0.005
 """Physics step [s] (GM-Loco: 200 Hz)."""
@@ -51,16 +49,9 @@ HOME_POSE = {
 }
 
 
-def g1_xml() -> Path:
-    """Return the path of mjlab's G1 MJCF without importing mjlab (its import takes seconds)."""
-    spec = importlib.util.find_spec("mjlab")
-    assert spec is not None and spec.origin is not None
-    return Path(spec.origin).parent / "asset_zoo" / "robots" / "unitree_g1" / "xmls" / "g1.xml"
-
-
 def build_g1_on_slide() -> mujoco.MjModel:
     """Return the G1 with its free joint replaced by a vertical slide, PD position actuators, no contact."""
-    spec = mujoco.MjSpec.from_file(str(g1_xml()))
+    spec = mujoco.MjSpec.from_file(str(g1_mjcf_path()))
     pelvis = spec.body("pelvis")
     spec.delete(pelvis.joints[0])
     pelvis.add_joint(name="slide_z", type=mujoco.mjtJoint.mjJNT_SLIDE, axis=[0.0, 0.0, 1.0])

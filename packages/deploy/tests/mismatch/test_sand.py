@@ -15,7 +15,7 @@ from gmloco.deploy.mismatch.benchmark.truth import TruthEffect
 from gmloco.deploy.mismatch.effects import EFFECTS
 from gmloco.deploy.mismatch.replay import Replayer, sand_replay_cfg
 from gmloco.deploy.mismatch.sand import SandCfg, SoleRFT
-from gmloco.deploy.mismatch.terrain import TerrainCfg, TerrainParams, sand_effect_forces
+from gmloco.deploy.mismatch.terrain import TerrainEffectCfg, TerrainParams, sand_effect_forces
 
 
 def _soles(rng: np.random.Generator, sand: SoleRFT) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -74,7 +74,7 @@ def test_sand_effects_nominal_at_zero_and_scaling() -> None:
     rng = np.random.default_rng(1)
     f = rng.normal(0.0, 10.0, (6, 3))
     depth, vz, area = np.array([0.01, 0.0, -0.01, 0.005, 0.02, 0.003]), rng.normal(0, 0.2, 6), np.full(6, 1e-3)
-    cfg = TerrainCfg()
+    cfg = TerrainEffectCfg()
     np.testing.assert_array_equal(sand_effect_forces(f, depth, vz, area, TerrainParams(), cfg), f)
     np.testing.assert_allclose(sand_effect_forces(f, depth, vz, area, TerrainParams(zeta=0.5), cfg), 1.5 * f)
     coh = sand_effect_forces(f, depth, vz, area, TerrainParams(cohesion=1000.0), cfg)

@@ -11,7 +11,7 @@ import pytest
 from gmloco.eval.mpm.box_scene import MpmSolverCfg
 from gmloco.eval.mpm.coupled_setup import make_mpm_solver
 from gmloco.eval.mpm.window import SandWindow, SandWindowCfg
-from gmloco.eval.mpm.window_terrain import TerrainCfg, terrain_cfg, terrain_layer, terrain_surface_height
+from gmloco.eval.mpm.window_terrain import MpmTerrainCfg, terrain_cfg, terrain_layer, terrain_surface_height
 
 VOXEL = 0.1  # columns h = 5 cm at 2 particles per voxel edge
 
@@ -26,7 +26,7 @@ def _pelvis(x: np.ndarray, lane_y: np.ndarray, bodies: int, heading: float | np.
 
 
 def _window(
-    terrain: TerrainCfg,
+    terrain: MpmTerrainCfg,
     lane_y: np.ndarray,
     bodies: int = 2,
     capacity: int = -1,
@@ -86,7 +86,7 @@ def test_recycle_keeps_the_mpm_volume_cache_consistent() -> None:
     """Rough transition sand: after a recycle the solver's cached volume/density equal a fresh notify's."""
     import warp as wp
 
-    terrain = TerrainCfg(name="t", materials=("basalt", "poppy_seed"), layer_start=0.0, layer_length=0.3,
+    terrain = MpmTerrainCfg(name="t", materials=("basalt", "poppy_seed"), layer_start=0.0, layer_length=0.3,
                          rough_amplitude=0.03, rough_wavelength=0.4)  # fmt: skip
     lane_y = np.array([0.0, 2.0])
     win, model, state, solver = _window(terrain, lane_y)

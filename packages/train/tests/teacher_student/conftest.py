@@ -18,6 +18,7 @@ from gmloco.train.teacher_student import (
     PpoSchedule,
     StudentCfg,
     StudentPPO,
+    TeacherActor,
     TeacherCfg,
     TeacherPPO,
 )
@@ -161,6 +162,17 @@ def teacher_ckpt(
         toy_env.get_observations(), toy_env, runner_cfg(teacher_cfg.to_rsl_rl(groups)), "cpu"
     )
     return alg.save()
+
+
+@pytest.fixture
+def teacher_actor(
+    toy_env: VecEnv, teacher_cfg: TeacherCfg, groups: ObsGroupsCfg, runner_cfg: Callable[[dict], dict]
+) -> TeacherActor:
+    """A randomly initialised TeacherActor, built by TeacherPPO's construct_algorithm."""
+    alg = TeacherPPO.construct_algorithm(
+        toy_env.get_observations(), toy_env, runner_cfg(teacher_cfg.to_rsl_rl(groups)), "cpu"
+    )
+    return alg.actor  # type: ignore[return-value]
 
 
 @pytest.fixture

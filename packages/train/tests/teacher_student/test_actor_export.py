@@ -3,28 +3,19 @@
 
 from __future__ import annotations
 
-from collections.abc import Callable
 from types import SimpleNamespace
 from typing import Any
 
 import torch
-from rsl_rl.env import VecEnv
 
-from gmloco.train.teacher_student import ObsGroupsCfg, StudentPPO, TeacherCfg, TeacherPPO
+from gmloco.train.teacher_student import StudentPPO, TeacherActor
 
 
 def test_both_wrappers_name_and_shape_their_inputs_and_copy_the_encoder_normalizer(
-    toy_env: VecEnv,
-    teacher_cfg: TeacherCfg,
-    groups: ObsGroupsCfg,
-    runner_cfg: Callable[[dict], dict],
-    student_alg: StudentPPO,
-    dims: SimpleNamespace,
+    teacher_actor: TeacherActor, student_alg: StudentPPO, dims: SimpleNamespace
 ) -> None:
     """Teacher: (obs, encoder_obs [enc_dim]); student: (obs, history [N, D]); each holds a copy of its normalizer."""
-    teacher = TeacherPPO.construct_algorithm(
-        toy_env.get_observations(), toy_env, runner_cfg(teacher_cfg.to_rsl_rl(groups)), "cpu"
-    ).actor
+    teacher = teacher_actor
     student = student_alg.actor
     cases: tuple[tuple[Any, Any, str, tuple[int, ...]], ...] = (
         (teacher, teacher.encoder_normalizer, "encoder_obs", (teacher.encoder_obs_dim,)),  # type: ignore[attr-defined]

@@ -1,5 +1,5 @@
 # SPDX-License-Identifier: Apache-2.0
-"""The Unitree G1 (29-DoF) in one place: joints, feet (bodies, sole sites, sole box), and the actuator table.
+"""The Unitree G1 (29-DoF) in one place: joints, feet (bodies, sole sites, sole box), actuator table, MJCF path.
 
 Pure Python, no dependency: every package (deploy's light core, contact, train, eval) may import it without
 pulling mujoco, Warp, torch or mjlab. The joint order is the Unitree SDK motor index order of the 29-DoF G1
@@ -10,7 +10,9 @@ mjlab 1.6.0's (``asset_zoo/robots/unitree_g1/g1_constants.py``); ``tests/test_g1
 
 from __future__ import annotations
 
+import importlib.util
 from dataclasses import dataclass
+from pathlib import Path
 
 __all__ = [
     "G1_ACTUATORS",
@@ -32,6 +34,7 @@ __all__ = [
     "G1Actuator",
     "g1_actuator",
     "g1_actuator_type",
+    "g1_mjcf_path",
     "joint_index",
 ]
 
@@ -101,6 +104,18 @@ G1_LEG_JOINTS: dict[str, tuple[str, ...]] = {
     foot: tuple(n for n in G1_JOINT_NAMES[:12] if n.startswith(foot)) for foot in G1_FEET
 }
 """Leg joints per foot, hip to ankle."""
+
+
+def g1_mjcf_path() -> Path:
+    """Return the path of the G1 MJCF (29 DoF) shipped with mjlab 1.6.0, found without importing mjlab.
+
+    Raises:
+        ImportError: If mjlab is not installed.
+    """
+    spec = importlib.util.find_spec("mjlab")  # locate only: importing mjlab pulls torch and Warp
+    if spec is None or spec.origin is None:
+        raise ImportError("mjlab is not installed; the G1 MJCF ships with mjlab 1.6.0 (uv sync the workspace)")
+    return Path(spec.origin).parent / "asset_zoo/robots/unitree_g1/xmls/g1.xml"
 
 
 def joint_index(name: str) -> int:

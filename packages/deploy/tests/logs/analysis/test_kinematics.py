@@ -6,17 +6,15 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from gmloco.deploy.g1 import joint_index
+from gmloco.deploy.g1 import g1_mjcf_path, joint_index
 from gmloco.deploy.logs.analysis import G1LegKinematics, g1_model, sole_heights
 
 
 def test_fk_matches_mujoco() -> None:
     """ankle_roll_link pose in the pelvis frame equals MuJoCo's mj_kinematics to float precision."""
     mujoco = pytest.importorskip("mujoco")
-    from gmloco.deploy.logs.sim.scene import g1_xml_path
-
     try:
-        model = mujoco.MjModel.from_xml_path(str(g1_xml_path()))
+        model = mujoco.MjModel.from_xml_path(str(g1_mjcf_path()))
     except ImportError:
         pytest.skip("mjlab (G1 MJCF) not installed")
     data = mujoco.MjData(model)

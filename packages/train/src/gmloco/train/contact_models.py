@@ -15,6 +15,9 @@ import torch
 import warp as wp
 
 import gmloco.contact as gc
+from gmloco.contact.extensions_io import load_rft_extensions
+from gmloco.contact.kernels_rft3d_ext import EXT_COLUMNS
+from gmloco.contact.kernels_state import eval_reset_state
 from gmloco.contact.materials import validate_material_arrays
 from gmloco.train.config import ContactModelName, GranularTaskCfg, MaterialRangeCfg, SandTerrainCfg
 
@@ -41,8 +44,6 @@ def contact_model_cfg(
     if name == "rft3d_calibrated":
         if extensions_file is None:
             raise ValueError("contact_model 'rft3d_calibrated' needs GranularTaskCfg.rft_extensions_file")
-        from gmloco.contact.extensions_io import load_rft_extensions
-
         ext = load_rft_extensions(extensions_file)
         return replace(contact_model_cfg("rft3d", foot_faces), extensions=ext)
     table = {
@@ -86,8 +87,6 @@ def reset_model_state(model: Any, env_ids: torch.Tensor) -> None:
     """
     if not getattr(model, "is_stateful", True) or env_ids.numel() == 0:
         return
-    from gmloco.contact.kernels_state import eval_reset_state
-
     eval_reset_state(model, wp.from_torch(env_ids.to(torch.int32), dtype=wp.int32))
 
 
@@ -99,8 +98,6 @@ def extension_dr_columns(model: Any, ranges: dict[str, tuple[float, float]]) -> 
     """
     if not ranges:
         return {}
-    from gmloco.contact.kernels_rft3d_ext import EXT_COLUMNS
-
     ext = getattr(getattr(model, "cfg", None), "extensions", None)
     if ext is None or not hasattr(model, "ext_values"):
         raise ValueError("rft_extension_ranges need a 3D-RFT contact model (contact_model 'rft3d_calibrated')")

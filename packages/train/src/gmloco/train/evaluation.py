@@ -20,6 +20,7 @@ from typing import Any
 import numpy as np
 import torch
 
+import gmloco.contact as gc
 from gmloco.train.config import ContactModelName, TerrainName
 from gmloco.train.evaluation_cells import MaterialCellsCfg, RolloutCriteriaCfg
 from gmloco.train.mdp.commands import hold_twist
@@ -93,8 +94,6 @@ def _cells(cfg: EvalCfg) -> list[tuple[str, float]]:
 
 def _pin_cells(env: Any, cells: list[tuple[str, float]]) -> torch.Tensor:
     """Fix each env's material and command; return the commands [W, 3]."""
-    import gmloco.contact as gc
-
     sand = env.sand
     presets = [gc.MATERIAL_PRESETS[m] for m, _ in cells]
     as_t = lambda vals: torch.tensor(vals, dtype=torch.float32, device=env.device)  # noqa: E731

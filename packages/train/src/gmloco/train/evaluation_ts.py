@@ -38,6 +38,8 @@ from typing import Any, Literal
 import numpy as np
 import torch
 
+import gmloco.contact as gc
+from gmloco.contact import MATERIAL_PRESETS
 from gmloco.train.config import ContactModelName, TerrainName
 from gmloco.train.evaluation import RolloutCriteriaCfg, accumulate_tracking, tracking_stats
 from gmloco.train.mdp.commands import hold_twist
@@ -125,8 +127,6 @@ class _Cell:
 
 def _cells(cfg: TsEvalCfg) -> list[_Cell]:
     """Held-out grid and presets x speeds x repeats, material-major."""
-    import gmloco.contact as gc
-
     materials: list[tuple[str, float, float, float, str]] = []
     for rho, mu in zip(*cfg.held_out.grid(*cfg.held_out_grid), strict=True):
         materials.append((f"held_out_rho{rho:.0f}_mu{mu:.3f}", float(rho), float(mu), cfg.held_out_mu_surf, "held_out"))
@@ -284,8 +284,6 @@ def pinned_walk(cfg: TsEvalCfg, materials: list[str], commands: list[tuple[float
     import time
 
     from tensordict import TensorDict
-
-    from gmloco.contact import MATERIAL_PRESETS
 
     if len(materials) != len(commands):
         raise ValueError(f"pinned_walk: {len(materials)} materials but {len(commands)} commands (one each per env)")
@@ -498,8 +496,6 @@ def swing_apexes(height: np.ndarray, in_contact: np.ndarray, alive: np.ndarray, 
 
 def _course_table(cfg: TsEvalCfg) -> torch.Tensor:
     """(rho_c, mu_int, mu_surf) of the course materials, ``[M, 3]``."""
-    import gmloco.contact as gc
-
     presets = [gc.MATERIAL_PRESETS[m] for m in cfg.adaptation_materials]
     return torch.tensor([[p.rho_c, p.mu_int, p.mu_surf] for p in presets], dtype=torch.float32)
 

@@ -33,8 +33,7 @@ Where each signal comes from (also in the run metadata, key ``signal_sources``):
 
 Per-joint arrays are mapped from mjlab's joint (and actuator) order to the schema's canonical G1 order by name
 (:func:`joint_permutation`); float32 simulator values are written with their shortest float32 decimal
-representation (exact, and about half the size of float64 text). Imports of ``gmloco.deploy`` are lazy: the
-deploy package must be installed to record (it is a uv workspace member).
+representation (exact, and about half the size of float64 text).
 """
 
 from __future__ import annotations
@@ -46,13 +45,25 @@ import re
 from collections.abc import Sequence
 from dataclasses import dataclass
 from pathlib import Path
-from typing import TYPE_CHECKING, Any
+from typing import Any
 
 import numpy as np
 import torch
 
-if TYPE_CHECKING:
-    from gmloco.deploy.logs import G1LogWriter, RunMetadata
+import gmloco.contact as gc
+from gmloco.deploy.logs import G1_FEET, G1_JOINT_NAMES, G1LogWriter, LogWriterCfg, RunMetadata, git_commit
+from gmloco.deploy.logs.rotations import quat_to_rpy
+from gmloco.deploy.logs.schema import (
+    TOPIC_COMMAND,
+    TOPIC_IMU,
+    TOPIC_JOINT_STATES,
+    TOPIC_LOWCMD,
+    TOPIC_ODOMETRY,
+    TOPIC_POLICY_ACTION,
+    TOPIC_POLICY_OBS,
+    TOPIC_SIM_CONTACT,
+    TOPIC_TF,
+)
 
 __all__ = [
     "EnvRecorder",
@@ -119,8 +130,6 @@ def joint_permutation(source_names: Sequence[str], target_names: Sequence[str] |
         ValueError: If a name is duplicated, missing or unknown.
     """
     if target_names is None:
-        from gmloco.deploy.logs import G1_JOINT_NAMES
-
         target_names = G1_JOINT_NAMES
     src = [n.split("/")[-1] for n in source_names]
     if len(set(src)) != len(src):
@@ -186,8 +195,6 @@ def policy_run_metadata(
         notes: Free text (e.g. how far the policy is validated).
         extra: Further key/values (stringified, non-strings as JSON).
     """
-    from gmloco.deploy.logs import RunMetadata, git_commit
-
     label = label or policy_label(policy_path, onnx_meta)
     digest = _sha256(policy_path)
     commit, dirty = git_commit(Path(__file__).parent)
@@ -199,14 +206,9 @@ def policy_run_metadata(
         "policy_metadata": onnx_meta,
         "signal_sources": SIGNAL_SOURCES,
     }
-    try:
-        import gmloco.contact as gc
-
-        preset = gc.MATERIAL_PRESETS.get(material)
-        if preset is not None and dataclasses.is_dataclass(preset):
-            fields["material_params"] = dataclasses.asdict(preset)
-    except ImportError:  # pragma: no cover - gmloco.contact is a dependency of gmloco.train
-        pass
+    preset = gc.MATERIAL_PRESETS.get(material)
+    if preset is not None and dataclasses.is_dataclass(preset):
+        fields["material_params"] = dataclasses.asdict(preset)
     fields.update(extra or {})
     return RunMetadata(
         controller=f"policy:{label}",
@@ -235,18 +237,6 @@ class EnvRecorder:
     """
 
     def __init__(self, env: Any, path: str | Path, metadata: RunMetadata, cfg: RecordingCfg | None = None) -> None:
-        from gmloco.deploy.logs import G1_FEET, G1_JOINT_NAMES, G1LogWriter, LogWriterCfg
-        from gmloco.deploy.logs.schema import (
-            TOPIC_COMMAND,
-            TOPIC_IMU,
-            TOPIC_JOINT_STATES,
-            TOPIC_LOWCMD,
-            TOPIC_ODOMETRY,
-            TOPIC_POLICY_ACTION,
-            TOPIC_POLICY_OBS,
-            TOPIC_SIM_CONTACT,
-            TOPIC_TF,
-        )
         from gmloco.train.sand import FOOT_SITES
 
         self.cfg = cfg or RecordingCfg()
@@ -304,9 +294,6 @@ class EnvRecorder:
 
     def _write_state(self, t: float) -> None:
         """Write LowState, IMU, odometry and contact truth of the current simulator state of env k."""
-        from gmloco.deploy.logs.rotations import quat_to_rpy
-        from gmloco.deploy.logs.schema import TOPIC_ODOMETRY, TOPIC_SIM_CONTACT
-
         k, d, jp = self.k, self.robot.data, self._joint_perm
         quat = _f32(d.site_quat_w[k, self._imu_site])
         self.writer.write_lowstate(

@@ -15,6 +15,7 @@ from typing import Literal
 
 import numpy as np
 
+from gmloco.deploy.g1 import g1_mjcf_path
 from gmloco.deploy.mismatch.frames import quat_conj, quat_mul, quat_to_mat
 from gmloco.deploy.mismatch.recording import Recording
 
@@ -109,8 +110,6 @@ class ContractCfg:
 @lru_cache(maxsize=1)
 def joint_ranges() -> dict[str, tuple[float, float]]:
     """Joint ranges [rad] read from mjlab's G1 MJCF (plain XML parsing, no mujoco import)."""
-    from gmloco.deploy.mismatch.g1model import g1_mjcf_path
-
     root = ET.parse(g1_mjcf_path()).getroot()
     out: dict[str, tuple[float, float]] = {}
     for j in root.iter("joint"):

@@ -10,14 +10,13 @@ parametric change of *this* model.
 
 from __future__ import annotations
 
-import importlib.util
 from dataclasses import dataclass, field
-from pathlib import Path
 from typing import Any, Literal
 
 import numpy as np
 
 from gmloco.deploy import g1
+from gmloco.deploy.g1 import g1_mjcf_path
 from gmloco.deploy.logs.g1 import G1_JOINT_NAMES
 from gmloco.deploy.mismatch.sand import SandCfg
 
@@ -43,14 +42,6 @@ _SX = (-0.05, 0.01, 0.07, 0.125)
 _SY = (-0.025, 0.025)
 SOLE_POINTS: np.ndarray = np.array([[x, y, -0.035] for x in _SX for y in _SY])
 """Foot sole points used by terrain effects, ankle-roll frame [m], shape [8, 3]."""
-
-
-def g1_mjcf_path() -> Path:
-    """Return mjlab's G1 MJCF path without importing mjlab (which pulls torch and warp)."""
-    spec = importlib.util.find_spec("mjlab")
-    if spec is None or spec.origin is None:
-        raise ImportError("mjlab is not installed; the G1 MJCF ships with mjlab 1.6.0")
-    return Path(spec.origin).parent / "asset_zoo/robots/unitree_g1/xmls/g1.xml"
 
 
 @dataclass

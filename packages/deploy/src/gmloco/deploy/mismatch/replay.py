@@ -25,7 +25,7 @@ from gmloco.deploy.mismatch.g1model import G1_ARMATURE, G1_EFFORT_LIMIT, SOLE_PO
 from gmloco.deploy.mismatch.memo import SegmentMemo, params_key
 from gmloco.deploy.mismatch.recording import Recording
 from gmloco.deploy.mismatch.sand import SandCfg, SoleRFT
-from gmloco.deploy.mismatch.terrain import TerrainCfg, TerrainParams, sand_effect_forces, sole_forces
+from gmloco.deploy.mismatch.terrain import TerrainEffectCfg, TerrainParams, sand_effect_forces, sole_forces
 
 __all__ = [
     "CHANNEL_GROUPS",
@@ -108,7 +108,7 @@ class ReplayCfg:
     """Nominal simulator."""
     base: BaseEstCfg = field(default_factory=BaseEstCfg)
     """Leg-odometry settings (used when the log has no odometry)."""
-    terrain: TerrainCfg = field(default_factory=TerrainCfg)
+    terrain: TerrainEffectCfg = field(default_factory=TerrainEffectCfg)
     """Terrain effect constants."""
     attitude_half_window: int = 8
     """Half window of the gyro-vs-attitude-rate channel [samples] (16 ms at 500 Hz)."""

@@ -59,6 +59,7 @@ class SoleRFT:
 
     def __init__(self, cfg: SandCfg | None = None) -> None:
         """Load the collider, coefficients and material."""
+        # here, not at the top: gmloco.contact pulls Warp; deploy's light core imports without it
         from gmloco.contact import MATERIAL_PRESETS, g1_foot_collider
         from gmloco.contact.coefficients import RFT3D_MONOMIAL_POWERS, resolve_rft3d_coeffs
 

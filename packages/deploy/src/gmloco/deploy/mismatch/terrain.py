@@ -24,12 +24,12 @@ from dataclasses import dataclass
 
 import numpy as np
 
-__all__ = ["TerrainCfg", "TerrainParams", "sand_effect_forces", "sole_forces"]
+__all__ = ["TerrainEffectCfg", "TerrainParams", "sand_effect_forces", "sole_forces"]
 
 
 @dataclass
-class TerrainCfg:
-    """Constants of the terrain effect laws."""
+class TerrainEffectCfg:
+    """Constants of the terrain effect laws of the replay (``TerrainParams`` holds the effects themselves)."""
 
     alpha_ref: float = 8.0e6
     """Reference depth-stress coefficient [N/m^3], close to the nominal soft contact's effective stiffness per
@@ -60,7 +60,7 @@ class TerrainParams:
         return any(v != 0.0 for v in (self.zeta, self.kappa, self.rho_drag, self.cohesion))
 
 
-def sole_forces(points_z: np.ndarray, vel_z: np.ndarray, p: TerrainParams, cfg: TerrainCfg) -> np.ndarray:
+def sole_forces(points_z: np.ndarray, vel_z: np.ndarray, p: TerrainParams, cfg: TerrainEffectCfg) -> np.ndarray:
     """Return the added vertical force on each sole point [N], shape like ``points_z``.
 
     Args:
@@ -78,7 +78,7 @@ def sole_forces(points_z: np.ndarray, vel_z: np.ndarray, p: TerrainParams, cfg: 
 
 
 def sand_effect_forces(
-    f: np.ndarray, depth: np.ndarray, vel_z: np.ndarray, area: np.ndarray, p: TerrainParams, cfg: TerrainCfg
+    f: np.ndarray, depth: np.ndarray, vel_z: np.ndarray, area: np.ndarray, p: TerrainParams, cfg: TerrainEffectCfg
 ) -> np.ndarray:
     """Return the RFT cell forces changed by the terrain effects [N], shape [K, 3] (``f`` itself at zero).
 

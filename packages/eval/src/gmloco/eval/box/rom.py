@@ -73,6 +73,7 @@ def cone_sigmas(rho_c: np.ndarray, mu_int: np.ndarray) -> tuple[np.ndarray, np.n
     sigma_flat = 0.8757 xi_n makes the cone's flat-area stiffness equal 3D-RFT's for a horizontal plate pushed
     straight down; sigma_cone keeps GM-Loco's default ratio 0.08.
     """
+    # here, not at the top: gmloco.contact pulls Warp; this module imports with numpy alone
     from gmloco.contact import xi_n
 
     flat = G_VERTICAL_SOLE * np.asarray(xi_n(np.asarray(rho_c), np.asarray(mu_int)), dtype=np.float64)
@@ -81,6 +82,7 @@ def cone_sigmas(rho_c: np.ndarray, mu_int: np.ndarray) -> tuple[np.ndarray, np.n
 
 def make_box_contact_cfg(model: str, cfg: RomBoxCfg) -> Any:
     """Return the contact-package configuration of ``model`` with the box as its (six-face) collider."""
+    # here, not at the top: gmloco.contact pulls Warp; this module imports with numpy alone
     import gmloco.contact as gc
 
     hx, hy, hz = cfg.box.half_extents
@@ -136,6 +138,7 @@ def simulate_rom_box(
         mu_int: Internal friction per trial [-], [W].
         mu_surf: Surface friction per trial [-], [W].
     """
+    # MuJoCo C, Warp and gmloco.contact load only when trials run; this module imports with numpy alone
     import mujoco
     import warp as wp
 

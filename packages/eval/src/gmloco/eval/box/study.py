@@ -186,6 +186,7 @@ def _run_mpm_batch(
     Timing per trial: ``wall_s`` = the batch's wall time / its trials, ``frames_per_s`` = the batch's frames per
     second, ``particle_count`` = particles of one region.
     """
+    # here, not at the top: gmloco.contact pulls Warp; this module imports with numpy alone
     from gmloco.contact import MaterialCfg
     from gmloco.eval.mpm.box_scene import MpmBoxScene, MpmBoxSceneCfg
 

@@ -123,6 +123,7 @@ class StudentOnnxPolicy:
 
     def __init__(self, path: str | Path, num_robots: int = 1) -> None:
         """Load the runner; check that the observation terms are ones the scene provides."""
+        # here, not at the top: gmloco.deploy.export pulls onnx (and the runner onnxruntime)
         from gmloco.deploy.export import OnnxPolicyRunner
 
         self.runner = OnnxPolicyRunner(path, num_envs=num_robots)
@@ -181,6 +182,7 @@ def load_policy(path: str | Path, num_robots: int = 1) -> MjlabOnnxPolicy | Stud
     Raises:
         PolicyMetadataError: If the file has neither gmloco's document nor mjlab's keys (e.g. version-1 metadata).
     """
+    # onnx, and gmloco.deploy.export that pulls it, load only when a policy file is read
     import onnx
 
     from gmloco.deploy.export import METADATA_KEY, PolicyMetadata

@@ -15,6 +15,19 @@ from typing import Any
 
 import numpy as np
 
+from gmloco.deploy.logs import G1_JOINT_NAMES, G1LogWriter, LogWriterCfg, RunMetadata
+from gmloco.deploy.logs.schema import (
+    TOPIC_COMMAND,
+    TOPIC_ETA,
+    TOPIC_IMU,
+    TOPIC_JOINT_STATES,
+    TOPIC_LOWCMD,
+    TOPIC_ODOMETRY,
+    TOPIC_POLICY_ACTION,
+    TOPIC_SIM_CONTACT,
+    TOPIC_TF,
+)
+
 __all__ = ["CONTACT_FORCE_N", "write_episode_mcap"]
 
 CONTACT_FORCE_N = 40.0
@@ -40,19 +53,6 @@ def write_episode_mcap(path: str | Path, ep: dict[str, Any], meta: dict[str, str
             written where finite: other policies decode none).
         meta: ``policy``, ``material`` and free-form notes for the run metadata.
     """
-    from gmloco.deploy.logs import G1_JOINT_NAMES, G1LogWriter, LogWriterCfg, RunMetadata
-    from gmloco.deploy.logs.schema import (
-        TOPIC_COMMAND,
-        TOPIC_ETA,
-        TOPIC_IMU,
-        TOPIC_JOINT_STATES,
-        TOPIC_LOWCMD,
-        TOPIC_ODOMETRY,
-        TOPIC_POLICY_ACTION,
-        TOPIC_SIM_CONTACT,
-        TOPIC_TF,
-    )
-
     dt, q = float(ep["dt"]), np.asarray(ep["base_q"], dtype=np.float64)
     order = [list(ep["joint_names"]).index(n) for n in G1_JOINT_NAMES]
     jq, jqd, tgt = (np.asarray(ep[k], dtype=np.float64)[:, order] for k in ("joint_q", "joint_qd", "target"))

@@ -8,7 +8,7 @@ from dataclasses import dataclass, field
 from gmloco.eval.g1.soles import SoleCfg
 from gmloco.eval.mpm.box_scene import MpmSolverCfg
 from gmloco.eval.mpm.window import SandWindowCfg
-from gmloco.eval.mpm.window_terrain import TerrainCfg
+from gmloco.eval.mpm.window_terrain import MpmTerrainCfg
 
 __all__ = ["LOG_FIELDS", "G1MpmSceneCfg"]
 
@@ -21,7 +21,7 @@ LOG_FIELDS = ("base_q", "base_qd", "foot_force", "sinkage", "foot_sinkage", "joi
 class G1MpmSceneCfg:
     """G1s-on-sand scene."""
 
-    terrain: TerrainCfg = field(default_factory=lambda: TerrainCfg(name="dry_sand", materials=("dry_sand",)))
+    terrain: MpmTerrainCfg = field(default_factory=lambda: MpmTerrainCfg(name="dry_sand", materials=("dry_sand",)))
     """Terrain (media along x, surface, depth)."""
     window: SandWindowCfg = field(default_factory=lambda: SandWindowCfg(moving=False, length=0.6, width=0.5))
     """Each robot's sand patch (default: a static 0.6 x 0.5 m bed under the feet)."""

@@ -1,18 +1,18 @@
 # SPDX-License-Identifier: Apache-2.0
 """The G1's soles on the sand: sole boxes, which corners need sand, where they lie against the window and pelvis.
 
-Also what the scene builds from besides the G1 facts of :mod:`gmloco.deploy.g1` (foot bodies, sole box): mjlab's
-MJCF, MuJoCo Warp's constraint rows per robot, and the quaternion helpers of the pelvis frame.
+Also what the scene builds from besides the G1 facts of :mod:`gmloco.deploy.g1` (foot bodies, sole box, and mjlab's
+MJCF, ``g1_mjcf_path``, named here too): MuJoCo Warp's constraint rows per robot and the quaternion helpers of the
+pelvis frame.
 """
 
 from __future__ import annotations
 
 from dataclasses import dataclass
-from pathlib import Path
 
 import numpy as np
 
-from gmloco.deploy.g1 import G1_SOLE_BOX_CENTER, G1_SOLE_BOX_HALF_EXTENTS
+from gmloco.deploy.g1 import G1_SOLE_BOX_CENTER, G1_SOLE_BOX_HALF_EXTENTS, g1_mjcf_path
 from gmloco.eval.metrics.locomotion import quat_wxyz_to_roll_pitch_yaw
 
 __all__ = [
@@ -94,13 +94,6 @@ def sole_reach(corners: np.ndarray, low: np.ndarray, base_q: np.ndarray) -> np.n
 # MuJoCo Warp constraint rows per robot: both soles on the rigid floor (8 corners x 2 soles x 4 pyramidal rows) plus
 # joint limits of a fallen robot reached 93 on the H100 (the voxel-size probes: "nefc overflow" at 64, rows dropped).
 NJMAX_PER_ROBOT = 160
-
-
-def g1_mjcf_path() -> Path:
-    """Path of mjlab's G1 MJCF (29 DoF)."""
-    import mjlab
-
-    return Path(mjlab.__file__).parent / "asset_zoo/robots/unitree_g1/xmls/g1.xml"
 
 
 def quat_rotate_inv(q_xyzw: np.ndarray, v: np.ndarray) -> np.ndarray:

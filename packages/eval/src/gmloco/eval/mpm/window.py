@@ -23,7 +23,7 @@ from typing import Any
 
 import numpy as np
 
-from gmloco.eval.mpm.window_terrain import TerrainCfg, terrain_materials
+from gmloco.eval.mpm.window_terrain import MpmTerrainCfg, terrain_materials
 
 __all__ = ["SandWindow", "SandWindowCfg", "reach_within_window", "window_grid", "window_slots"]
 
@@ -101,7 +101,7 @@ class SandWindow:
     def __init__(
         self,
         cfg: SandWindowCfg,
-        terrain: TerrainCfg,
+        terrain: MpmTerrainCfg,
         voxel_size: float,
         lane_y: np.ndarray,
         bodies_per_robot: int,

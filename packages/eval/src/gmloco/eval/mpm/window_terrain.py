@@ -7,7 +7,7 @@ window sees exactly the terrain a full-length bed would have held.
 
 * flat: one medium, surface z = 0;
 * rough: z_s = A sin(2 pi x / lambda) sin(2 pi y / lambda) (GM-Loco initialises the rough MPM surface from a
-  sinusoid; amplitude and wavelength are project choices, ``TerrainCfg.rough_*``);
+  sinusoid; amplitude and wavelength are project choices, ``MpmTerrainCfg.rough_*``);
 * deep: 30 cm of sand with a 20 deg internal friction angle (mu_int = tan 20 deg);
 * transition: basalt -> dry sand -> poppy seed, each ``layer_length`` long along the course.
 """
@@ -21,12 +21,12 @@ import numpy as np
 
 from gmloco.eval.mpm.materials import MpmMaterialCfg, mpm_material
 
-__all__ = ["TERRAIN_NAMES", "TerrainCfg", "terrain_cfg", "terrain_materials", "terrain_surface_height"]
+__all__ = ["TERRAIN_NAMES", "MpmTerrainCfg", "terrain_cfg", "terrain_materials", "terrain_surface_height"]
 
 
 @dataclass(frozen=True)
-class TerrainCfg:
-    """One evaluation terrain."""
+class MpmTerrainCfg:
+    """One evaluation terrain on MPM sand: its media along the course, depth and surface (``terrain_cfg`` names them)."""
 
     name: str
     """Label in tables (e.g. ``dry_sand``, ``dry_sand_rough``, ``transition``)."""
@@ -50,17 +50,18 @@ TERRAIN_NAMES = ("basalt", "dry_sand", "poppy_seed", "dry_sand_rough", "dry_sand
 """The paper's terrains (``terrain_cfg`` names); any preset name alone is a flat terrain of that medium."""
 
 
-def terrain_cfg(name: str, depth: float = 0.15) -> TerrainCfg:
+def terrain_cfg(name: str, depth: float = 0.15) -> MpmTerrainCfg:
     """Return a named terrain: a preset medium (flat), ``<medium>_rough``, ``<medium>_deep`` or ``transition``."""
+    # here, not at the top: gmloco.contact pulls Warp; this module imports with numpy alone
     from gmloco.contact import MATERIAL_PRESETS
 
     if name == "transition":
-        return TerrainCfg(name=name, materials=("basalt", "dry_sand", "poppy_seed"), depth=depth)
+        return MpmTerrainCfg(name=name, materials=("basalt", "dry_sand", "poppy_seed"), depth=depth)
     base, _, variant = name.rpartition("_") if name.endswith(("_rough", "_deep")) else (name, "", "")
     if base not in MATERIAL_PRESETS:
         raise ValueError(f"unknown terrain {name!r}: use a preset ({sorted(MATERIAL_PRESETS)}), "
                          "'<preset>_rough', '<preset>_deep' or 'transition'")  # fmt: skip
-    cfg = TerrainCfg(name=name, materials=(base,), depth=depth)
+    cfg = MpmTerrainCfg(name=name, materials=(base,), depth=depth)
     if variant == "rough":
         return replace(cfg, rough_amplitude=0.04, rough_wavelength=0.8)
     if variant == "deep":
@@ -68,21 +69,22 @@ def terrain_cfg(name: str, depth: float = 0.15) -> TerrainCfg:
     return cfg
 
 
-def terrain_materials(cfg: TerrainCfg) -> list[MpmMaterialCfg]:
+def terrain_materials(cfg: MpmTerrainCfg) -> list[MpmMaterialCfg]:
     """MPM parameters of each medium of the terrain (``mu_int`` override applied)."""
+    # here, not at the top: gmloco.contact pulls Warp; this module imports with numpy alone
     from gmloco.contact import MATERIAL_PRESETS
 
     mats = [mpm_material(MATERIAL_PRESETS[m]) for m in cfg.materials]
     return [m if cfg.mu_int is None else replace(m, friction=float(cfg.mu_int)) for m in mats]
 
 
-def terrain_surface_height(cfg: TerrainCfg, x: np.ndarray, y: np.ndarray) -> np.ndarray:
+def terrain_surface_height(cfg: MpmTerrainCfg, x: np.ndarray, y: np.ndarray) -> np.ndarray:
     """Surface height z_s(x, y) [m] in lane coordinates (the numpy twin of the window kernel's ``surface_z``)."""
     k = 2.0 * math.pi / cfg.rough_wavelength
     return cfg.rough_amplitude * np.sin(k * np.asarray(x)) * np.sin(k * np.asarray(y))
 
 
-def terrain_layer(cfg: TerrainCfg, x: np.ndarray) -> np.ndarray:
+def terrain_layer(cfg: MpmTerrainCfg, x: np.ndarray) -> np.ndarray:
     """Index of the medium at course position x [m] (numpy twin of the window kernel's ``layer_index``)."""
     n = len(cfg.materials)
     k = np.floor((np.asarray(x) - cfg.layer_start) / cfg.layer_length).astype(int)

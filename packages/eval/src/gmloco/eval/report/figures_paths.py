@@ -18,6 +18,8 @@ from pathlib import Path
 
 import numpy as np
 
+from gmloco.deploy.logs import read_log
+
 __all__ = ["RecordedPath", "fig_paths", "recorded_path", "recordings_by_cell"]
 
 _END_MARKERS: dict[str, str | None] = {"completed": "*", "timeout": None}
@@ -47,7 +49,6 @@ def recorded_path(recording: str | Path) -> RecordedPath:
     Raises:
         KeyError: The recording holds no odometry or no velocity command (not an evaluation episode).
     """
-    from gmloco.deploy.logs import read_log
     from gmloco.eval.metrics.locomotion import quat_wxyz_to_roll_pitch_yaw
 
     with warnings.catch_warnings():  # a recording has no run_end record by design; the reader warns about it

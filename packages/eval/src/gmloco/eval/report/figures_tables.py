@@ -30,6 +30,8 @@ from typing import Any
 
 import numpy as np
 
+from gmloco.deploy.logs import read_log
+
 __all__ = [
     "AdaptationTrace",
     "adaptation_trace",
@@ -202,8 +204,6 @@ def adaptation_trace(recording: str | Path) -> AdaptationTrace:
     Raises:
         KeyError: The recording lacks odometry or the simulated foot contact (not an evaluation episode).
     """
-    from gmloco.deploy.logs import read_log
-
     with warnings.catch_warnings():  # a recording has no run_end record by design; the reader warns about it
         warnings.simplefilter("ignore")
         lg = read_log(recording)
@@ -261,7 +261,7 @@ def fig_adaptation(
         recordings: Recorded transition walks (``recordings/transition__*.mcap``), any number.
         path: Output PNG.
         label: Policy label for the title.
-        terrain: The course (``window_terrain.TerrainCfg``; default ``terrain_cfg("transition")``).
+        terrain: The course (``window_terrain.MpmTerrainCfg``; default ``terrain_cfg("transition")``).
     """
     from gmloco.eval.mpm.window_terrain import terrain_cfg
     from gmloco.eval.report.tables_mpm import table_transition

@@ -151,6 +151,7 @@ def _usable(runs: list[dict[str, Any]]) -> list[dict[str, Any]]:
 
 def _fit_and_compare(cfg: RftFitCfg, runs: list[dict[str, Any]], out: Path) -> dict[str, Any]:
     """Fit the 60 coefficients, compare with the prior set, write the coefficient file and the per-run table."""
+    # here, not at the top: gmloco.contact pulls Warp; this module imports with numpy alone
     from gmloco.contact import RFT3D_COEFFS
 
     nrm = np.array([r["leading_normal"] for r in runs])
@@ -210,6 +211,7 @@ def _write_table(path: Path, runs: list[dict[str, Any]], g_prior: np.ndarray, g_
 
 def run(cfg: RftFitCfg) -> dict[str, Any]:
     """Run (or resume) the sweep, fit the coefficients, compare with the prior set, write the outputs."""
+    # here, not at the top: gmloco.contact pulls Warp; this module imports with numpy alone
     from gmloco.contact import MATERIAL_PRESETS
 
     t_start = time.perf_counter()

@@ -82,7 +82,7 @@ def _parse(argv: Sequence[str] | None) -> argparse.Namespace:
 
 def _cfg(args: argparse.Namespace) -> GateCfg:
     """The gate config of the arguments; ValueError names a bad value."""
-    import gmloco.contact as gc
+    import gmloco.contact as gc  # here, not at the top: it pulls Warp, which --help does not need
 
     materials = tuple(m.strip() for m in args.materials.split(",") if m.strip())
     unknown = [m for m in materials if m not in gc.MATERIAL_PRESETS]
@@ -99,7 +99,7 @@ def _cfg(args: argparse.Namespace) -> GateCfg:
             "the decoded eta needs more than one material), e.g. 3,3"
         )
     if args.contact_model == "rft3d_calibrated":
-        from gmloco.contact.extensions_io import load_rft_extensions
+        from gmloco.contact.extensions_io import load_rft_extensions  # Warp, as above
 
         load_rft_extensions(args.rft_extensions)  # a missing or malformed file stops here, before any env is built
     return GateCfg(

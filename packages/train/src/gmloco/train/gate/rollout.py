@@ -15,6 +15,7 @@ from typing import Any, Literal
 import numpy as np
 import torch
 
+import gmloco.contact as gc
 from gmloco.train.gate.config import GateCfg
 from gmloco.train.gate.metrics import (
     circle_reference,
@@ -56,8 +57,6 @@ def gate_cells(cfg: GateCfg) -> list[GateCell]:
 
     The forward cells are the ``speeds`` (part ``success``) and ``apex_speed`` (part ``apex``), each once.
     """
-    import gmloco.contact as gc
-
     parts = set(cfg.parts)
     speeds = list(cfg.speeds) if "success" in parts else []
     if "apex" in parts and cfg.apex_speed not in speeds:

@@ -10,6 +10,7 @@ from dataclasses import asdict
 from pathlib import Path
 from typing import Any
 
+from gmloco.contact.extensions_io import load_rft_extensions
 from gmloco.train.gate.config import GateCfg
 from gmloco.train.gate.policy import gpu_minutes, read_policy
 from gmloco.train.gate.rollout import gate_cells, run_cells
@@ -33,8 +34,6 @@ def _extensions(cfg: GateCfg) -> dict[str, Any] | None:
     """The fitted terms the ``rft3d_calibrated`` model ran with and their file; None for the other models."""
     if cfg.contact_model != "rft3d_calibrated":
         return None
-    from gmloco.contact.extensions_io import load_rft_extensions
-
     return {"file": cfg.rft_extensions_file, "values": asdict(load_rft_extensions(cfg.rft_extensions_file))}
 
 

@@ -11,6 +11,8 @@ from typing import TYPE_CHECKING, Any
 
 from mjlab.rl.exporter_utils import attach_metadata_to_onnx, get_base_metadata
 
+from gmloco.deploy.export import write_policy_metadata
+
 if TYPE_CHECKING:
     from mjlab.envs import ManagerBasedRlEnv
     from mjlab.rl import MjlabOnPolicyRunner
@@ -72,7 +74,6 @@ def export_policy_onnx(
         extra: More mjlab-style keys.
         commit: Git commit of the training code.
     """
-    from gmloco.deploy.export import write_policy_metadata
     from gmloco.train.tasks.g1_granular.policy_metadata import policy_metadata_from_env
 
     path = Path(path)

@@ -20,6 +20,7 @@ from typing import Any
 import numpy as np
 import torch
 
+from gmloco.deploy.export import OnnxPolicyRunner, ParityError, export_policy_onnx, verify_parity
 from gmloco.train.config import GranularTaskCfg
 
 __all__ = ["build_runner", "export_student_onnx", "rollout_parity_check", "student_policy_metadata"]
@@ -94,8 +95,6 @@ def export_student_onnx(runner: Any, path: str | Path, metadata: Any, atol: floa
     Raises:
         ParityError: If onnxruntime and torch differ by more than ``atol`` on random inputs.
     """
-    from gmloco.deploy.export import export_policy_onnx, verify_parity
-
     path = Path(path)
     policy = runner.alg.get_policy()
     tmp = path.with_suffix(".onnx.tmp")
@@ -126,8 +125,6 @@ def rollout_parity_check(
     Raises:
         ParityError: If onnxruntime's action or eta differs from torch's by more than ``atol``.
     """
-    from gmloco.deploy.export import OnnxPolicyRunner, ParityError
-
     env, student, teacher = runner.env, runner.get_inference_policy(), runner.alg.teacher
     onnx_runner = OnnxPolicyRunner(path, num_envs=env.num_envs)
     if force_reset_after is not None:

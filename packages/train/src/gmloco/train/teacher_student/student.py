@@ -14,18 +14,18 @@ from __future__ import annotations
 
 import torch
 import torch.nn as nn
-from rsl_rl.models import MLPModel
-from rsl_rl.modules import MLP, EmpiricalNormalization, HiddenState
+from rsl_rl.modules import MLP, EmpiricalNormalization
 from tensordict import TensorDict
 
 from gmloco.train.teacher_student.actor_export import LatentActorExport
 from gmloco.train.teacher_student.config import DEFAULT_HISTORY_LENGTH
+from gmloco.train.teacher_student.latent_actor import LatentActor
 from gmloco.train.teacher_student.networks import TemporalConvEncoder, history_to_time_major
 
 __all__ = ["DEFAULT_HISTORY_LENGTH", "StudentActor"]
 
 
-class StudentActor(MLPModel):
+class StudentActor(LatentActor):
     """MLP actor over ``[o_t, z_hat_t]`` with a temporal-convolution history encoder.
 
     It also carries a frozen copy of the teacher's stiffness decoder psi, so the exported policy can report the
@@ -109,10 +109,6 @@ class StudentActor(MLPModel):
         self.latent: torch.Tensor | None = None
         """Latent estimate z_hat of the last forward pass, ``[batch, latent_dim]``."""
 
-    def _get_latent_dim(self) -> int:
-        """Return the actor MLP input size, ``obs_dim + latent_dim``."""
-        return self.obs_dim + self.latent_dim
-
     def history(self, obs: TensorDict) -> torch.Tensor:
         """Return the raw history ``[batch, N, D]``, oldest frame first."""
         return history_to_time_major(obs[self.history_group], self.history_length, self.history_term_dims)
@@ -125,13 +121,10 @@ class StudentActor(MLPModel):
         """Return psi(z) ``[batch, 1]`` with the frozen decoder copy."""
         return self.decoder(z)
 
-    def get_latent(
-        self, obs: TensorDict, masks: torch.Tensor | None = None, hidden_state: HiddenState = None
-    ) -> torch.Tensor:
-        """Return the actor input ``[batch, obs_dim + latent_dim]``: normalized o_t and z_hat."""
-        o_t = super().get_latent(obs, masks, hidden_state)
+    def latent_for_actor(self, obs: TensorDict) -> torch.Tensor:
+        """Return z_hat ``[batch, latent_dim]`` and keep it as :attr:`latent` for the distillation loss."""
         self.latent = self.encode(obs)
-        return torch.cat([o_t, self.latent], dim=-1)
+        return self.latent
 
     def update_normalization(self, obs: TensorDict) -> None:
         """Update the o_t and per-frame history running statistics."""
@@ -139,13 +132,9 @@ class StudentActor(MLPModel):
         if self.history_obs_normalization:
             self.history_normalizer.update(self.history(obs).reshape(-1, self.history_frame_dim))  # type: ignore[operator]
 
-    def as_jit(self) -> nn.Module:
-        """Return a TorchScript-ready copy that keeps the encoder: ``(obs, history) -> actions``."""
-        return _StudentExport(self)
-
-    def as_onnx(self, verbose: bool) -> nn.Module:
-        """Return an ONNX-ready copy: inputs ``obs``, ``history``; outputs ``actions``, ``latent``, ``eta``."""
-        return _StudentOnnxExport(self)
+    def export_copy(self, onnx: bool) -> nn.Module:
+        """Return ``(obs, history) -> actions``, or for ONNX the outputs ``actions``, ``latent``, ``eta``."""
+        return _StudentOnnxExport(self) if onnx else _StudentExport(self)
 
 
 class _StudentExport(LatentActorExport):

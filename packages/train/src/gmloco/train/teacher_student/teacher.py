@@ -13,17 +13,17 @@ from typing import Literal
 
 import torch
 import torch.nn as nn
-from rsl_rl.models import MLPModel
-from rsl_rl.modules import MLP, EmpiricalNormalization, HiddenState
+from rsl_rl.modules import MLP, EmpiricalNormalization
 from tensordict import TensorDict
 
 from gmloco.train.teacher_student.actor_export import LatentActorExport
+from gmloco.train.teacher_student.latent_actor import LatentActor
 from gmloco.train.teacher_student.networks import GaussianEncoder, flatten_groups
 
 __all__ = ["TeacherActor"]
 
 
-class TeacherActor(MLPModel):
+class TeacherActor(LatentActor):
     """MLP actor over ``[o_t, z_t]`` with a Gaussian terrain encoder and a stiffness decoder.
 
     The encoder input is the concatenation of the observation groups of the ``encoder_obs_set`` set
@@ -89,10 +89,6 @@ class TeacherActor(MLPModel):
         self.latent_logvar: torch.Tensor | None = None
         """Latent log-variance of the last forward pass, ``[batch, latent_dim]``."""
 
-    def _get_latent_dim(self) -> int:
-        """Return the actor MLP input size, ``obs_dim + latent_dim``."""
-        return self.obs_dim + self.latent_dim
-
     def encoder_input(self, obs: TensorDict) -> torch.Tensor:
         """Return the flattened, un-normalized encoder input ``[batch, encoder_obs_dim]``."""
         return flatten_groups(obs, self.encoder_obs_groups, self.encoder_history_steps)
@@ -105,16 +101,12 @@ class TeacherActor(MLPModel):
         """Return the decoded normalized stiffness psi(z), ``[batch, 1]``."""
         return self.decoder(z)
 
-    def get_latent(
-        self, obs: TensorDict, masks: torch.Tensor | None = None, hidden_state: HiddenState = None
-    ) -> torch.Tensor:
-        """Return the actor input ``[batch, obs_dim + latent_dim]``: normalized o_t and the terrain latent."""
-        o_t = super().get_latent(obs, masks, hidden_state)
+    def latent_for_actor(self, obs: TensorDict) -> torch.Tensor:
+        """Return z ``[batch, latent_dim]`` (mu, or a training-mode sample) and keep mu and logvar for the VAE loss."""
         mu, logvar = self.encode(obs)
         self.latent_mu, self.latent_logvar = mu, logvar
         use_sample = self.actor_latent == "sample" and self.training
-        z = mu + torch.exp(0.5 * logvar) * torch.randn_like(mu) if use_sample else mu
-        return torch.cat([o_t, z], dim=-1)
+        return mu + torch.exp(0.5 * logvar) * torch.randn_like(mu) if use_sample else mu
 
     def update_normalization(self, obs: TensorDict) -> None:
         """Update the o_t and encoder-input running statistics."""
@@ -122,12 +114,8 @@ class TeacherActor(MLPModel):
         if self.encoder_obs_normalization:
             self.encoder_normalizer.update(self.encoder_input(obs))  # type: ignore[operator]
 
-    def as_jit(self) -> nn.Module:
-        """Return a TorchScript-ready copy that keeps the encoder: ``(obs, encoder_obs) -> actions``."""
-        return _TeacherExport(self)
-
-    def as_onnx(self, verbose: bool) -> nn.Module:
-        """Return an ONNX-ready copy that keeps the encoder: inputs ``obs``, ``encoder_obs``."""
+    def export_copy(self, onnx: bool) -> nn.Module:
+        """Return the same copy for TorchScript and ONNX: ``(obs, encoder_obs) -> actions``."""
         return _TeacherExport(self)
 
 

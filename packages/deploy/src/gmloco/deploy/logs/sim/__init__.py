@@ -4,7 +4,7 @@
 from gmloco.deploy.logs.sim.ground import GroundContact, RigidGround, RigidGroundCfg
 from gmloco.deploy.logs.sim.recorder import MujocoG1Recorder
 from gmloco.deploy.logs.sim.run import CommandSegment, ScriptedRunCfg, record_scripted_run
-from gmloco.deploy.logs.sim.scene import G1SceneCfg, build_g1_model, g1_xml_path
+from gmloco.deploy.logs.sim.scene import G1SceneCfg, build_g1_model
 from gmloco.deploy.logs.sim.scripted import ScriptedStepping, ScriptedSteppingCfg
 from gmloco.deploy.logs.sim.support import VirtualGantry, VirtualGantryCfg
 
@@ -21,6 +21,5 @@ __all__ = [
     "VirtualGantry",
     "VirtualGantryCfg",
     "build_g1_model",
-    "g1_xml_path",
     "record_scripted_run",
 ]

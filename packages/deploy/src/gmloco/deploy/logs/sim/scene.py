@@ -3,29 +3,19 @@
 
 from __future__ import annotations
 
-import importlib.util
 from dataclasses import dataclass
-from pathlib import Path
 from typing import Any
 
 import numpy as np
 
-from gmloco.deploy.g1 import G1_EFFORT_LIMIT, G1_JOINT_NAMES, g1_actuator
+from gmloco.deploy.g1 import G1_EFFORT_LIMIT, G1_JOINT_NAMES, g1_actuator, g1_mjcf_path
 
-__all__ = ["G1SceneCfg", "build_g1_model", "g1_effort_limits", "g1_xml_path"]
+__all__ = ["G1SceneCfg", "build_g1_model", "g1_effort_limits"]
 
 
 def g1_effort_limits() -> np.ndarray:
     """Joint torque limits [N*m], canonical order, shape [29]."""
     return np.array(G1_EFFORT_LIMIT)
-
-
-def g1_xml_path() -> Path:
-    """Return the G1 MJCF shipped with mjlab, located without importing mjlab (which pulls torch and warp)."""
-    spec = importlib.util.find_spec("mjlab")
-    if spec is None or spec.origin is None:
-        raise ImportError("mjlab is not installed; the G1 MJCF ships with mjlab 1.6.0 (uv sync the workspace)")
-    return Path(spec.origin).parent / "asset_zoo/robots/unitree_g1/xmls/g1.xml"
 
 
 @dataclass
@@ -49,7 +39,7 @@ def build_g1_model(cfg: G1SceneCfg | None = None) -> Any:
     import mujoco
 
     cfg = cfg or G1SceneCfg()
-    spec = mujoco.MjSpec.from_file(str(g1_xml_path()))
+    spec = mujoco.MjSpec.from_file(str(g1_mjcf_path()))
     spec.option.timestep = cfg.timestep
     spec.option.integrator = mujoco.mjtIntegrator.mjINT_IMPLICITFAST
     if cfg.floor:

@@ -29,6 +29,7 @@ class TruthSand:
 
     def __init__(self, e: TruthEffect, material: str = "dry_sand", resolution: int = 7) -> None:
         """Collider, medium and effect parameters."""
+        # here, not at the top: gmloco.contact pulls Warp; deploy's light core imports without it
         from gmloco.contact import MATERIAL_PRESETS, ContactRFT3DCfg, g1_foot_collider
 
         col = g1_foot_collider("sole", resolution)
@@ -48,6 +49,7 @@ class TruthSand:
         """Add the sand wrench of both feet to ``data.xfrc_applied`` and advance the crater state."""
         import mujoco
 
+        # gmloco.contact pulls Warp, as above
         from gmloco.contact.reference import advance_stick_anchors, rft3d_unloading_forces
 
         r = self.rest

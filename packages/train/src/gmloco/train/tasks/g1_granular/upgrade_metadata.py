@@ -30,6 +30,7 @@ from typing import Any
 
 import onnx
 
+from gmloco.deploy.export import METADATA_KEY, write_policy_metadata
 from gmloco.train.config import GranularTaskCfg, MaterialRangeCfg, RobotDrCfg, SandFloorCfg, SandTerrainCfg
 
 __all__ = ["main", "task_from_dict", "upgrade_policy_dir"]
@@ -149,8 +150,6 @@ def upgrade_policy_dir(folder: Path, overrides: Mapping[str, Any] | None = None)
         ValueError: If the file has neither version-1 student nor mjlab export entries, or the facts disagree
             (history length, actor terms, policy dt, contact model).
     """
-    from gmloco.deploy.export import METADATA_KEY, write_policy_metadata
-
     path, cfg = folder / "policy.onnx", json.loads((folder / "train_cfg.json").read_text())
     model = onnx.load(str(path))
     props = {p.key: p.value for p in model.metadata_props}

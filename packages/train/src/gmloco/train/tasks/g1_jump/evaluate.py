@@ -72,7 +72,7 @@ def _parser() -> argparse.ArgumentParser:
 
 def _check(args: argparse.Namespace) -> dict[str, Path]:
     """Validate the arguments; raise ValueError with the fix."""
-    import gmloco.contact as gc
+    import gmloco.contact as gc  # here, not at the top: it pulls Warp, which --help does not need
 
     unknown = sorted(set(args.materials) - set(gc.MATERIAL_PRESETS))
     if unknown:
