@@ -113,6 +113,13 @@ def _parse(argv: list[str] | None) -> argparse.Namespace:
         "value to every chunk of a run",
     )
     p.add_argument(
+        "--floor-depth-max",
+        type=float,
+        default=None,
+        help="deepest floor of the floor-depth curriculum [m] (SandFloorCfg.depth_range's upper end; default: the "
+        "task's, GM-Loco's 0.12); 0.30 puts the top levels below any foot, as the gate's and MPM's deep beds",
+    )
+    p.add_argument(
         "--allow-changed",
         action="append",
         default=[],
@@ -169,6 +176,8 @@ def _parse(argv: list[str] | None) -> argparse.Namespace:
         help="CUDA device ids trained on data-parallel, one rank each (TrainRunCfg.gpus); default: --device alone",
     )
     args = p.parse_args(argv)
+    if args.floor_depth_max is not None and not 0.0 < args.floor_depth_max <= 1.0:
+        p.error(f"--floor-depth-max {args.floor_depth_max}: give the deepest floor in (0, 1] m, e.g. 0.30")
     if args.gpus:
         from gmloco.train.multi_gpu import cuda_device_count, gpus_problem
 
@@ -275,6 +284,9 @@ def _task(args: argparse.Namespace) -> Any:
         from gmloco.train.config import FloorPromotion
 
         floor = replace(task.terrain.floor, promotion=FloorPromotion(args.floor_promotion))
+        task = replace(task, terrain=replace(task.terrain, floor=floor))
+    if args.floor_depth_max is not None:
+        floor = replace(task.terrain.floor, depth_range=(task.terrain.floor.depth_range[0], args.floor_depth_max))
         task = replace(task, terrain=replace(task.terrain, floor=floor))
     weights = reward_weights(args.reward_weight)
     if weights:

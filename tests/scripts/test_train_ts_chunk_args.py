@@ -79,3 +79,21 @@ def test_bad_gpus_exit_2(gpus: list[str], words: str, capsys: pytest.CaptureFixt
 def test_gpus_reach_the_parsed_args() -> None:
     """Without ``--gpus`` the run trains on ``--device`` alone."""
     assert _load()._parse(["--stage", "teacher", "--out", "unused"]).gpus == []
+
+
+def test_floor_depth_max_deepens_the_curriculum_only() -> None:
+    """--floor-depth-max sets the deepest level's floor [m]; the shallowest and the level count stay the task's."""
+    chunk = _load()
+    base = ["--stage", "teacher", "--out", "unused", "--no-held-out"]
+    default = chunk._task(chunk._parse(base)).terrain.floor
+    floor = chunk._task(chunk._parse([*base, "--floor-depth-max", "0.3"])).terrain.floor
+    assert default.depth_range == (0.0, 0.12)
+    assert floor.depth_range == (0.0, 0.3) and floor.num_levels == default.num_levels
+
+
+@pytest.mark.parametrize("depth", ["0", "-0.1", "1.5"])
+def test_bad_floor_depth_max_exits_2(depth: str, capsys: pytest.CaptureFixture[str]) -> None:
+    """A depth outside (0, 1] m is refused with exit 2 and says what to give."""
+    with pytest.raises(SystemExit) as exc:
+        _load()._parse(["--stage", "teacher", "--out", "unused", "--floor-depth-max", depth])
+    assert exc.value.code == 2 and "deepest floor in (0, 1] m" in capsys.readouterr().err

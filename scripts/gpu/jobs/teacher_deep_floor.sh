@@ -2,7 +2,9 @@
 # Copy to .devsrc/job.sh, with .devsrc/checkpoint.pt = the checkpoint to resume (e.g. the newest of a chunk) and
 # .devsrc/rft3d_calibrated.json = results/sand_calibration/rft3d_calibrated.json; start it with launch_job.sh SECONDS
 # and poll with jobs/poll_teacher.sh MAX_SECONDS gm_loco_teacher_calibrated.
-# The calibrated-sand teacher alone on the GPU, resumed with the survival rule of the floor-depth curriculum.
+# The calibrated-sand teacher alone on the GPU, resumed with the survival rule of the floor-depth curriculum and
+# floors down to 30 cm: the top levels are the gate's and MPM's deep bed, where no foot meets the floor (over a 2.5 cm
+# floor the teacher walks every gate cell on the calibrated sand; over the deep bed it tips over within 2 s).
 set -uo pipefail
 end=$1
 run=gm_loco_teacher_calibrated
@@ -16,7 +18,8 @@ mins=$(python3 -c "import time; print(round(($end - time.time())/60 - 0.4, 2))")
 echo "teacher chunk: max-minutes $mins" > ~/chunks/job.log
 python3 scripts/gpu/train_ts_chunk.py --stage teacher --run "$run" --contact-model rft3d_calibrated \
   --foot-clearance sinkage --foot-faces box --curriculum-scale 0.1 --reward-weight foot_clearance_l2=-50 \
-  --floor-promotion survival --allow-changed task.terrain.floor.promotion \
+  --floor-promotion survival --floor-depth-max 0.30 \
+  --allow-changed task.terrain.floor.promotion --allow-changed task.terrain.floor.depth_range \
   --max-iterations 6000 --max-minutes "$mins" --post-minutes 1.0 --full-checkpoint --out ~/chunks/teacher \
   >> ~/chunks/job.log 2>&1
 echo "train rc $?" >> ~/chunks/job.log
