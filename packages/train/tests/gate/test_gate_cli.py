@@ -54,3 +54,23 @@ def test_cpu_sized_gate_writes_every_key(run: str, tmp_path: Path, monkeypatch: 
     assert summary["gpu_minutes"] is not None and summary["gpu_minutes"] > 0
     assert (summary["eta_r2_heldout"] is None) == (run == "ppo_rft3d")
     assert summary["setup"]["yaw_command"] == ("yaw_target" if run == "gm_loco_teacher_yaw" else "heading_envs")
+
+
+def test_floor_depth_puts_a_hard_floor_under_the_feet() -> None:
+    """--floor-depth D enables the feet's floor D m down; without it the gate keeps the 30 cm bed with no foot floor."""
+    from gmloco.train.gate.__main__ import _cfg, _parse
+
+    base = ["--policy", "unused", "--out", "unused.json", "--contact-model", "rft3d"]
+    deep = _cfg(_parse(base)).floor
+    floor = _cfg(_parse([*base, "--floor-depth", "0.025"])).floor
+    assert not deep.enabled and deep.depth_range == (0.3, 0.3)
+    assert floor.enabled and floor.depth_range == (0.025, 0.025) and not floor.curriculum
+
+
+def test_floor_depth_must_be_positive(capsys: pytest.CaptureFixture[str]) -> None:
+    """A floor at or above the surface is refused with exit 2."""
+    from gmloco.train.gate.__main__ import _parse
+
+    with pytest.raises(SystemExit) as exc:
+        _parse(["--policy", "unused", "--out", "unused.json", "--floor-depth", "0"])
+    assert exc.value.code == 2 and "expected a number > 0" in capsys.readouterr().err

@@ -12,6 +12,7 @@ import argparse
 import json
 import sys
 from collections.abc import Sequence
+from dataclasses import replace
 from typing import get_args
 
 from gmloco.train.config import ContactModelName
@@ -75,6 +76,13 @@ def _parse(argv: Sequence[str] | None) -> argparse.Namespace:
     p.add_argument(
         "--parts", type=_parts, default=d.parts, help=f"parts measured, e.g. success (default {','.join(d.parts)})"
     )
+    p.add_argument(
+        "--floor-depth",
+        type=_positive_float,
+        default=None,
+        help="feet meet a hard floor this far below the surface [m], as over the training floors (default: none, "
+        "a 30 cm bed as on MPM)",
+    )
     p.add_argument("--device", default=d.device)
     p.add_argument("--seed", type=int, default=d.seed)
     return p.parse_args(argv)
@@ -102,7 +110,11 @@ def _cfg(args: argparse.Namespace) -> GateCfg:
         from gmloco.contact.extensions_io import load_rft_extensions  # Warp, as above
 
         load_rft_extensions(args.rft_extensions)  # a missing or malformed file stops here, before any env is built
+    floor = GateCfg().floor
+    if args.floor_depth is not None:
+        floor = replace(floor, enabled=True, depth_range=(args.floor_depth, args.floor_depth))
     return GateCfg(
+        floor=floor,
         policy_dir=args.policy,
         out_path=args.out,
         repeats=args.episodes,
