@@ -132,6 +132,18 @@ class SandContact:
         frac = self.floor_level.float() / max(floor.num_levels - 1, 1)
         return lo + (hi - lo) * frac
 
+    # Checkpoint state.
+
+    def state_dict(self) -> dict[str, torch.Tensor]:
+        """What a checkpoint keeps of the sand: each env's floor-depth curriculum level."""
+        return {"floor_level": self.floor_level.cpu()}
+
+    def load_state_dict(self, state: dict[str, torch.Tensor]) -> None:
+        """Restore :meth:`state_dict`'s levels; a checkpoint of another env count leaves the drawn levels."""
+        levels = state["floor_level"]
+        if levels.shape[0] == self.num_envs:
+            self.floor_level.copy_(levels.to(self.device))
+
     # Event interface.
 
     def __call__(self, env: ManagerBasedRlEnv, env_ids: torch.Tensor | None, task: GranularTaskCfg) -> None:

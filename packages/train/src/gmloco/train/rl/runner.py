@@ -14,9 +14,15 @@ import torch
 from mjlab.rl import MjlabOnPolicyRunner
 
 from gmloco.train.multi_gpu import any_rank, rank_info
-from gmloco.train.sand import get_sand
 
-__all__ = ["CHECKPOINT_PATTERN", "GmlocoOnPolicyRunner", "latest_checkpoint"]
+__all__ = [
+    "CHECKPOINT_PATTERN",
+    "ENV_STATE_OWNERS",
+    "GmlocoOnPolicyRunner",
+    "env_state",
+    "latest_checkpoint",
+    "restore_env_state",
+]
 
 CHECKPOINT_PATTERN = re.compile(r"^model_(\d+)\.pt$")
 """File names of checkpoints: ``model_<iteration>.pt``."""
@@ -30,6 +36,31 @@ before ``physics_diverged`` resets it, which would wreck the critic."""
 def bounded_step_reward(rewards: torch.Tensor, limit: float = STEP_REWARD_LIMIT) -> torch.Tensor:
     """Clamp each env's step reward to [-limit, limit] (non-finite values are zeroed by mjlab's reward manager)."""
     return rewards.clamp(-limit, limit)
+
+
+ENV_STATE_OWNERS = ("sand", "jump_assist")
+"""Env attributes whose ``state_dict()`` a checkpoint keeps under the same name (curriculum state that the env step
+counter does not carry: floor levels, the jump assist's scale)."""
+
+
+def env_state(env: object) -> dict[str, dict]:
+    """The ``state_dict()`` of each of the env's :data:`ENV_STATE_OWNERS` it has, by name."""
+    owners = {name: getattr(env, name, None) for name in ENV_STATE_OWNERS}
+    return {name: owner.state_dict() for name, owner in owners.items() if owner is not None}
+
+
+def restore_env_state(env: object, infos: dict) -> None:
+    """Load each saved owner's state into the env's owner of that name; skip owners either side lacks.
+
+    An older checkpoint's ``sand_floor_level`` reads as the sand's state.
+    """
+    saved = dict(infos)
+    if saved.get("sand_floor_level") is not None and "sand" not in saved:
+        saved["sand"] = {"floor_level": saved["sand_floor_level"]}
+    for name in ENV_STATE_OWNERS:
+        owner = getattr(env, name, None)
+        if owner is not None and saved.get(name) is not None:
+            owner.load_state_dict(saved[name])
 
 
 def latest_checkpoint(run_dir: str | Path) -> Path | None:
@@ -166,11 +197,7 @@ class GmlocoOnPolicyRunner(MjlabOnPolicyRunner):
 
     def save(self, path: str, infos: dict | None = None) -> None:
         """Write the checkpoint to ``path + '.tmp'`` then ``os.replace`` it (a kill never leaves half a file)."""
-        sand = getattr(self.env.unwrapped, "sand", None)
-        infos = {**(infos or {}), "sand_floor_level": None if sand is None else sand.floor_level.cpu()}
-        assist = getattr(self.env.unwrapped, "jump_assist", None)
-        if assist is not None:
-            infos["jump_assist"] = assist.state_dict()
+        infos = {**(infos or {}), **env_state(self.env.unwrapped)}
         tmp = f"{path}.tmp"
         super().save(tmp, infos)
         os.replace(tmp, path)
@@ -190,13 +217,7 @@ class GmlocoOnPolicyRunner(MjlabOnPolicyRunner):
         if load_cfg is None and "optimizer_state_dict" not in peek:
             load_cfg = {"actor": True, "critic": True, "iteration": True, "optimizer": False, "rnd": False}
         infos = super().load(path, load_cfg, strict, map_location or self.device)
-        levels = (infos or {}).get("sand_floor_level")
-        env = self.env.unwrapped
-        assist = (infos or {}).get("jump_assist")
-        if assist is not None and getattr(env, "jump_assist", None) is not None:
-            env.jump_assist.load_state_dict(assist)
-        if levels is not None and levels.shape[0] == env.num_envs:
-            get_sand(env).floor_level.copy_(levels.to(env.device))
+        restore_env_state(self.env.unwrapped, infos or {})
         return infos
 
     def _prune(self) -> None:
