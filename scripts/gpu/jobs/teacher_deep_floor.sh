@@ -5,6 +5,8 @@
 # The calibrated-sand teacher alone on the GPU, resumed with the survival rule of the floor-depth curriculum and
 # floors down to 30 cm: the top levels are the gate's and MPM's deep bed, where no foot meets the floor (over a 2.5 cm
 # floor the teacher walks every gate cell on the calibrated sand; over the deep bed it tips over within 2 s).
+# The last ~3 minutes score the newest checkpoint on the gate's deep bed (success part, 20 episodes per cell, on the
+# GPU) into ~/chunks/gate/.
 set -uo pipefail
 end=$1
 run=gm_loco_teacher_calibrated
@@ -14,7 +16,7 @@ mkdir -p ~/chunks/teacher "artifacts/$run" results/sand_calibration
 cp .devsrc/checkpoint.pt "artifacts/$run/checkpoint.pt"
 cp .devsrc/rft3d_calibrated.json results/sand_calibration/rft3d_calibrated.json
 nvidia-smi --query-gpu=name,memory.total --format=csv > ~/chunks/gpu.txt 2>&1
-mins=$(python3 -c "import time; print(round(($end - time.time())/60 - 0.4, 2))")
+mins=$(python3 -c "import time; print(round(($end - time.time())/60 - 3.4, 2))")
 echo "teacher chunk: max-minutes $mins" > ~/chunks/job.log
 python3 scripts/gpu/train_ts_chunk.py --stage teacher --run "$run" --contact-model rft3d_calibrated \
   --foot-clearance sinkage --foot-faces box --curriculum-scale 0.1 --reward-weight foot_clearance_l2=-50 \
@@ -23,4 +25,11 @@ python3 scripts/gpu/train_ts_chunk.py --stage teacher --run "$run" --contact-mod
   --max-iterations 6000 --max-minutes "$mins" --post-minutes 1.0 --full-checkpoint --out ~/chunks/teacher \
   >> ~/chunks/job.log 2>&1
 echo "train rc $?" >> ~/chunks/job.log
+mkdir -p ~/chunks/gate "artifacts/${run}_newest"
+cp ~/chunks/teacher/checkpoint.pt ~/chunks/teacher/summary.json "artifacts/${run}_newest/" 2>/dev/null &&
+  timeout "$(( end - $(date +%s) - 10 ))" python3 -m gmloco.train.gate --policy "artifacts/${run}_newest" \
+    --episodes 20 --num-envs 240 --seconds 10 --materials dry_sand,poppy_seed,basalt --speeds 0.5,1.0,1.5,2.0 \
+    --parts success --contact-model rft3d_calibrated --device cuda:0 --out ~/chunks/gate/deep_bed.json \
+    > ~/chunks/gate/deep_bed.log 2>&1
+echo "gate rc $?" >> ~/chunks/job.log
 touch ~/chunks/DONE
