@@ -1,29 +1,12 @@
 #!/usr/bin/env bash
-# Copy to .devsrc/job.sh, with .devsrc/checkpoint.pt = artifacts/gm_loco_teacher_calibrated/checkpoint.pt and
-# .devsrc/rft3d_calibrated.json = results/sand_calibration/rft3d_calibrated.json (results/ does not travel with a
-# slimmed tree); start it with launch_job.sh SECONDS and poll with jobs/poll_teacher.sh MAX_SECONDS
-# gm_loco_teacher_calibrated.
-# The calibrated-sand teacher resumes with the survival rule of the floor-depth curriculum (deeper after an episode
-# that ran to its time limit), so it meets the deep soft sand that MPM and the gate use; beside it, a reward A/B of
-# the adaptive rate and the action std on gmloco's rigid task (jobs/reward_ab.sh's three runs), first, while the
-# teacher compiles.
+# Copy to .devsrc/job.sh with what jobs/teacher_deep_floor.sh needs; start it with launch_job.sh SECONDS and poll with
+# jobs/poll_teacher.sh MAX_SECONDS gm_loco_teacher_calibrated.
+# jobs/teacher_deep_floor.sh with, beside it, a reward A/B of the adaptive rate and the action std on gmloco's rigid
+# task (jobs/reward_ab.sh's three runs), first, while the teacher compiles. Sharing the GPU slows the teacher ~4x
+# while the A/B runs.
 set -uo pipefail
 end=$1
-run=gm_loco_teacher_calibrated
 cd ~/src
-source scripts/gpu/env.sh
-mkdir -p ~/chunks/teacher "artifacts/$run" results/sand_calibration
-cp .devsrc/checkpoint.pt "artifacts/$run/checkpoint.pt"
-cp .devsrc/rft3d_calibrated.json results/sand_calibration/rft3d_calibrated.json
-nvidia-smi --query-gpu=name,memory.total --format=csv > ~/chunks/gpu.txt 2>&1
 REWARD_AB_ITERATIONS=150 REWARD_AB_NESTED=1 bash scripts/gpu/jobs/reward_ab.sh "$end" &
-mins=$(python3 -c "import time; print(round(($end - time.time())/60 - 0.6, 2))")
-echo "teacher chunk: max-minutes $mins" > ~/chunks/job.log
-python3 scripts/gpu/train_ts_chunk.py --stage teacher --run "$run" --contact-model rft3d_calibrated \
-  --foot-clearance sinkage --foot-faces box --curriculum-scale 0.1 --reward-weight foot_clearance_l2=-50 \
-  --floor-promotion survival --allow-changed task.terrain.floor.promotion \
-  --max-iterations 6000 --max-minutes "$mins" --post-minutes 2.0 --full-checkpoint --out ~/chunks/teacher \
-  >> ~/chunks/job.log 2>&1
-echo "train rc $?" >> ~/chunks/job.log
+bash scripts/gpu/jobs/teacher_deep_floor.sh "$end"
 wait
-touch ~/chunks/DONE
