@@ -181,9 +181,9 @@ def _rollout(env: Any, act: Actor, commands: torch.Tensor, steps: int) -> dict[s
 
     Returns:
         ``[T, W]`` traces after each step (``x``, ``y`` [m], ``yaw`` [rad], ``wz`` world yaw rate [rad/s],
-        ``vx``/``vy`` yaw-frame velocity [m/s], ``alive``, ``eta_true``, ``eta_decoded``, ``base_height`` pelvis
-        above the sand surface [m], ``ended_<term>`` 1 where a failure term fired), ``[T, W, 2]`` feet ``height``
-        [m] and ``contact``, and the start pose ``x0``/``y0``/``yaw0`` ``[W]``.
+        ``vx``/``vy`` yaw-frame velocity [m/s], ``alive``, ``eta_true``, ``eta_decoded``, ``ended_<term>`` 1 where
+        a failure term fired), ``[T, W, 2]`` feet ``height`` [m] and ``contact``, and the start pose
+        ``x0``/``y0``/``yaw0`` ``[W]``.
     """
     from mjlab.utils.lab_api.math import quat_apply_inverse, yaw_quat
 
@@ -201,7 +201,6 @@ def _rollout(env: Any, act: Actor, commands: torch.Tensor, steps: int) -> dict[s
         ended = {f"ended_{name}": terms.get_term(name) & alive for name in terms.active_terms}
         alive &= ~terminated
         feet.update()
-        pelvis = data.root_link_pos_w
         v_yaw = quat_apply_inverse(yaw_quat(data.root_link_quat_w), data.root_link_lin_vel_w)
         step = {
             "x": data.root_link_pos_w[:, 0],
@@ -214,7 +213,6 @@ def _rollout(env: Any, act: Actor, commands: torch.Tensor, steps: int) -> dict[s
             "eta_true": env.sand.eta,
             "height": feet.height,
             "contact": feet.in_contact.float(),
-            "base_height": pelvis[:, 2] - env.sand.surface_height(pelvis[:, 0], pelvis[:, 1]),
             **{k: v.float() for k, v in ended.items()},
         }
         if eta is not None:
