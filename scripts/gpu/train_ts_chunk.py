@@ -142,6 +142,13 @@ def _parse(argv: list[str] | None) -> argparse.Namespace:
         "(e.g. artifacts/gm_loco_student_clr50/checkpoint.pt) instead of from scratch",
     )
     p.add_argument(
+        "--entropy-coef",
+        type=float,
+        default=None,
+        help="teacher: PpoCfg.entropy_coef (default: the package's 0.005); a resumed run names "
+        "rsl_rl_overrides.algorithm.entropy_coef in --allow-changed",
+    )
+    p.add_argument(
         "--curriculum-scale",
         type=float,
         default=None,
@@ -178,6 +185,8 @@ def _parse(argv: list[str] | None) -> argparse.Namespace:
     args = p.parse_args(argv)
     if args.floor_depth_max is not None and not 0.0 < args.floor_depth_max <= 1.0:
         p.error(f"--floor-depth-max {args.floor_depth_max}: give the deepest floor in (0, 1] m, e.g. 0.30")
+    if args.entropy_coef is not None and (args.stage != "teacher" or not args.entropy_coef >= 0):
+        p.error(f"--entropy-coef {args.entropy_coef}: a number >= 0, for --stage teacher only, e.g. 0.001")
     if args.gpus:
         from gmloco.train.multi_gpu import cuda_device_count, gpus_problem
 
@@ -307,6 +316,8 @@ def _entries(args: argparse.Namespace) -> dict[str, Any]:
     from gmloco.train.teacher_student import DistillCfg, ObsGroupsCfg, StudentCfg, TeacherCfg, student_train_entries
 
     teacher = TeacherCfg(latent_dim=args.latent_dim)
+    if args.entropy_coef is not None:
+        teacher = replace(teacher, ppo=replace(teacher.ppo, entropy_coef=args.entropy_coef))
     if args.stage == "teacher":
         return teacher.to_rsl_rl(ObsGroupsCfg())
     student = StudentCfg(history_length=args.history_length)

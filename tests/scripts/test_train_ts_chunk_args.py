@@ -97,3 +97,21 @@ def test_bad_floor_depth_max_exits_2(depth: str, capsys: pytest.CaptureFixture[s
     with pytest.raises(SystemExit) as exc:
         _load()._parse(["--stage", "teacher", "--out", "unused", "--floor-depth-max", depth])
     assert exc.value.code == 2 and "deepest floor in (0, 1] m" in capsys.readouterr().err
+
+
+def test_entropy_coef_reaches_the_teacher_algorithm_only() -> None:
+    """--entropy-coef sets the teacher PPO's entropy coefficient in the rsl-rl entries; the default stays 0.005."""
+    chunk = _load()
+    base = ["--stage", "teacher", "--out", "unused"]
+    assert chunk._entries(chunk._parse(base))["algorithm"]["entropy_coef"] == 0.005
+    assert chunk._entries(chunk._parse([*base, "--entropy-coef", "0.001"]))["algorithm"]["entropy_coef"] == 0.001
+
+
+@pytest.mark.parametrize(
+    "argv", [["--stage", "teacher", "--entropy-coef", "-1"], ["--stage", "student", "--entropy-coef", "0.001"]]
+)
+def test_bad_entropy_coef_exits_2(argv: list[str], capsys: pytest.CaptureFixture[str]) -> None:
+    """A negative coefficient, or one given to the student (its PPO has its own), is refused with exit 2."""
+    with pytest.raises(SystemExit) as exc:
+        _load()._parse([*argv, "--out", "unused"])
+    assert exc.value.code == 2 and "--entropy-coef" in capsys.readouterr().err
