@@ -78,6 +78,7 @@ def test_bad_input_names_key_and_choices(
         (["+exp=gm_lco"], "gm_lco"),
         (["+exp=gm_loco", "train_teacher.num_envz=8"], "train_teacher.num_envz"),
         ([], "+exp"),
+        (["+exp=gm_loco", "contact=rft4d"], "contact=rft4d"),
         (["+exp=gm_loco", "eval_mpm.num_episodes=-1"], "eval_mpm.num_episodes=-1"),
         (["+exp=gm_loco", "train_teacher.gpus=[0,0]"], "train_teacher.gpus"),
     ],
