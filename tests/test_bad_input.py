@@ -27,6 +27,9 @@ CASES = [
     (["+exp=gm_loco", "stages=[train]"], "stages", ["train_teacher", "mismatch"]),
     (["+exp=gm_loco", "force=[exprt]"], "force", ["export"]),
     (["+exp=gm_loco", "+scale=huge"], "scale", ["full", "smoke"]),
+    (["+exp=gm_loco", "tracking=nope"], "tracking", ["from 'tracking=nope'", "default"]),
+    (["+exp=gm_loco", "tracking=null"], "tracking", ["'tracking=null' cannot unset", "tracking=<option>", "default"]),
+    (["+exp=gm_loco", "+scale=smoke", "+scale=full"], "scale", ["chosen more than once", "+scale=<option>", "full"]),
     # numeric values outside the range their schema field declares (workflows/config_ranges.py)
     (["+exp=gm_loco", "eval_mpm.num_episodes=-1"], "eval_mpm.num_episodes", ["=-1 ", "an integer >= 1"]),
     (["+exp=gm_loco", "train_teacher.num_envs=-3"], "train_teacher.num_envs", ["=-3 ", "an integer >= 1"]),
@@ -75,6 +78,7 @@ def test_bad_input_names_key_and_choices(
         (["+exp=gm_lco"], "gm_lco"),
         (["+exp=gm_loco", "train_teacher.num_envz=8"], "train_teacher.num_envz"),
         ([], "+exp"),
+        (["+exp=gm_loco", "contact=rft4d"], "contact=rft4d"),
         (["+exp=gm_loco", "eval_mpm.num_episodes=-1"], "eval_mpm.num_episodes=-1"),
         (["+exp=gm_loco", "train_teacher.gpus=[0,0]"], "train_teacher.gpus"),
     ],

@@ -10,14 +10,14 @@ from pathlib import Path
 import pytest
 from omegaconf import DictConfig, OmegaConf
 
-from workflows.config_errors import CONF_DIR, ConfigInputError, group_options, groups
+from workflows.config_errors import CONF_DIR, ConfigInputError, default_groups, group_options, groups
 from workflows.schemas import ContactModelName, PipelineCfg, StageCfg, SweepCfg
 from workflows.stage_registry import stage_names
 
 EXPS = group_options("exp")
 """Every experiment config."""
-DEFAULT_GROUPS = ("paths", "tracking")
-"""Groups selected in ``full_pipeline.yaml``'s defaults list (overridden without ``+``)."""
+DEFAULT_GROUPS = default_groups()
+"""Groups in ``full_pipeline.yaml``'s defaults list (chosen without ``+``)."""
 GROUP_OPTIONS = [(g, o) for g in groups() if g != "exp" for o in group_options(g)]
 """Every (group, option) pair except experiments."""
 

@@ -15,7 +15,15 @@ from omegaconf.errors import OmegaConfBaseException
 
 from workflows.schemas import REPO_ROOT, PipelineCfg
 
-__all__ = ["CONF_DIR", "ConfigInputError", "explain", "group_options", "groups", "unknown_key_error"]
+__all__ = [
+    "CONF_DIR",
+    "ConfigInputError",
+    "default_groups",
+    "explain",
+    "group_options",
+    "groups",
+    "unknown_key_error",
+]
 
 CONF_DIR = REPO_ROOT / "conf"
 """Hydra config root."""
@@ -73,15 +81,42 @@ def unknown_key_error(key: str, override: str) -> ConfigInputError:
     return ConfigInputError(key, f"invalid override '{override}'.")
 
 
-def _missing_group(e: MissingConfigException) -> ConfigInputError:
-    """Unknown option of a config group, e.g. ``+exp=gm_lco``."""
+def default_groups(conf_dir: Path = CONF_DIR) -> list[str]:
+    """Groups in the primary config's defaults list (``paths``, ``contact``, ...): chosen without ``+``."""
+    primary = OmegaConf.load(conf_dir / "full_pipeline.yaml")
+    assert isinstance(primary, DictConfig)
+    entries = [next(iter(d)) for d in primary.get("defaults", []) if isinstance(d, DictConfig)]
+    return sorted(str(k).removeprefix("optional ") for k in entries if str(k).removeprefix("optional ") in groups())
+
+
+def _choose(group: str) -> str:
+    """How the command line chooses an option of ``group``: ``contact=<option>`` or ``+exp=<option>``."""
+    return f"{'' if group in default_groups() else '+'}{group}=<option>"
+
+
+def _missing_group(e: MissingConfigException, overrides: Sequence[str]) -> ConfigInputError:
+    """Unknown option of a config group, e.g. ``+exp=gm_lco`` or ``contact=rft4d``."""
     missing = e.missing_cfg_file or ""
     group, _, choice = missing.rpartition("/")
     if group and group in groups():
         options = list(e.options or group_options(group))
-        msg = f"unknown {group} '{choice}' (from '+{group}={choice}'). Valid choices for '{group}': {_choices(options)}"
+        given = next((o for o in overrides if o.lstrip("+").split("=", 1)[0] == group), f"{group}={choice}")
+        msg = f"unknown {group} '{choice}' (from '{given}'). Valid choices for '{group}': {_choices(options)}"
         return ConfigInputError(group, f"{msg}{_did_you_mean(choice, options)}.")
     return ConfigInputError(missing, f"cannot find config '{missing}'. Config groups: {_choices(groups())}.")
+
+
+def _null_group(overrides: Sequence[str]) -> ConfigInputError | None:
+    """A config group given ``null`` on the command line (``contact=null``), which Hydra cannot take; else None."""
+    given = next((o for o in overrides if o.endswith("=null") and o.lstrip("+").split("=")[0] in groups()), None)
+    if given is None:
+        return None
+    group = given.lstrip("+").split("=")[0]
+    return ConfigInputError(
+        group,
+        f"'{given}' cannot unset the config group '{group}': leave it out of the command, or choose one with "
+        f"{_choose(group)}. Valid choices: {_choices(group_options(group))}.",
+    )
 
 
 def _composition(e: ConfigCompositionException, overrides: Sequence[str]) -> ConfigInputError:
@@ -102,6 +137,14 @@ def _composition(e: ConfigCompositionException, overrides: Sequence[str]) -> Con
     if m:
         key = m.group(1)
         return ConfigInputError(key, f"'{key}' already exists: override it without the '+', e.g. {key}=<value>.")
+    m = re.search(r"Multiple values for ([\w/]+)\.", msg) or re.search(r"([\w/]+) appears more than once in", msg)
+    if m:
+        group = m.group(1)
+        return ConfigInputError(
+            group,
+            f"config group '{group}' is chosen more than once: choose it once, as {_choose(group)}. "
+            f"Valid choices: {_choices(group_options(group))}.",
+        )
     m = re.search(r"Error merging override (\S+)", msg)
     cause = e.__cause__
     if m and isinstance(cause, OmegaConfBaseException):
@@ -116,7 +159,7 @@ def explain(e: Exception, overrides: Sequence[str]) -> ConfigInputError:
     if isinstance(e, ConfigInputError):
         return e
     if isinstance(e, MissingConfigException):
-        return _missing_group(e)
+        return _missing_group(e, overrides)
     if isinstance(e, ConfigCompositionException):
         return _composition(e, overrides)
     if isinstance(e, OverrideParseException):
@@ -125,4 +168,6 @@ def explain(e: Exception, overrides: Sequence[str]) -> ConfigInputError:
     if isinstance(e, OmegaConfBaseException):
         key = str(getattr(e, "full_key", "") or "")
         return ConfigInputError(key, f"config error at '{key}': {str(e).splitlines()[0]}.")
+    if isinstance(e, ValueError) and (null := _null_group(overrides)) is not None:
+        return null  # Hydra's "Config group override must be a string or a list. Got NoneType"
     raise e

@@ -217,7 +217,7 @@ class TrainTeacherCfg(TeacherCfg, PolicyTrainingCfg):
     algorithm: TrainAlgorithm = TrainAlgorithm.vae_teacher
     """Vanilla PPO (``+exp=ppo_*``) or the VAE teacher (``+exp=gm_loco``)."""
     contact_model: ContactModelName = ContactModelName.rft3d
-    """Granular contact model applied to the feet."""
+    """Granular contact model applied to the feet; ``contact=<model>`` (``conf/contact/``) sets it."""
     terrain: TerrainName = TerrainName.flat
     """Sand bed: flat soft sand, sinusoidal rough surface, or a 30 cm deep loose bed."""
     policy_history_length: int = ranged(5, ge=1)
@@ -245,8 +245,9 @@ class TrainTeacherCfg(TeacherCfg, PolicyTrainingCfg):
     material: MaterialRangeCfg = field(default_factory=MaterialRangeCfg)
     """Per-env granular material of the velocity task (``gmloco.train.MaterialRangeCfg``): the ranges of mu_int,
     packing, bulk_density, ... drawn on every reset, or one ``preset`` (``train_teacher.material.mu_int=[0.3,0.6]``,
-    ``train_teacher.material.preset=dry_sand``). A field left at its default keeps the terrain's value (the deep
-    bed's mu_int 0.1-0.4); the VAE teacher's held-out rectangle is then cut out of the ranges."""
+    ``train_teacher.material.preset=dry_sand``, or ``material=dry_sand`` from ``conf/material/``). A field left at
+    its default keeps the terrain's value (the deep bed's mu_int 0.1-0.4); the VAE teacher's held-out rectangle is
+    then cut out of the ranges."""
 
 
 @dataclass
