@@ -6,7 +6,8 @@
 # floors down to 30 cm: the top levels are the gate's and MPM's deep bed, where no foot meets the floor (over a 2.5 cm
 # floor the teacher walks every gate cell on the calibrated sand; over the deep bed it tips over within 2 s).
 # The last ~3 minutes score the newest checkpoint on the gate's deep bed (success part, 20 episodes per cell, on the
-# GPU) into ~/chunks/gate/.
+# GPU) into ~/chunks/gate/; GATE=0 in the environment of launch_job.sh gives them to training instead (the gate
+# then runs on a CPU afterwards).
 # The entropy coefficient drops from 0.005 to 0.001 (the student PPO's): at 0.005 the action std rose from 0.86 to
 # 1.22 over 2,048 iterations, the entropy bonus outweighing the little the GM-Loco rewards charge for noisy actions.
 set -uo pipefail
@@ -18,7 +19,8 @@ mkdir -p ~/chunks/teacher "artifacts/$run" results/sand_calibration
 cp .devsrc/checkpoint.pt "artifacts/$run/checkpoint.pt"
 cp .devsrc/rft3d_calibrated.json results/sand_calibration/rft3d_calibrated.json
 nvidia-smi --query-gpu=name,memory.total --format=csv > ~/chunks/gpu.txt 2>&1
-mins=$(python3 -c "import time; print(round(($end - time.time())/60 - 3.4, 2))")
+gate=${GATE:-1}
+mins=$(python3 -c "import time; print(round(($end - time.time())/60 - (3.4 if $gate == 1 else 0.3), 2))")
 echo "teacher chunk: max-minutes $mins" > ~/chunks/job.log
 python3 scripts/gpu/train_ts_chunk.py --stage teacher --run "$run" --contact-model rft3d_calibrated \
   --foot-clearance sinkage --foot-faces box --curriculum-scale 0.1 --reward-weight foot_clearance_l2=-50 \
@@ -29,7 +31,7 @@ python3 scripts/gpu/train_ts_chunk.py --stage teacher --run "$run" --contact-mod
   >> ~/chunks/job.log 2>&1
 echo "train rc $?" >> ~/chunks/job.log
 mkdir -p ~/chunks/gate "artifacts/${run}_newest"
-cp ~/chunks/teacher/checkpoint.pt ~/chunks/teacher/summary.json "artifacts/${run}_newest/" 2>/dev/null &&
+[ "$gate" = 1 ] && cp ~/chunks/teacher/checkpoint.pt ~/chunks/teacher/summary.json "artifacts/${run}_newest/" &&
   timeout "$(( end - $(date +%s) - 10 ))" python3 -m gmloco.train.gate --policy "artifacts/${run}_newest" \
     --episodes 20 --num-envs 240 --seconds 10 --materials dry_sand,poppy_seed,basalt --speeds 0.5,1.0,1.5,2.0 \
     --parts success --contact-model rft3d_calibrated --device cuda:0 --out ~/chunks/gate/deep_bed.json \
