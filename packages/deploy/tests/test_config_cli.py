@@ -61,6 +61,8 @@ class ToyCfg(ToyBaseCfg):
     """Contact model."""
     record: bool = True
     """Write a recording."""
+    resume: bool = False
+    """Skip the finished episodes."""
     names: tuple[str, ...] = ("a",)
     """Names, as separate words."""
     label: str | None = None
@@ -76,6 +78,7 @@ FLAGS = (
     Flag("--gait", "gait"),
     Flag("--model", "model"),
     Flag("--no-record", "record", off=True),
+    Flag("--resume", "resume"),
     Flag("--names", "names"),
     Flag("--label", "label"),
     Flag("--voxel", "solver.voxel_size"),
@@ -107,21 +110,22 @@ def test_no_flags_give_the_defaults() -> None:
 def test_flags_set_nested_tuple_enum_literal_and_switch_fields() -> None:
     """Each flag sets its field, with the field's type."""
     argv = ["--seconds", "4", "--speeds", "1.5, 2", "--grid", "2,1", "--gait", "trot", "--model", "rigid",
-            "--no-record", "--names", "x", "y", "--label", "l", "--voxel", "0.1", "--iters", "0"]  # fmt: skip
+            "--no-record", "--resume", "--names", "x", "y", "--label", "l", "--voxel", "0.1", "--iters", "0"]  # fmt: skip
     cfg = _cfg(argv)
     assert cfg == ToyCfg(duration_s=4.0, speeds=(1.5, 2.0), grid=(2, 1), gait=Gait.trot, model="rigid", record=False,
-                         names=("x", "y"), label="l", solver=ToySolverCfg(voxel_size=0.1, iterations=0))  # fmt: skip
+                         resume=True, names=("x", "y"), label="l", solver=ToySolverCfg(voxel_size=0.1, iterations=0))  # fmt: skip
     assert unflagged(cfg, ToyCfg()) == [
-        "duration_s", "speeds", "grid", "gait", "model", "record", "names", "label", "solver.voxel_size",
+        "duration_s", "speeds", "grid", "gait", "model", "record", "resume", "names", "label", "solver.voxel_size",
         "solver.iterations",
     ]  # fmt: skip
 
 
 def test_flag_args_give_the_config_back() -> None:
     """The arguments written for a config parse back to it (separated tuples as one word)."""
-    cfg = ToyCfg(speeds=(0.25,), record=False, names=("p", "q"), solver=ToySolverCfg(iterations=3))
+    cfg = ToyCfg(speeds=(0.25,), record=False, resume=True, names=("p", "q"), solver=ToySolverCfg(iterations=3))
     args = flag_args(cfg, FLAGS)
-    assert args[args.index("--speeds") + 1] == "0.25" and "--no-record" in args
+    assert args[args.index("--speeds") + 1] == "0.25" and "--no-record" in args and "--resume" in args
+    assert "--resume" not in flag_args(ToyCfg(), FLAGS)
     assert _cfg(args) == cfg
 
 
@@ -131,6 +135,7 @@ def test_help_is_the_field_docstring_with_the_default() -> None:
     assert "Episode length [s]. Default: 10.0." in text
     assert "Forward speeds [m/s]. Default: 0.5,1.0." in text
     assert "record = False. Write a recording." in text
+    assert "resume = True. Skip the finished episodes." in text
     assert field_doc(ToyCfg, "solver.voxel_size") == "Grid voxel size [m]."
 
 

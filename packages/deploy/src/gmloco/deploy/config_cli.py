@@ -6,7 +6,7 @@ type, ``nargs`` and choices from the field's annotation (``X | None``, ``tuple[X
 fields), the default from the config's defaults, the help from the field's docstring (the string literal on the
 line after the field, inherited fields included) and the valid range from its ``metadata`` (``ge`` / ``gt`` /
 ``le`` / ``lt``, and ``also`` for values accepted outside them). A boolean field is a switch that turns it off
-(``--no-mcap``); a tuple field takes its values as separate words (``--speeds 0.5 1.0``) or, with ``sep``, as one
+(``--no-mcap``, ``off=True``) or on (``--resume``, the default for a field that is False); a tuple field takes its values as separate words (``--speeds 0.5 1.0``) or, with ``sep``, as one
 word (``--speeds 0.5,1.0``). The flag names belong to the command line, so recorded commands keep running when a
 field is renamed.
 
@@ -53,7 +53,8 @@ class Flag:
     path: str
     """Dotted path of the field in the config, e.g. ``solver.voxel_size``."""
     off: bool = False
-    """A switch that sets the boolean field to False (``--no-refill``); else a flag taking the field's value."""
+    """A switch that sets the boolean field to False (``--no-refill``); else a flag taking the field's value, or
+    for a boolean field a switch that sets it to True (``--resume``)."""
     sep: str | None = None
     """For a tuple field: the values come as one word split at this separator (``","``: ``0.5,1.0``); None: as
     separate words (``nargs="+"``)."""
@@ -147,11 +148,18 @@ def _text(value: Any) -> str:
     return repr(value) if isinstance(value, float) else str(value)
 
 
+def _switch(cls: type, flag: Flag) -> bool | None:
+    """The value a switch sets: False for ``off``, True for a boolean field's plain flag, None for a valued flag."""
+    if flag.off:
+        return False
+    return True if _field(cls, flag.path)[2] is bool else None
+
+
 def _help(cls: type, flag: Flag, default: Any) -> str:
     """The flag's help: the field's docstring (its first paragraph, ``%`` escaped for argparse) and the default."""
     doc = field_doc(cls, flag.path).split("\n\n")[0].replace("\n", " ").replace("%", "%%")
-    if flag.off:
-        return f"{flag.path} = False. {doc}"
+    if (sets := _switch(cls, flag)) is not None:
+        return f"{flag.path} = {sets}. {doc}"
     if flag.sep is not None and isinstance(default, tuple):
         return f"{doc} Default: {flag.sep.join(_text(v) for v in default).replace('%', '%%')}."
     return f"{doc} Default: %(default)s."
@@ -206,7 +214,7 @@ def add_flags(parser: argparse.ArgumentParser, base: Any, flags: Sequence[Flag])
     cls = type(base)
     for flag in flags:
         value = get_value(base, flag.path)
-        if flag.off:
+        if _switch(cls, flag) is not None:
             parser.add_argument(flag.name, action="store_true", help=_help(cls, flag, value))
             continue
         kind, count = _value_type(_field(cls, flag.path)[2])
@@ -247,7 +255,7 @@ def flag_problem(cls: type, flag: Flag, value: Any) -> str | None:
     """``FLAG VALUE must be ...`` for a parsed value outside its field's range in ``cls``, else None."""
     metadata = _field(cls, flag.path)[1].metadata
     words = _bounds_text(metadata)
-    if words is None or value is None or flag.off:
+    if words is None or value is None or _switch(cls, flag) is not None:
         return None
     for v in value if isinstance(value, list | tuple) else [value]:
         if not _fits(v, metadata):
@@ -267,8 +275,8 @@ def cfg_from_flags(args: argparse.Namespace, base: Any, flags: Sequence[Flag]) -
     values: dict[str, Any] = {}
     for flag in flags:
         given = getattr(args, flag.dest)
-        if flag.off:
-            values[flag.path] = not given
+        if (sets := _switch(type(base), flag)) is not None:
+            values[flag.path] = sets if given else get_value(base, flag.path)
             continue
         kind = _value_type(_field(type(base), flag.path)[2])[0]
         cast = kind if isinstance(kind, type) and issubclass(kind, Enum) else (lambda v: v)
@@ -280,12 +288,12 @@ def cfg_from_flags(args: argparse.Namespace, base: Any, flags: Sequence[Flag]) -
 
 
 def flag_args(cfg: Any, flags: Sequence[Flag]) -> list[str]:
-    """The arguments of ``flags`` that give back ``cfg``'s values (a switch only when its field is False)."""
+    """The arguments of ``flags`` that give back ``cfg``'s values (a switch only when its field has its value)."""
     out: list[str] = []
     for flag in flags:
         value = get_value(cfg, flag.path)
-        if flag.off:
-            out += [flag.name] if not value else []
+        if (sets := _switch(type(cfg), flag)) is not None:
+            out += [flag.name] if value == sets else []
         elif value is None:
             continue
         elif isinstance(value, tuple | list) and flag.sep is not None:
