@@ -133,7 +133,7 @@ def test_help_is_the_field_docstring_with_the_default() -> None:
     """Help quotes the docstring (inherited ones too) and the default, written as the command line takes it."""
     text = " ".join(_parser().format_help().split())
     assert "Episode length [s]. Default: 10.0." in text
-    assert "Forward speeds [m/s]. Default: 0.5,1.0." in text
+    assert "Forward speeds [m/s]. Values separated by ','. Default: 0.5,1.0." in text
     assert "record = False. Write a recording." in text
     assert "resume = True. Skip the finished episodes." in text
     assert field_doc(ToyCfg, "solver.voxel_size") == "Grid voxel size [m]."

@@ -160,8 +160,9 @@ def _help(cls: type, flag: Flag, default: Any) -> str:
     doc = field_doc(cls, flag.path).split("\n\n")[0].replace("\n", " ").replace("%", "%%")
     if (sets := _switch(cls, flag)) is not None:
         return f"{flag.path} = {sets}. {doc}"
-    if flag.sep is not None and isinstance(default, tuple):
-        return f"{doc} Default: {flag.sep.join(_text(v) for v in default).replace('%', '%%')}."
+    if flag.sep is not None:
+        shown = flag.sep.join(_text(v) for v in default) if isinstance(default, tuple) else str(default)
+        return f"{doc} Values separated by '{flag.sep}'. Default: {shown.replace('%', '%%')}."
     return f"{doc} Default: %(default)s."
 
 
