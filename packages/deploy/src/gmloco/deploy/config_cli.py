@@ -6,9 +6,9 @@ type, ``nargs`` and choices from the field's annotation (``X | None``, ``tuple[X
 fields), the default from the config's defaults, the help from the field's docstring (the string literal on the
 line after the field, inherited fields included) and the valid range from its ``metadata`` (``ge`` / ``gt`` /
 ``le`` / ``lt``, and ``also`` for values accepted outside them). A boolean field is a switch that turns it off
-(``--no-mcap``, ``off=True``) or on (``--resume``, the default for a field that is False); a tuple field takes its values as separate words (``--speeds 0.5 1.0``) or, with ``sep``, as one
-word (``--speeds 0.5,1.0``). The flag names belong to the command line, so recorded commands keep running when a
-field is renamed.
+(``--no-mcap``, ``off=True``) or on (``--resume``); a tuple field takes its values as separate words
+(``--speeds 0.5 1.0``) or, with ``sep``, as one word (``--speeds 0.5,1.0``). The flag names belong to the command
+line, so recorded commands keep running when a field is renamed.
 
 Standard library only, so every package that depends on ``gmloco-deploy`` may use it without pulling in Warp,
 MuJoCo or torch.
