@@ -4,9 +4,18 @@
 from __future__ import annotations
 
 import json
+import re
+import shlex
 from pathlib import Path
+from typing import get_args
 
+import pytest
+
+from gmloco.deploy.mismatch.benchmark import sweep
+from gmloco.deploy.mismatch.benchmark.episodes import STRENGTH_TABLES, STRENGTHS
+from gmloco.deploy.mismatch.benchmark.policy_motion import MOTIONS
 from gmloco.deploy.mismatch.benchmark.sweep import main
+from gmloco.deploy.mismatch.benchmark.sweep_cfg import MotionName, StrengthLevel, StrengthTableName, SweepCfg
 
 
 def test_sweep_subset_writes_rows_summary_manifest_and_a_separate_key(tmp_path: Path) -> None:
@@ -99,3 +108,90 @@ def test_strength_table_v4_with_parts_and_resume(tmp_path: Path) -> None:
     assert null["name"] not in inv["episodes_run_by_this_invocation"]
     assert inv["strength_table"]["name"] == "v4"
     assert inv["strength_table"]["mid"]["terrain.depth_hardening"] == {"kappa": [150.0]}
+
+
+OPTIONS = {"-h", "--help", "--out", "--workers", "--seeds", "--nulls", "--duration", "--motion", "--strengths",
+           "--strength-table", "--suite", "--keep-before-fall", "--only", "--score-only", "--pool", "--resume",
+           "--effects", "--seed-offset", "--part", "--deadline-s"}  # fmt: skip
+"""The option strings of the sweep's command line as the recorded commands know it (hand-written, 18 flags)."""
+REPO = Path(__file__).resolve().parents[4]
+"""Repository root (the recorded manifests)."""
+
+
+def _recorded_commands() -> list[list[str]]:
+    """The sweep's arguments in every command of ``results/**/manifest.json``."""
+    found: list[str] = []
+
+    def walk(node: object) -> None:
+        if isinstance(node, dict):
+            node = list(node.values())
+        if isinstance(node, list):
+            for child in node:
+                walk(child)
+        elif isinstance(node, str) and node.startswith(f"python -m {sweep.__name__} "):
+            found.append(node.removeprefix(f"python -m {sweep.__name__} "))
+
+    for path in REPO.glob("results/**/manifest.json"):
+        walk(json.loads(path.read_text()))
+    return [shlex.split(args) for args in found]
+
+
+def test_help_lists_the_recorded_options(capsys: pytest.CaptureFixture[str]) -> None:
+    """The generated flags and ``--out`` give exactly the option strings the commands were written with."""
+    with pytest.raises(SystemExit) as stop:
+        sweep._parse(["--help"])
+    assert stop.value.code == 0
+    assert set(re.findall(r"(?<![\w-])-{1,2}[a-z][\w-]*", capsys.readouterr().out.split("options:")[1])) == OPTIONS
+
+
+def test_recorded_commands_still_parse() -> None:
+    """Every sweep command in the results' manifests parses to a config."""
+    commands = _recorded_commands()
+    assert len(commands) >= 10
+    for argv in commands:
+        out, cfg = sweep._parse(argv)
+        assert out.parts and cfg.workers >= 1
+
+
+def test_flags_fill_the_sweep_config() -> None:
+    """A sand replicate command sets its fields; lists are comma-separated words, switches set True."""
+    argv = ["--out", "o", "--seeds", "2", "--seed-offset", "20000", "--part", "3/8", "--resume", "--deadline-s", "300",
+            "--suite", "sand", "--motion", "composite", "--strength-table", "v4", "--only", "none-,imu.",
+            "--strengths", "low,high", "--effects", "imu.gyro_bias"]  # fmt: skip
+    out, cfg = sweep._parse(argv)
+    assert out == Path("o")
+    assert cfg == SweepCfg(seeds=2, seed_offset=20000, part="3/8", resume=True, deadline_s=300.0, suite="sand",
+                           motion="composite", strength_table="v4", only=("none-", "imu."), strengths=("low", "high"),
+                           effects=("imu.gyro_bias",))  # fmt: skip
+    assert sweep._parse(["--out", "o"])[1] == SweepCfg()
+
+
+def test_the_closed_choices_match_the_episode_tables() -> None:
+    """The motions, strength levels and tables of the config are those the episode lists know."""
+    assert set(get_args(MotionName)) == set(MOTIONS)
+    assert set(get_args(StrengthLevel)) == set(STRENGTHS)
+    assert set(get_args(StrengthTableName)) == set(STRENGTH_TABLES)
+
+
+@pytest.mark.parametrize(
+    ("flag", "value", "message"),
+    [
+        ("--workers", "0", "--workers 0 must be >= 1"),
+        ("--nulls", "-1", "--nulls -1 must be >= 0"),
+        ("--duration", "0", "--duration 0.0 must be > 0"),
+        ("--strengths", "mid,huge", "argument --strengths: 'huge': choose from low, mid, high"),
+        ("--motion", "run", "argument --motion: invalid choice: 'run'"),
+        ("--part", "2/2", "argument --part: 2/2: need 0 <= i < n"),
+        ("--part", "half", "argument --part: 'half': give I/N with whole numbers"),
+        ("--seeds", "two", "argument --seeds: invalid int value: 'two'"),
+    ],
+)
+def test_malformed_or_out_of_range_flags_exit_2(
+    flag: str, value: str, message: str, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """A malformed or out-of-range value is a usage error (exit code 2) naming the flag; nothing is written."""
+    with pytest.raises(SystemExit) as stop:
+        main(["--out", str(tmp_path / "sweep"), flag, value])
+    assert stop.value.code == 2
+    assert message in capsys.readouterr().err
+    assert not (tmp_path / "sweep").exists()

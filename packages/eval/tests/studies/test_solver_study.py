@@ -4,6 +4,7 @@
 from __future__ import annotations
 
 import math
+import re
 from pathlib import Path
 from types import SimpleNamespace
 from typing import Any
@@ -161,3 +162,66 @@ def test_a_probe_cap_below_newtons_report_interval_is_refused(
     with pytest.raises(SystemExit):
         solver_study.main(["--policy", "p.onnx", "--out", str(tmp_path), "--probe-iterations", "10"])
     assert "--probe-iterations" in capsys.readouterr().err
+
+
+OPTIONS = {"-h", "--help", "--policy", "--out", "--variants", "--robots", "--speed", "--terrain", "--voxel", "--warm-s",
+           "--probe-iterations", "--cycles", "--cell-capacity-factor", "--device"}  # fmt: skip
+"""The option strings of the study's command line as the recorded commands know it (hand-written, 12 flags)."""
+RECORDED = ["--variants", "gs", "jacobi", "jacobi,gs", "gs-batched", "--robots", "8", "--warm-s", "1.0",
+            "--probe-iterations", "2000", "--cycles", "3"]  # fmt: skip
+"""The study's arguments as ``results/`` records them (besides ``--policy`` and ``--out``)."""
+
+
+def _stop_before_the_study(monkeypatch: pytest.MonkeyPatch) -> list[tuple[Any, SolverStudyCfg]]:
+    """Replace the study by a recorder of its configs (no scene is built)."""
+    calls: list[tuple[Any, SolverStudyCfg]] = []
+
+    def record(eval_cfg: Any, cfg: SolverStudyCfg, _out: Path) -> dict[str, Any]:
+        calls.append((eval_cfg, cfg))
+        return {"variants": {}}
+
+    monkeypatch.setattr(solver_study, "run_study", record)
+    return calls
+
+
+def test_help_lists_the_recorded_options(capsys: pytest.CaptureFixture[str]) -> None:
+    """The generated flags and the command line's own give exactly the option strings the commands were written with."""
+    with pytest.raises(SystemExit) as stop:
+        solver_study.main(["--help"])
+    assert stop.value.code == 0
+    assert set(re.findall(r"(?<![\w-])-{1,2}[a-z][\w-]*", capsys.readouterr().out.split("options:")[1])) == OPTIONS
+
+
+def test_the_recorded_command_fills_the_study_and_evaluation_configs(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """The recorded flags set the study's fields; robots, speed, terrain and voxel reach the evaluation setting."""
+    calls = _stop_before_the_study(monkeypatch)
+    solver_study.main(["--policy", "p.onnx", "--out", str(tmp_path), *RECORDED, "--speed", "1.5", "--voxel", "0.04"])
+    (eval_cfg, cfg), = calls  # fmt: skip
+    assert cfg == SolverStudyCfg(variants=("gs", "jacobi", "jacobi,gs", "gs-batched"), speed=1.5, voxel_size=0.04)
+    assert (eval_cfg.num_episodes, eval_cfg.robots_per_batch, eval_cfg.speeds, eval_cfg.terrains) == (
+        8, 8, (1.5,), ("dry_sand",))  # fmt: skip
+    assert eval_cfg.solver.voxel_size == 0.04 and eval_cfg.policy_path == "p.onnx" and not eval_cfg.record_mcap
+
+
+@pytest.mark.parametrize(
+    ("flag", "value", "message"),
+    [
+        ("--robots", "0", "--robots 0 must be >= 1"),
+        ("--cycles", "0", "--cycles 0 must be >= 1"),
+        ("--robots", "eight", "argument --robots: invalid int value: 'eight'"),
+        ("--voxel", "0", "--voxel 0.0 must be > 0"),
+        ("--cell-capacity-factor", "0.5", "--cell-capacity-factor 0.5 must be >= 1 or 0"),
+    ],
+)
+def test_malformed_or_out_of_range_flags_exit_2(
+    flag: str, value: str, message: str, tmp_path: Path, monkeypatch: pytest.MonkeyPatch,
+    capsys: pytest.CaptureFixture[str],
+) -> None:  # fmt: skip
+    """A malformed or out-of-range value is a usage error (exit code 2) naming the flag, before any scene is built."""
+    calls = _stop_before_the_study(monkeypatch)
+    with pytest.raises(SystemExit) as stop:
+        solver_study.main(["--policy", "p.onnx", "--out", str(tmp_path), flag, value])
+    assert stop.value.code == 2 and not calls
+    assert message in capsys.readouterr().err

@@ -23,14 +23,18 @@ import json
 import math
 import re
 import time
-from dataclasses import dataclass, replace
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 
+from gmloco.deploy.config_cli import Flag, add_flags, cfg_from_flags, check_flags
+
 __all__ = [
+    "FLAGS",
     "SolverStudyCfg",
+    "eval_cfg_of",
     "finite_residuals",
     "main",
     "parse_residual_log",
@@ -45,20 +49,47 @@ _LINEAR = re.compile(r"(\w+) terminated after (\d+) iterations with residual (\S
 
 @dataclass(frozen=True)
 class SolverStudyCfg:
-    """The probe schedule."""
+    """The probe schedule and the walk it probes."""
 
     variants: tuple[str, ...] = ("gs", "jacobi", "jacobi,gs", "gs-soa")
     """Solver names as ``MpmSolverCfg.rheology_solver``; the first is the reference."""
-    warm_s: float = 1.0
+    warm_s: float = field(default=1.0, metadata={"ge": 0})
     """Walk before the first probe [s] (the evaluation's own solver, CUDA graph)."""
-    probe_iterations: int = 2000
-    """Sweep cap of a probe frame [-]."""
+    probe_iterations: int = field(default=2000, metadata={"ge": 50})
+    """Sweep cap of a probe frame, at least 50 (Newton reports the residual every 25-50 sweeps) [-]."""
     probe_tolerance: float = 1.0e-7
     """Tolerance of a probe frame (below any residual reached, so every curve runs to the cap)."""
-    cycles: int = 3
+    cycles: int = field(default=3, metadata={"ge": 1})
     """Rounds of probes (each variant once per round) [-]."""
     reference_iterations: int = 500
     """The reference variant's residual at this sweep count is the target the others must reach [-]."""
+    robots: int = field(default=8, metadata={"ge": 1})
+    """Robots (lanes) walking in the solver, one batch [-]."""
+    speed: float = field(default=1.0, metadata={"gt": 0})
+    """Commanded forward speed of the straight walk [m/s]."""
+    terrain: str = "dry_sand"
+    """Terrain of the walk (``G1EvalCfg.terrains``)."""
+    voxel_size: float | None = field(default=None, metadata={"gt": 0})
+    """Grid voxel size [m]; None: the evaluation's (``G1EvalCfg().solver.voxel_size``)."""
+    cell_capacity_factor: float | None = field(default=None, metadata={"ge": 1, "also": (0.0,)})
+    """Grid capacity factor (``G1EvalCfg.cell_capacity_factor``, 0 = unbounded); None: the evaluation's."""
+    device: str | None = None
+    """Warp device, e.g. ``cuda:0``; None: Warp's default."""
+
+
+FLAGS: tuple[Flag, ...] = (
+    Flag("--variants", "variants"),
+    Flag("--robots", "robots"),
+    Flag("--speed", "speed"),
+    Flag("--terrain", "terrain"),
+    Flag("--voxel", "voxel_size"),
+    Flag("--warm-s", "warm_s"),
+    Flag("--probe-iterations", "probe_iterations"),
+    Flag("--cycles", "cycles"),
+    Flag("--cell-capacity-factor", "cell_capacity_factor"),
+    Flag("--device", "device"),
+)
+"""Every ``SolverStudyCfg`` field the command line sets; ``--policy`` and ``--out`` are the command line's own."""
 
 
 def parse_residual_log(text: str) -> dict[str, Any]:
@@ -251,38 +282,30 @@ def run_study(eval_cfg: Any, cfg: SolverStudyCfg, out: Path) -> dict[str, Any]:
     return summary
 
 
-def main(argv: list[str] | None = None) -> None:
-    """CLI: ``python -m gmloco.eval.studies.solver_study --policy P --out DIR [--variants gs,jacobi ...]``."""
+def eval_cfg_of(cfg: SolverStudyCfg, policy: str, out: str) -> Any:
+    """The evaluation setting the study walks: ``G1EvalCfg()`` with the study's robots, speed, terrain and grid."""
     from gmloco.eval.g1.config import G1EvalCfg
 
+    base = G1EvalCfg()
+    solver = base.solver if cfg.voxel_size is None else replace(base.solver, voxel_size=cfg.voxel_size)
+    eval_cfg = replace(base, policy_path=policy, terrains=(cfg.terrain,), speeds=(cfg.speed,), scenarios=("straight",),
+                       num_episodes=cfg.robots, robots_per_batch=cfg.robots, solver=solver, device=cfg.device,
+                       record_mcap=False, out_dir=out)  # fmt: skip
+    if cfg.cell_capacity_factor is not None:
+        eval_cfg = replace(eval_cfg, cell_capacity_factor=cfg.cell_capacity_factor)
+    return eval_cfg
+
+
+def main(argv: list[str] | None = None) -> None:
+    """CLI: ``python -m gmloco.eval.studies.solver_study --policy P --out DIR [--variants gs jacobi ...]``."""
     p = argparse.ArgumentParser(description=(__doc__ or "").split("\n")[0])
     p.add_argument("--policy", required=True, help="exported policy (ONNX with its metadata)")
     p.add_argument("--out", required=True, help="output folder")
-    p.add_argument(
-        "--variants", nargs="+", default=list(SolverStudyCfg.variants), help="solver names; first = reference"
-    )
-    p.add_argument("--robots", type=int, default=8, help="robots (lanes) in the solver")
-    p.add_argument("--speed", type=float, default=1.0, help="commanded forward speed [m/s]")
-    p.add_argument("--terrain", default="dry_sand")
-    p.add_argument("--voxel", type=float, default=None, help="voxel size [m] (default: the evaluation's)")
-    p.add_argument("--warm-s", type=float, default=SolverStudyCfg.warm_s)
-    p.add_argument("--probe-iterations", type=int, default=SolverStudyCfg.probe_iterations)
-    p.add_argument("--cycles", type=int, default=SolverStudyCfg.cycles)
-    p.add_argument("--cell-capacity-factor", type=float, default=None, help="default: the evaluation's")
-    p.add_argument("--device", default=None)
+    add_flags(p, SolverStudyCfg(), FLAGS)
     a = p.parse_args(argv)
-    if a.robots < 1 or a.cycles < 1 or a.probe_iterations < 50:
-        p.error("--robots and --cycles must be >= 1 and --probe-iterations >= 50 (Newton reports every 25-50 sweeps)")
-    base = G1EvalCfg()
-    solver = base.solver if a.voxel is None else replace(base.solver, voxel_size=a.voxel)
-    eval_cfg = replace(base, policy_path=a.policy, terrains=(a.terrain,), speeds=(a.speed,), scenarios=("straight",),
-                       num_episodes=a.robots, robots_per_batch=a.robots, solver=solver, device=a.device,
-                       record_mcap=False, out_dir=a.out)  # fmt: skip
-    if a.cell_capacity_factor is not None:
-        eval_cfg = replace(eval_cfg, cell_capacity_factor=a.cell_capacity_factor)
-    cfg = SolverStudyCfg(variants=tuple(a.variants), warm_s=a.warm_s, probe_iterations=a.probe_iterations,
-                         cycles=a.cycles)  # fmt: skip
-    summary = run_study(eval_cfg, cfg, Path(a.out))
+    check_flags(p, a, SolverStudyCfg, FLAGS)
+    cfg: SolverStudyCfg = cfg_from_flags(a, SolverStudyCfg(), FLAGS)
+    summary = run_study(eval_cfg_of(cfg, a.policy, a.out), cfg, Path(a.out))
     print(json.dumps(summary["variants"], indent=1, default=str))
 
 

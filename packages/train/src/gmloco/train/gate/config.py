@@ -55,12 +55,13 @@ class GateCfg(RolloutCriteriaCfg):
     ``summary.json`` holding ``train_cfg``; ``manifest.json`` / ``summary.json`` give the GPU minutes."""
     materials: tuple[str, ...] = ("basalt", "dry_sand", "poppy_seed")
     """Material presets, stiffest first (``gmloco.contact.MATERIAL_PRESETS``)."""
-    speeds: tuple[float, ...] = (0.5, 1.0, 1.5, 2.0, 2.5)
+    speeds: tuple[float, ...] = field(default=(0.5, 1.0, 1.5, 2.0, 2.5), metadata={"gt": 0})
     """Commanded forward speeds of the straight cells [m/s]."""
-    repeats: int = 20
+    repeats: int = field(default=20, metadata={"ge": 1})
     """Episodes per cell."""
     yaw_rates: tuple[float, ...] = (-1.0, -0.5, 0.5, 1.0)
-    """Commanded yaw rates of the turning cells [rad/s]."""
+    """Commanded yaw rates of the turning cells [rad/s], none zero (0 has no achieved/commanded ratio; straight
+    walking is in ``speeds``)."""
     yaw_forward_speed: float = 0.5
     """Forward speed commanded with each yaw rate [m/s]."""
     circle_radius_m: float = 2.0
@@ -75,8 +76,9 @@ class GateCfg(RolloutCriteriaCfg):
     """Sampling rate of the paths compared by DTW [Hz]."""
     held_out: HeldOutRegionCfg = field(default_factory=lambda: DEFAULT_HELD_OUT)
     """The (rho_c, mu_int) rectangle the training DR never draws."""
-    held_out_grid: tuple[int, int] = (3, 3)
-    """Held-out materials along rho_c and mu_int."""
+    held_out_grid: tuple[int, int] = field(default=(3, 3), metadata={"ge": 1})
+    """Held-out materials along rho_c and mu_int, at least two in all (the R^2 of the decoded eta needs more than
+    one material)."""
     held_out_mu_surf: float = 0.45
     """Surface friction of the held-out materials [-]."""
     held_out_speed: float = 1.0
@@ -90,10 +92,10 @@ class GateCfg(RolloutCriteriaCfg):
     parts: tuple[GatePart, ...] = GATE_PARTS
     """Parts measured; the cells of the others are not run and their keys are null (e.g. ``("success",)`` for a
     success-by-speed table)."""
-    num_envs: int = 1024
+    num_envs: int = field(default=1024, metadata={"ge": 1})
     """Envs stepped at once; the cells run in batches of this size."""
     device: str = "cpu"
-    """Torch / Warp device."""
+    """Torch / Warp device, e.g. ``cuda:0``."""
     seed: int = 0
     """Env seed."""
     thresholds: GateThresholdsCfg = field(default_factory=GateThresholdsCfg)

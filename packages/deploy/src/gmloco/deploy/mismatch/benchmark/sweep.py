@@ -22,7 +22,10 @@ from pathlib import Path
 
 import numpy as np
 
-__all__ = ["HASH_SKIP", "in_source_hash", "main", "run_episode", "source_sha256"]
+from gmloco.deploy.config_cli import Flag, add_flags, cfg_from_flags, check_flags
+from gmloco.deploy.mismatch.benchmark.sweep_cfg import SweepCfg
+
+__all__ = ["FLAGS", "HASH_SKIP", "in_source_hash", "main", "run_episode", "source_sha256"]
 
 
 def run_episode(
@@ -167,16 +170,31 @@ def source_sha256() -> dict[str, str]:
     return out
 
 
-def _part(eps: list[dict], spec: str | None) -> list[dict]:
-    """Episodes at the positions ``i``, ``i + n``, ... of the list for ``spec`` = ``"i/n"`` (all for None)."""
-    if spec is None:
-        return eps
+def _part_indices(spec: str) -> tuple[int, int]:
+    """``(i, n)`` of ``spec`` = ``"i/n"``; ValueError says what a valid one looks like."""
     try:
         i, n = (int(x) for x in spec.split("/"))
     except ValueError:
         raise ValueError(f"--part {spec!r}: give I/N with whole numbers, e.g. --part 0/2") from None
     if not 0 <= i < n:
         raise ValueError(f"--part {spec}: need 0 <= i < n")
+    return i, n
+
+
+def _part_spec(text: str) -> str:
+    """Check ``--part I/N`` at parse time (a usage error, exit code 2)."""
+    try:
+        _part_indices(text)
+    except ValueError as err:
+        raise argparse.ArgumentTypeError(str(err).removeprefix("--part ")) from None
+    return text
+
+
+def _part(eps: list[dict], spec: str | None) -> list[dict]:
+    """Episodes at the positions ``i``, ``i + n``, ... of the list for ``spec`` = ``"i/n"`` (all for None)."""
+    if spec is None:
+        return eps
+    i, n = _part_indices(spec)
     return eps[i::n]
 
 
@@ -246,106 +264,104 @@ def _manifest(
     path.write_text(json.dumps({"invocations": [*runs, man]}, indent=2, default=str))
 
 
+FLAGS: tuple[Flag, ...] = (
+    Flag("--workers", "workers"),
+    Flag("--seeds", "seeds"),
+    Flag("--nulls", "nulls"),
+    Flag("--duration", "duration"),
+    Flag("--motion", "motion"),
+    Flag("--strengths", "strengths", sep=","),
+    Flag("--strength-table", "strength_table"),
+    Flag("--suite", "suite"),
+    Flag("--keep-before-fall", "keep_before_fall"),
+    Flag("--only", "only", sep=","),
+    Flag("--score-only", "score_only"),
+    Flag("--pool", "pool"),
+    Flag("--resume", "resume"),
+    Flag("--effects", "effects", sep=","),
+    Flag("--seed-offset", "seed_offset"),
+    Flag("--part", "part", parse=_part_spec),
+    Flag("--deadline-s", "deadline_s"),
+)
+"""Every ``SweepCfg`` field the command line sets (lists as one comma-separated word); ``--out`` is its own."""
+
+
+def _parse(argv: list[str]) -> tuple[Path, SweepCfg]:
+    """The sweep folder and config of the arguments (exit code 2 on a malformed or out-of-range one)."""
+    p = argparse.ArgumentParser(description=(__doc__ or "").splitlines()[0])
+    p.add_argument("--out", type=Path, required=True, help="sweep folder: rows/, keys/, summary.json, manifest.json")
+    add_flags(p, SweepCfg(), FLAGS)
+    a = p.parse_args(argv)
+    check_flags(p, a, SweepCfg, FLAGS)
+    return a.out, cfg_from_flags(a, SweepCfg(), FLAGS)
+
+
+def _score_only(out: Path, pool: str | None) -> None:
+    """Score the rows under ``out/rows`` (and, pooled, ``pool/rows``) into the summaries."""
+    from gmloco.deploy.mismatch.benchmark.scorer import score
+
+    rows = [json.loads(f.read_text()) for f in sorted((out / "rows").glob("*.json"))]
+    (out / "summary.json").write_text(
+        json.dumps({**score(rows), "episodes_scored": len(rows)}, indent=2, default=float)
+    )
+    if pool is not None:
+        rows += [json.loads(f.read_text()) for f in sorted((Path(pool) / "rows").glob("*.json"))]
+        pooled = {**score(rows), "episodes_scored": len(rows), "pooled_with": pool}
+        (out / "summary_pooled.json").write_text(json.dumps(pooled, indent=2, default=float))
+
+
+def _episodes(cfg: SweepCfg) -> list[dict]:
+    """The episodes of the config's suite, part and name prefixes."""
+    from gmloco.deploy.mismatch.benchmark.episodes import episode_list, sand_episode_list
+
+    if cfg.suite == "sand":
+        eps = sand_episode_list(
+            cfg.seeds, cfg.nulls, seed_offset=cfg.seed_offset, motion=cfg.motion, table=cfg.strength_table
+        )
+    else:
+        eps = episode_list(cfg.seeds, cfg.nulls, cfg.strengths, seed_offset=cfg.seed_offset, table=cfg.strength_table)
+    eps = _part(eps, cfg.part)
+    if cfg.only:
+        eps = [e for e in eps if any(e["name"].startswith(s) for s in cfg.only)]
+    return eps
+
+
 def main(argv: list[str] | None = None) -> None:
     """Run the sweep and write ``summary.json`` and ``manifest.json``."""
-    from gmloco.deploy.mismatch.benchmark.episodes import STRENGTH_TABLES, episode_list, sand_episode_list
+    from gmloco.deploy.mismatch.benchmark.episodes import STRENGTH_TABLES
     from gmloco.deploy.mismatch.benchmark.policy_motion import MOTIONS
     from gmloco.deploy.mismatch.benchmark.scorer import score
 
-    p = argparse.ArgumentParser()
-    p.add_argument("--out", type=Path, required=True)
-    p.add_argument("--workers", type=int, default=2)
-    p.add_argument("--seeds", type=int, default=1)
-    p.add_argument("--nulls", type=int, default=20)
-    p.add_argument(
-        "--duration",
-        type=float,
-        default=None,
-        help="recording length [s] (default: 8 on the plane, the motion's length on sand: walk 8, composite 18)",
-    )
-    p.add_argument(
-        "--motion",
-        choices=sorted(MOTIONS),
-        default="walk",
-        help="sand suite's policy command schedule (walk: 1 m/s; composite: stand, 0.5/1.0/1.5 m/s, a turn)",
-    )
-    p.add_argument("--strengths", default="mid", help="plane: comma-separated strength levels (low, mid, high)")
-    p.add_argument(
-        "--strength-table",
-        choices=sorted(STRENGTH_TABLES),
-        default="v3",
-        help="mid-strength table (v3: the stock strengths; v4: every mid strength >= 1.5x the effect's tolerance)",
-    )
-    p.add_argument("--suite", choices=("plane", "sand"), default="plane", help="plane: scripted stepping; sand: policy")
-    p.add_argument(
-        "--keep-before-fall",
-        type=float,
-        default=None,
-        help="trim a truth log that ends in a fall to this many seconds before it (default: the episode errors)",
-    )
-    p.add_argument("--only", default=None, help="comma-separated episode-name prefixes")
-    p.add_argument("--score-only", action="store_true", help="score the rows already under OUT/rows and exit")
-    p.add_argument(
-        "--pool",
-        type=Path,
-        default=None,
-        help="with --score-only: also score OUT/rows pooled with POOL/rows (another suite) into OUT/summary_pooled.json",
-    )
-    p.add_argument("--resume", action="store_true", help="skip episodes whose row already exists under OUT/rows")
-    p.add_argument("--effects", default=None, help="comma-separated effect ids the tool screens (default: all)")
-    p.add_argument("--seed-offset", type=int, default=0, help="added to every episode's seed (fresh test seeds)")
-    p.add_argument("--part", default=None, help="I/N: run only the episodes at positions I, I+N, ... of the list")
-    p.add_argument(
-        "--deadline-s",
-        type=float,
-        default=None,
-        help="start no episode later than this many seconds after the sweep began (the rest: --resume later)",
-    )
     argv = list(sys.argv[1:] if argv is None else argv)
-    a = p.parse_args(argv)
-    if a.score_only:
-        rows = [json.loads(f.read_text()) for f in sorted((a.out / "rows").glob("*.json"))]
-        (a.out / "summary.json").write_text(
-            json.dumps({**score(rows), "episodes_scored": len(rows)}, indent=2, default=float)
-        )
-        if a.pool is not None:
-            rows += [json.loads(f.read_text()) for f in sorted((a.pool / "rows").glob("*.json"))]
-            pooled = {**score(rows), "episodes_scored": len(rows), "pooled_with": str(a.pool)}
-            (a.out / "summary_pooled.json").write_text(json.dumps(pooled, indent=2, default=float))
+    out, cfg = _parse(argv)
+    if cfg.score_only:
+        _score_only(out, cfg.pool)
         return
-    if a.suite == "sand":
-        eps = sand_episode_list(a.seeds, a.nulls, seed_offset=a.seed_offset, motion=a.motion, table=a.strength_table)
-    else:
-        eps = episode_list(
-            a.seeds, a.nulls, tuple(a.strengths.split(",")), seed_offset=a.seed_offset, table=a.strength_table
-        )
-    eps = _part(eps, a.part)
-    if a.only:
-        eps = [e for e in eps if any(e["name"].startswith(s) for s in a.only.split(","))]
-    a.out.mkdir(parents=True, exist_ok=True)
-    todo = [e for e in eps if not (a.resume and (a.out / "rows" / f"{e['name']}.json").exists())]
+    eps = _episodes(cfg)
+    out.mkdir(parents=True, exist_ok=True)
+    todo = [e for e in eps if not (cfg.resume and (out / "rows" / f"{e['name']}.json").exists())]
     t0, git = time.time(), _git_commit()
-    deadline = None if a.deadline_s is None else t0 + a.deadline_s
-    effects = tuple(a.effects.split(",")) if a.effects else None
-    duration = a.duration if a.duration is not None else MOTIONS[a.motion] if a.suite == "sand" else 8.0
-    args = [(e, str(a.out), duration, a.keep_before_fall, effects, deadline) for e in todo]
-    with Pool(a.workers) as pool:
+    deadline = None if cfg.deadline_s is None else t0 + cfg.deadline_s
+    duration = cfg.duration if cfg.duration is not None else MOTIONS[cfg.motion] if cfg.suite == "sand" else 8.0
+    args = [(e, str(out), duration, cfg.keep_before_fall, cfg.effects, deadline) for e in todo]
+    with Pool(cfg.workers) as pool:
         fresh = pool.map(_star, args, chunksize=1)
     cpu = sum(os.times()[2:4])
     by_name = {r["name"]: r for r in fresh if "skipped" not in r}
     rows, missing = [], []
     for n in sorted(e["name"] for e in eps):
-        f = a.out / "rows" / f"{n}.json"
+        f = out / "rows" / f"{n}.json"
         row = by_name.get(n) or (json.loads(f.read_text()) if f.exists() else None)
         if row is None:
             missing.append(n)
         else:
             rows.append(row)
-    (a.out / "rows.json").write_text(json.dumps(rows, indent=1, default=float))
+    (out / "rows.json").write_text(json.dumps(rows, indent=1, default=float))
     summary = {**score(rows), "episodes_scored": len(rows), "missing": missing, "wall_s": time.time() - t0}
-    (a.out / "summary.json").write_text(json.dumps(summary, indent=2, default=float))
-    table = {"name": a.strength_table, "mid": STRENGTH_TABLES[a.strength_table][a.suite]}
-    _manifest(a.out, argv, eps, todo, time.time() - t0, cpu, git, a.motion if a.suite == "sand" else None, table)
+    (out / "summary.json").write_text(json.dumps(summary, indent=2, default=float))
+    table = {"name": cfg.strength_table, "mid": STRENGTH_TABLES[cfg.strength_table][cfg.suite]}
+    motion = cfg.motion if cfg.suite == "sand" else None
+    _manifest(out, argv, eps, todo, time.time() - t0, cpu, git, motion, table)
 
 
 if __name__ == "__main__":
