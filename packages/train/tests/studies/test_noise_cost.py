@@ -47,3 +47,23 @@ def test_a_missing_run_folder_exits_2(tmp_path: Path, capsys: pytest.CaptureFixt
     """A folder without a training config is named, with what to pass."""
     assert main(["--policy", str(tmp_path), "--out", str(tmp_path / "out.json")]) == 2
     assert str(tmp_path) in capsys.readouterr().err
+
+
+def test_replot_draws_the_figure_from_a_written_study(tmp_path: Path) -> None:
+    """--replot redraws the PNG from the JSON alone (no simulator)."""
+    import json
+
+    doc = {
+        "policy": "artifacts/x",
+        "terms": ["track", "penalty"],
+        "levels": {
+            "0": {"rate": {"track": 2.0, "penalty": -0.1}, "total_rate": 1.9},
+            "1": {"rate": {"track": 1.5, "penalty": -1.1}, "total_rate": 0.4},
+        },
+        "setup": {"cfg": {"floor_depth": 0.025, "material": "dry_sand", "contact_model": "rft3d", "speed": 1.0}},
+    }
+    (tmp_path / "s.json").write_text(json.dumps(doc))
+    png = tmp_path / "s.png"
+    assert main(["--out", str(tmp_path / "s.json"), "--figure", str(png), "--mark", "0.5", "--replot"]) == 0
+    assert png.stat().st_size > 1000
+    assert main(["--out", str(tmp_path / "missing.json"), "--figure", str(png), "--replot"]) == 2

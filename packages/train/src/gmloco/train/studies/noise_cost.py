@@ -19,13 +19,14 @@ import sys
 import time
 from collections.abc import Sequence
 from dataclasses import asdict, dataclass, field, replace
+from pathlib import Path
 from typing import Any
 
 import numpy as np
 
 from gmloco.train.config import ContactModelName
 
-__all__ = ["NoiseCostCfg", "noise_rates", "run_noise_cost"]
+__all__ = ["NoiseCostCfg", "noise_rates", "plot_noise_cost", "run_noise_cost"]
 
 
 @dataclass(frozen=True)
@@ -153,6 +154,49 @@ def run_noise_cost(cfg: NoiseCostCfg) -> dict[str, Any]:
     }
 
 
+def plot_noise_cost(doc: dict[str, Any], path: str, marks: Sequence[float] = ()) -> None:
+    """Figure: the reward rate against the noise std, and the terms that lose most between the extreme stds.
+
+    Args:
+        doc: A :func:`run_noise_cost` result.
+        path: PNG to write.
+        marks: Stds to mark with a dotted line (e.g. the action stds a training run reached).
+    """
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    levels = doc["levels"]
+    sigma = [float(s) for s in levels]
+    fig, (left, right) = plt.subplots(1, 2, figsize=(11, 4.2), gridspec_kw={"width_ratios": [1, 1.4]})
+    left.plot(sigma, [levels[s]["total_rate"] for s in levels], "o-")
+    for m in marks:
+        left.axvline(m, ls=":", c="gray")
+    left.set_xlabel("noise std per action dimension [policy action units]")
+    left.set_ylabel("reward rate over alive steps [1/s]")
+    left.set_title("All terms")
+    names = list(levels)
+    first, last = names[0], names[-1]
+    delta = {t: levels[last]["rate"][t] - levels[first]["rate"][t] for t in doc["terms"]}
+    worst = sorted(delta, key=delta.__getitem__)[:10]
+    right.barh(range(len(worst)), [delta[t] for t in worst])
+    right.set_yticks(range(len(worst)), worst, fontsize=8)
+    right.invert_yaxis()
+    right.set_xlabel(f"rate at std {last} minus rate at std {first} [1/s]")
+    right.set_title("The ten terms that lose most")
+    cfg = doc["setup"]["cfg"]
+    floor = "the deep bed" if cfg["floor_depth"] is None else f"a {100 * cfg['floor_depth']:g} cm floor"
+    fig.suptitle(
+        f"What the rewards charge for action noise: {doc['policy']}, {cfg['material']} ({cfg['contact_model']}) "
+        f"over {floor}, {cfg['speed']:g} m/s",
+        fontsize=9,
+    )
+    fig.tight_layout()
+    fig.savefig(path, dpi=120)
+    plt.close(fig)
+
+
 def _floats(text: str) -> tuple[float, ...]:
     """Parse ``"0,0.5,1.0"`` into non-negative numbers."""
     try:
@@ -185,7 +229,23 @@ def main(argv: Sequence[str] | None = None) -> int:
     p.add_argument("--seconds", type=float, default=d.seconds, help="horizon [s]")
     p.add_argument("--device", default=d.device)
     p.add_argument("--seed", type=int, default=d.seed)
+    p.add_argument("--figure", default=None, help="PNG of the rates against the noise std")
+    p.add_argument("--mark", type=_floats, default=(), help="stds to mark in the figure, e.g. 0.86,1.22")
+    p.add_argument(
+        "--replot", action="store_true", help="no rollout: redraw --figure from the JSON at --out (written earlier)"
+    )
     a = p.parse_args(argv)
+    if a.replot:
+        if a.figure is None:
+            p.error("--replot needs --figure PATH")
+        import json
+
+        try:
+            plot_noise_cost(json.loads(Path(a.out).read_text()), a.figure, a.mark)
+        except (OSError, ValueError, KeyError) as err:
+            print(f"noise_cost: cannot replot {a.out}: {err}; give the JSON this study wrote", file=sys.stderr)
+            return 2
+        return 0
     if a.num_envs < 1 or not a.seconds > 0:
         p.error(f"--num-envs {a.num_envs} --seconds {a.seconds}: give at least 1 env and a horizon > 0 s")
     from typing import get_args
@@ -210,6 +270,8 @@ def main(argv: Sequence[str] | None = None) -> int:
         print(f"noise_cost: {err}", file=sys.stderr)
         return 2
     write_json(a.out, doc)
+    if a.figure is not None:
+        plot_noise_cost(doc, a.figure, a.mark)
     for sigma, level in doc["levels"].items():
         print(f"sigma {sigma}: return {level['return']:.2f}, survival {level['survival']:.2f}")
     return 0
