@@ -86,12 +86,14 @@ def test_failures_and_stance_sinkage_say_why_episodes_ended() -> None:
     rows = _rows(0.16)
     rows[2] |= {"failed": True, "failure": "base_too_low", "fail_s": 3.5}
     for r in rows[:4]:
-        r["stance_sink_m"] = 0.04
+        r["stance_sink_m"], r["stance_sink_peak_m"] = 0.04, 0.07
     m = gate_metrics(_cfg(), rows)
     assert m["failures"]["basalt"] == {"0.5": [], "1": ["base_too_low at 3.50 s"]}
     assert m["failures"]["poppy_seed"] == {"0.5": [], "1": []}
     np.testing.assert_allclose(m["stance_sink_cm"]["basalt"]["1"], 4.0)
     assert m["stance_sink_cm"]["poppy_seed"]["1"] is None  # rows without the read-out
+    np.testing.assert_allclose(m["stance_sink_peak_cm"]["basalt"]["1"], 7.0)
+    assert m["stance_sink_peak_cm"]["poppy_seed"]["1"] is None
 
 
 def test_failure_is_the_first_term_that_fired() -> None:
@@ -106,3 +108,26 @@ def test_failure_is_the_first_term_that_fired() -> None:
     assert name == "base_too_low" and math.isclose(when, 5 * dt)
     name, when = _failure(raw, 1, dt)
     assert name is None and math.isnan(when)
+
+
+def test_episode_rows_read_the_peak_stance_depth_of_alive_contact_steps() -> None:
+    """The peak is the 95th percentile of the depth of feet in contact while alive; swing feet do not count."""
+    from gmloco.train.gate.rollout import GateCell, episode_rows
+
+    steps = 100
+    height = np.zeros((steps, 1, 2))
+    height[:, 0, 0] = -np.linspace(0.0, 0.05, steps)  # foot 0 in contact, sinking 0-5 cm
+    height[:, 0, 1] = -0.5  # foot 1 deep but never in contact
+    contact = np.zeros((steps, 1, 2))
+    contact[:, 0, 0] = 1.0
+    raw = {
+        "alive": np.ones((steps, 1)),
+        "contact": contact,
+        "height": height,
+        **{k: np.zeros((steps, 1)) for k in ("vx", "vy", "wz", "yaw", "x", "y", "eta_true")},
+        **{k: np.zeros(1) for k in ("x0", "y0", "yaw0")},
+    }
+    cell = GateCell("forward", "basalt", 2000.0, 0.4, 0.4, (0.5, 0.0, 0.0))
+    (row,) = episode_rows(_cfg(), [cell], raw, 0.02)
+    np.testing.assert_allclose(row["stance_sink_m"], 0.025)
+    np.testing.assert_allclose(row["stance_sink_peak_m"], np.percentile(np.linspace(0.0, 0.05, steps), 95.0))

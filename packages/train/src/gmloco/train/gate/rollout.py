@@ -240,7 +240,8 @@ def episode_rows(cfg: GateCfg, cells: list[GateCell], raw: dict[str, np.ndarray]
     only); ``dtw_m`` (circle cells: DTW error of the pelvis path against the commanded circle over the alive
     steps); ``apex_m`` (swing apexes of both feet); ``eta`` (decoded and true eta after ``eta_warmup_s``);
     ``failure`` (the failure term that ended the episode, None for a survivor) and ``fail_s`` (when [s]);
-    ``stance_sink_m`` (mean depth of a foot in contact below the surface over the alive steps [m]).
+    ``stance_sink_m`` (mean depth of a foot in contact below the surface over the alive steps [m]) and
+    ``stance_sink_peak_m`` (its 95th percentile: how deep the feet dig at touchdown and push-off [m]).
     """
     settle, warm = round(cfg.settle_s / dt), round(cfg.eta_warmup_s / dt)
     stride = max(1, round(1.0 / (cfg.dtw_hz * dt)))
@@ -260,6 +261,7 @@ def episode_rows(cfg: GateCfg, cells: list[GateCell], raw: dict[str, np.ndarray]
             "failure": failure,
             "fail_s": fail_s,
             "stance_sink_m": float(sink.mean()) if sink.size else float("nan"),
+            "stance_sink_peak_m": float(np.percentile(sink, 95.0)) if sink.size else float("nan"),
             "vel_error": float(verr[tracked].mean()) if tracked.any() else float("nan"),
             "yaw_rate": float(raw["wz"][tracked, w].mean()) if tracked.any() else float("nan"),
             "drift_deg": heading_drift_deg(raw["yaw0"][w], raw["yaw"][-1, w]) if alive[-1] else float("nan"),

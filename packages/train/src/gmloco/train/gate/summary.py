@@ -50,9 +50,10 @@ def _forward(cfg: GateCfg, rows: list[dict[str, Any]], out: dict[str, Any]) -> N
     """Fill ``success_pct``, ``vel_error_mps`` and ``heading_drift_deg`` from the forward cells.
 
     Beside them, to tell why: ``failures`` (``{material: {v_x: ["<term> at <t> s", ...]}}``, one entry per failed
-    episode) and ``stance_sink_cm`` (mean depth of a foot in contact below the surface [cm]).
+    episode), ``stance_sink_cm`` (mean depth of a foot in contact below the surface [cm]) and
+    ``stance_sink_peak_cm`` (the episodes' mean 95th percentile of that depth [cm]).
     """
-    for key in (*PART_KEYS["success"], "failures", "stance_sink_cm"):
+    for key in (*PART_KEYS["success"], "failures", "stance_sink_cm", "stance_sink_peak_cm"):
         out[key] = {m: {} for m in cfg.materials}
     for m in cfg.materials:
         for v in cfg.speeds:
@@ -60,6 +61,8 @@ def _forward(cfg: GateCfg, rows: list[dict[str, Any]], out: dict[str, Any]) -> N
             out["failures"][m][_key(v)] = [f"{r['failure']} at {r['fail_s']:.2f} s" for r in sel if r.get("failure")]
             sink = _mean([r["stance_sink_m"] for r in sel if "stance_sink_m" in r])
             out["stance_sink_cm"][m][_key(v)] = None if sink is None else 100.0 * sink
+            peak = _mean([r["stance_sink_peak_m"] for r in sel if "stance_sink_peak_m" in r])
+            out["stance_sink_peak_cm"][m][_key(v)] = None if peak is None else 100.0 * peak
             out["success_pct"][m][_key(v)] = 100.0 * float(np.mean([not r["failed"] for r in sel]))
             out["vel_error_mps"][m][_key(v)] = _mean([r["vel_error"] for r in sel])
             out["heading_drift_deg"][m][_key(v)] = _mean([r["drift_deg"] for r in sel])
@@ -84,7 +87,7 @@ def gate_metrics(cfg: GateCfg, rows: list[dict[str, Any]]) -> dict[str, Any]:
     The keys of a part not in ``cfg.parts`` are None.
     """
     keys = ("success_pct", "vel_error_mps", "yaw_rate_ratio", "heading_drift_deg", "circle_dtw_m", "swing_apex_cm")
-    out: dict[str, Any] = dict.fromkeys((*keys, "eta_r2_heldout", "failures", "stance_sink_cm"))
+    out: dict[str, Any] = dict.fromkeys((*keys, "eta_r2_heldout", "failures", "stance_sink_cm", "stance_sink_peak_cm"))
     if "success" in cfg.parts:
         _forward(cfg, rows, out)
     if "yaw" in cfg.parts:
