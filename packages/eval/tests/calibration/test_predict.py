@@ -24,10 +24,21 @@ MPM_ROWS = [
 """MPM success [%] by speed: the straight rows are compared, the circle row is not."""
 
 
-def _gate(tmp: Path, model: str, success: dict[str, dict[str, float]], policy: str = POLICY) -> str:
-    """Write a gate summary of ``policy`` in ``model`` with the success table ``success`` [%]."""
+def _gate(
+    tmp: Path,
+    model: str,
+    success: dict[str, dict[str, float]],
+    policy: str = POLICY,
+    survival: dict[str, dict[str, float]] | None = None,
+) -> str:
+    """Write a gate summary of ``policy`` in ``model``: success [%] by MPM's rule, and survival (default: the same)."""
     path = tmp / f"gate_{policy}_{model}.json"
-    body = {"policy": f"artifacts/{policy}", "success_pct": success, "setup": {"contact_model": model}}
+    body = {
+        "policy": f"artifacts/{policy}",
+        "success_pct": success if survival is None else survival,
+        "success_course_pct": success,
+        "setup": {"contact_model": model},
+    }
     path.write_text(json.dumps(body))
     return str(path)
 
@@ -128,3 +139,30 @@ def test_only_judged_materials_lists_the_rest(tmp_path: Path) -> None:
     assert code == 0
     assert list(body["predicted_vs_mpm_success"][POLICY]) == ["dry_sand"]
     assert body["not_judged_on_mpm"] == {POLICY: ["basalt"]}
+
+
+def test_criterion_picks_the_gate_table(tmp_path: Path) -> None:
+    """MPM's course rule by default (success_course_pct); --criterion survival compares falls only (success_pct)."""
+    gate = _gate(tmp_path, "rft3d_calibrated", {"dry_sand": {"1": 50.0}}, survival={"dry_sand": {"1": 100.0}})
+    code, body = _run(tmp_path, [gate], _mpm(tmp_path), "--no-figures")
+    assert code == 0 and body["criterion"] == "course"
+    assert body["predicted_vs_mpm_success"][POLICY]["dry_sand"]["1"]["difference_points"] == {"rft3d_calibrated": -26.0}
+    code, body = _run(tmp_path, [gate], _mpm(tmp_path), "--no-figures", "--criterion", "survival")
+    assert code == 0 and body["criterion"] == "survival"
+    assert body["predicted_vs_mpm_success"][POLICY]["dry_sand"]["1"]["difference_points"] == {"rft3d_calibrated": 24.0}
+
+
+def test_gate_without_the_course_rule_exits_2(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    """A gate summary written before the course rule is refused by default and named; survival alone still reads."""
+    path = tmp_path / "old_gate.json"
+    body = {
+        "policy": f"artifacts/{POLICY}",
+        "success_pct": {"dry_sand": {"1": 90.0}},
+        "setup": {"contact_model": "rft3d"},
+    }
+    path.write_text(json.dumps(body))
+    code, out = _run(tmp_path, [str(path)], _mpm(tmp_path), "--no-figures")
+    assert code == 2 and out == {}
+    assert "has no success_course_pct" in capsys.readouterr().err
+    code, out = _run(tmp_path, [str(path)], _mpm(tmp_path), "--no-figures", "--criterion", "survival")
+    assert code == 0 and out["predicted_vs_mpm_success"][POLICY]["dry_sand"]["1"]["mpm_success_pct"] == 76.0

@@ -6,9 +6,11 @@ from __future__ import annotations
 import math
 
 import numpy as np
+import pytest
 
 from gmloco.train.gate.metrics import (
     circle_reference,
+    course_finished_s,
     dtw_path_error,
     heading_drift_deg,
     swing_apex_heights,
@@ -61,3 +63,38 @@ def test_swing_apex_heights_of_two_swings() -> None:
     h = np.array([0, 0.02, 0.08, 0.05, 0.01, 0, 0.03, 0, 0.04, 0.12, 0.06, 0.02, 0])
     contact = np.array([1, 0, 0, 0, 0, 1, 0, 1, 0, 0, 0, 0, 1]) > 0
     np.testing.assert_allclose(swing_apex_heights(h, contact, np.ones(13, bool)), [0.08, 0.12])
+
+
+def _line(speed: float, yaw: float, dt: float = 0.02, seconds: float = 10.0) -> np.ndarray:
+    """Positions [T, 2] [m] of a body walking from the origin at ``speed`` [m/s] along heading ``yaw`` [rad]."""
+    t = dt * np.arange(1, round(seconds / dt) + 1)
+    return np.stack([speed * t * math.cos(yaw), speed * t * math.sin(yaw)], axis=-1)
+
+
+def test_course_rule_by_hand() -> None:
+    """1 m/s on a 10 s, 1 m/s line with 20 % slack finishes at 8 s; at 0.7 m/s or 40 deg off it never does."""
+    dt = 0.02
+    ref = circle_reference(np.zeros(2), 0.0, 1.0, 0.0, dt * np.arange(501))
+    np.testing.assert_allclose(course_finished_s(_line(1.0, 0.0), ref, dt, 0.2), 8.0, atol=dt)
+    np.testing.assert_allclose(course_finished_s(_line(0.9, 0.0), ref, dt, 0.2), 8.0 / 0.9, atol=dt)
+    assert course_finished_s(_line(0.7, 0.0), ref, dt, 0.2) is None  # 7 m of the 8 m needed
+    # 25 deg off: 10 cos 25 = 9.06 m along the line, past 8 m; 40 deg off: 7.66 m, short of it.
+    assert course_finished_s(_line(1.0, math.radians(25.0)), ref, dt, 0.2) is not None
+    assert course_finished_s(_line(1.0, math.radians(40.0)), ref, dt, 0.2) is None
+    assert course_finished_s(_line(0.7, 0.0), ref, dt, 0.35) is not None
+
+
+def test_course_rule_is_mpms() -> None:
+    """The gate's course rule gives the MPM evaluation's times on drifting, wobbling, stopping walks."""
+    locomotion = pytest.importorskip("gmloco.eval.metrics.locomotion")
+    dt, rng = 0.02, np.random.default_rng(3)
+    for _ in range(20):
+        speed, yaw_rate = rng.uniform(0.5, 2.0), rng.choice([0.0, rng.uniform(-0.5, 0.5)])
+        ref, _ = locomotion.circular_path(speed, yaw_rate, 10.0, dt)
+        heading = rng.normal(0.0, 0.3) + np.cumsum(rng.normal(0.0, 0.02, 500))
+        step = rng.uniform(0.6, 1.1) * speed * dt * np.stack([np.cos(heading), np.sin(heading)], axis=-1)
+        path = np.cumsum(step, axis=0) + rng.normal(0.0, 0.01, (500, 2))
+        mine = course_finished_s(
+            path, circle_reference(np.zeros(2), 0.0, speed, yaw_rate, dt * np.arange(501)), dt, 0.2
+        )
+        assert mine == locomotion.course_finished_at(path, ref, dt, 0.2)

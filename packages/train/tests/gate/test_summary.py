@@ -131,3 +131,19 @@ def test_episode_rows_read_the_peak_stance_depth_of_alive_contact_steps() -> Non
     (row,) = episode_rows(_cfg(), [cell], raw, 0.02)
     np.testing.assert_allclose(row["stance_sink_m"], 0.025)
     np.testing.assert_allclose(row["stance_sink_peak_m"], np.percentile(np.linspace(0.0, 0.05, steps), 95.0))
+
+
+def test_success_by_the_course_rule() -> None:
+    """A survivor short of its course fails MPM's rule only; rows without ``course_s`` give no course table."""
+    rows = _rows(0.16)
+    for r in rows:
+        if r["cell"].kind == "forward":
+            r["course_s"] = 8.0
+    rows[2]["course_s"] = None  # basalt 1.0 m/s: survived, short of its course
+    rows[3] |= {"failed": True, "failure": "tilt", "fail_s": 3.0}  # basalt 1.0 m/s: fell (course_s ignored)
+    m = gate_metrics(_cfg(), rows)
+    assert m["success_pct"]["basalt"] == {"0.5": 100.0, "1": 50.0}
+    assert m["success_course_pct"]["basalt"] == {"0.5": 100.0, "1": 0.0}
+    assert m["success_course_pct"]["poppy_seed"] == {"0.5": 100.0, "1": 100.0}
+    assert m["failures"]["basalt"]["1"] == ["tilt at 3.00 s", "course_unfinished"]
+    assert gate_metrics(_cfg(), _rows(0.16))["success_course_pct"]["basalt"] == {"0.5": None, "1": None}

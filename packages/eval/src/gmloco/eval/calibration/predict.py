@@ -2,8 +2,10 @@
 """MPM success against the training simulator's prediction, per policy, material and speed; bad input exits 2.
 
 The prediction of a contact model is the gate's straight-walking success (``python -m gmloco.train.gate
---contact-model NAME --parts success``); the judge is the committed MPM success by speed (``speed_rows`` of
-``results/mpm_eval/summary.json`` or ``tables/tables.json``, or ``tables/table_speeds.csv``).
+--contact-model NAME --parts success``), by MPM's rule by default (``success_course_pct``: survived *and* walked
+the course; ``--criterion survival`` compares survival alone, ``success_pct``); the judge is the committed MPM
+success by speed (``speed_rows`` of ``results/mpm_eval/summary.json`` or ``tables/tables.json``, or
+``tables/table_speeds.csv``).
 
 python -m gmloco.eval.calibration.predict --gate results/sand_calibration/gate_*.json
         --mpm results/mpm_eval/summary.json --out results/sand_calibration/predicted_vs_mpm_success.json
@@ -18,7 +20,7 @@ import re
 import sys
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any
+from typing import Any, Literal
 
 from gmloco.deploy.atomic_io import atomic_write_json
 from gmloco.eval.calibration.dataset import read_json_object
@@ -32,9 +34,26 @@ _SPEED_COLUMN = re.compile(r"^v=([0-9.]+) m/s$")
 """Column of the MPM speed table holding the success [%] at one commanded speed, e.g. ``v=1.5 m/s``."""
 
 
+Criterion = Literal["course", "survival"]
+"""Which gate success predicts MPM's: ``course`` (MPM's rule) or ``survival`` (no fall, the course ignored)."""
+
+_GATE_KEY: dict[str, str] = {"course": "success_course_pct", "survival": "success_pct"}
+"""Gate summary key of each criterion."""
+
+_CRITERION_NOTE: dict[str, str] = {
+    "course": "MPM's rule: survived and walked 1 - course_slack of the commanded line (success_course_pct)",
+    "survival": "survival alone, the course ignored (success_pct)",
+}
+"""What the predicted success counts, per criterion (the JSON's notes)."""
+
+
 @dataclass(frozen=True)
 class PredictCfg:
     """What is compared and the tolerance of a prediction."""
+
+    criterion: Criterion = "course"
+    """Gate success compared with MPM's: ``course`` counts a survivor that did not walk ``1 - course_slack`` of
+    its commanded line as failed, as MPM does; ``survival`` counts falls only."""
 
     scenario: str = "straight"
     """MPM scenario whose speed rows are compared (the gate's forward cells walk straight)."""
@@ -50,13 +69,18 @@ def _speed_key(v: float) -> str:
     return f"{v:g}"
 
 
-def read_gate(path: str | Path) -> tuple[str, str, dict[str, dict[str, float]]]:
+def read_gate(path: str | Path, criterion: Criterion = "course") -> tuple[str, str, dict[str, dict[str, float]]]:
     """Return (policy name, contact model, success [%] by material and speed key) of a gate summary."""
     body = read_json_object(path, "gate summary")
-    success, setup = body.get("success_pct"), body.get("setup", {})
+    success, setup = body.get(_GATE_KEY[criterion]), body.get("setup", {})
     if "policy" not in body or not isinstance(setup, dict) or "contact_model" not in setup:
         raise ValueError(
             f"gate summary {path} lacks policy or setup.contact_model: is it python -m gmloco.train.gate's?"
+        )
+    if criterion == "course" and isinstance(body.get("success_pct"), dict) and success is None:
+        raise ValueError(
+            f"gate summary {path} has no success_course_pct (MPM's course rule): rerun the gate with this code, or "
+            "compare survival alone with --criterion survival"
         )
     if not isinstance(success, dict) or not success:
         raise ValueError(f"gate summary {path} has no success table: run the gate with --parts success")
@@ -94,11 +118,11 @@ def read_mpm_speeds(path: str | Path, scenario: str = "straight") -> dict[str, d
     return out
 
 
-def _gates(paths: list[str]) -> dict[str, dict[str, dict[str, dict[str, float]]]]:
+def _gates(paths: list[str], criterion: Criterion) -> dict[str, dict[str, dict[str, dict[str, float]]]]:
     """Return success [%] by policy, contact model, material and speed key; one gate per policy and model."""
     out: dict[str, dict[str, dict[str, dict[str, float]]]] = {}
     for path in paths:
-        policy, model, table = read_gate(path)
+        policy, model, table = read_gate(path, criterion)
         if model in out.get(policy, {}):
             raise ValueError(f"two gate summaries of {policy} with contact model {model!r}: give one each ({path})")
         out.setdefault(policy, {})[model] = table
@@ -149,7 +173,7 @@ def predict_success(gates: list[str], mpm: str, out: str | Path, cfg: PredictCfg
     Raises:
         ValueError: If a gate's policy or material has no MPM speed row, or no speed is in both.
     """
-    judged, predicted = read_mpm_speeds(mpm, cfg.scenario), _gates(gates)
+    judged, predicted = read_mpm_speeds(mpm, cfg.scenario), _gates(gates, cfg.criterion)
     table: dict[str, Any] = {}
     not_judged: dict[str, list[str]] = {}
     for policy, by_model in predicted.items():
@@ -168,8 +192,10 @@ def predict_success(gates: list[str], mpm: str, out: str | Path, cfg: PredictCfg
         "contact_models": models,
         "max_points": MAX_POINTS,
         "scenario": cfg.scenario,
+        "criterion": cfg.criterion,
         "notes": {
-            "predicted_success_pct": "straight-walking success [%] of the gate in the training simulator, per model",
+            "predicted_success_pct": "straight-walking success [%] of the gate in the training simulator, per model; "
+            + _CRITERION_NOTE[cfg.criterion],
             "difference_points": "predicted - MPM success [percentage points]; only speeds MPM has are compared",
         },
         "not_judged_on_mpm": not_judged,
@@ -195,6 +221,8 @@ def parse_args(argv: list[str] | None) -> argparse.Namespace:
     p.add_argument("--gate", nargs="+", required=True, help="gate summaries (python -m gmloco.train.gate)")
     p.add_argument("--mpm", default="results/mpm_eval/summary.json", help="MPM summary or table_speeds.csv")
     p.add_argument("--out", default="results/sand_calibration/predicted_vs_mpm_success.json")
+    p.add_argument("--criterion", choices=list(_GATE_KEY), default="course",
+                   help="gate success compared: MPM's rule (course, default) or survival alone")  # fmt: skip
     p.add_argument("--no-figures", action="store_true")
     p.add_argument("--only-judged-materials", action="store_true",
                    help="compare each policy on the materials MPM judged it on; list the others (default: error)")  # fmt: skip
@@ -206,7 +234,10 @@ def main(argv: list[str] | None = None) -> int:
     a = parse_args(argv)
     try:
         body = predict_success(
-            a.gate, a.mpm, a.out, PredictCfg(figures=not a.no_figures, only_judged_materials=a.only_judged_materials)
+            a.gate,
+            a.mpm,
+            a.out,
+            PredictCfg(criterion=a.criterion, figures=not a.no_figures, only_judged_materials=a.only_judged_materials),
         )
     except (FileNotFoundError, ValueError) as e:
         print(f"error: {e}", file=sys.stderr)

@@ -70,6 +70,9 @@ class GateCfg(RolloutCriteriaCfg):
     """Forward speed of the circle cell [m/s]."""
     apex_speed: float = 1.0
     """Forward cells whose swings give the swing apex per material [m/s]."""
+    course_slack: float = field(default=0.2, metadata={"ge": 0, "lt": 1})
+    """Fraction of the commanded path a straight walk may leave unwalked and still finish its course [-]: MPM's
+    rule (``G1EvalCfg.course_slack``), applied for ``success_course_pct``."""
     settle_s: float = 1.0
     """Start of each episode left out of the velocity and yaw-rate metrics (acceleration from rest) [s]."""
     dtw_hz: float = 10.0

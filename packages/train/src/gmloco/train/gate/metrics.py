@@ -52,6 +52,27 @@ def circle_reference(
     return np.asarray(xy0, dtype=np.float64)[None, :] + local @ rot.T
 
 
+def course_finished_s(path: np.ndarray, reference: np.ndarray, dt: float, slack: float) -> float | None:
+    """Return when the body passed ``1 - slack`` of the commanded path [s] (None: never); MPM's course rule.
+
+    Progress is the reference sample nearest the body, searched forwards from the last one within 0.5 s of
+    samples, so a walk that bends away from its course still progresses along it, only more slowly.
+
+    Args:
+        path: Body positions [T, 2] [m], sample k at time (k + 1) dt.
+        reference: Commanded path [N, 2] [m] (``circle_reference`` at 0, dt, 2 dt, ...).
+        dt: Sample period [s].
+        slack: Fraction of the commanded path that may be left and still count as finished [-].
+    """
+    ref = np.asarray(reference, dtype=np.float64)
+    idx, window, goal = 0, max(1, round(0.5 / dt)), (1.0 - slack) * (len(ref) - 1)
+    for k, p in enumerate(np.asarray(path, dtype=np.float64)):
+        idx += int(np.argmin(np.linalg.norm(ref[idx : idx + window] - p, axis=1)))
+        if idx >= goal:
+            return (k + 1) * dt
+    return None
+
+
 def dtw_path_error(path: np.ndarray, reference: np.ndarray) -> float:
     """Return the mean point distance [m] along the dynamic-time-warping alignment of two paths [N, 2], [M, 2].
 

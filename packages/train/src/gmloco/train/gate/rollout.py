@@ -19,6 +19,7 @@ import gmloco.contact as gc
 from gmloco.train.gate.config import GateCfg
 from gmloco.train.gate.metrics import (
     circle_reference,
+    course_finished_s,
     dtw_path_error,
     heading_drift_deg,
     swing_apex_heights,
@@ -241,7 +242,9 @@ def episode_rows(cfg: GateCfg, cells: list[GateCell], raw: dict[str, np.ndarray]
     steps); ``apex_m`` (swing apexes of both feet); ``eta`` (decoded and true eta after ``eta_warmup_s``);
     ``failure`` (the failure term that ended the episode, None for a survivor) and ``fail_s`` (when [s]);
     ``stance_sink_m`` (mean depth of a foot in contact below the surface over the alive steps [m]) and
-    ``stance_sink_peak_m`` (its 95th percentile: how deep the feet dig at touchdown and push-off [m]).
+    ``stance_sink_peak_m`` (its 95th percentile: how deep the feet dig at touchdown and push-off [m]);
+    ``course_s`` (forward cells: when the pelvis passed ``1 - course_slack`` of the commanded straight line, MPM's
+    rule [s]; None when it never did, which fails the episode by MPM's rule even if it did not fall).
     """
     settle, warm = round(cfg.settle_s / dt), round(cfg.eta_warmup_s / dt)
     stride = max(1, round(1.0 / (cfg.dtw_hz * dt)))
@@ -266,6 +269,12 @@ def episode_rows(cfg: GateCfg, cells: list[GateCell], raw: dict[str, np.ndarray]
             "yaw_rate": float(raw["wz"][tracked, w].mean()) if tracked.any() else float("nan"),
             "drift_deg": heading_drift_deg(raw["yaw0"][w], raw["yaw"][-1, w]) if alive[-1] else float("nan"),
         }
+        if cell.kind == "forward":
+            steps = len(alive)
+            ref = circle_reference(np.array([raw["x0"][w], raw["y0"][w]]), float(raw["yaw0"][w]), cmd[0], 0.0,
+                                   dt * np.arange(steps + 1))  # fmt: skip
+            path = np.stack([raw["x"][:, w], raw["y"][:, w]], axis=-1)
+            row["course_s"] = course_finished_s(path, ref, dt, cfg.course_slack)
         if cell.kind == "circle":
             n = int(alive.sum())
             times = dt * np.arange(1, n + 1)

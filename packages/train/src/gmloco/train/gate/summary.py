@@ -46,24 +46,34 @@ PART_KEYS: dict[str, tuple[str, ...]] = {
 """Summary keys of each gate part (``GatePart``)."""
 
 
+def _short_of_course(row: dict[str, Any]) -> bool:
+    """A survivor that never passed the course's end by MPM's rule (rows without ``course_s``: False)."""
+    return not row["failed"] and "course_s" in row and row["course_s"] is None
+
+
 def _forward(cfg: GateCfg, rows: list[dict[str, Any]], out: dict[str, Any]) -> None:
     """Fill ``success_pct``, ``vel_error_mps`` and ``heading_drift_deg`` from the forward cells.
 
     Beside them, to tell why: ``failures`` (``{material: {v_x: ["<term> at <t> s", ...]}}``, one entry per failed
-    episode), ``stance_sink_cm`` (mean depth of a foot in contact below the surface [cm]) and
-    ``stance_sink_peak_cm`` (the episodes' mean 95th percentile of that depth [cm]).
+    episode), ``stance_sink_cm`` (mean depth of a foot in contact below the surface [cm]),
+    ``stance_sink_peak_cm`` (the episodes' mean 95th percentile of that depth [cm]) and ``success_course_pct``
+    (success by MPM's rule [%]: survived and passed ``1 - course_slack`` of the commanded line within the episode;
+    a survivor short of it is listed in ``failures`` as ``course_unfinished``).
     """
-    for key in (*PART_KEYS["success"], "failures", "stance_sink_cm", "stance_sink_peak_cm"):
+    for key in (*PART_KEYS["success"], "failures", "stance_sink_cm", "stance_sink_peak_cm", "success_course_pct"):
         out[key] = {m: {} for m in cfg.materials}
     for m in cfg.materials:
         for v in cfg.speeds:
             sel = _rows(rows, "forward", m, (v, 0.0, 0.0))
             out["failures"][m][_key(v)] = [f"{r['failure']} at {r['fail_s']:.2f} s" for r in sel if r.get("failure")]
+            out["failures"][m][_key(v)] += ["course_unfinished" for r in sel if _short_of_course(r)]
             sink = _mean([r["stance_sink_m"] for r in sel if "stance_sink_m" in r])
             out["stance_sink_cm"][m][_key(v)] = None if sink is None else 100.0 * sink
             peak = _mean([r["stance_sink_peak_m"] for r in sel if "stance_sink_peak_m" in r])
             out["stance_sink_peak_cm"][m][_key(v)] = None if peak is None else 100.0 * peak
             out["success_pct"][m][_key(v)] = 100.0 * float(np.mean([not r["failed"] for r in sel]))
+            course = [not r["failed"] and r["course_s"] is not None for r in sel if "course_s" in r]
+            out["success_course_pct"][m][_key(v)] = 100.0 * float(np.mean(course)) if course else None
             out["vel_error_mps"][m][_key(v)] = _mean([r["vel_error"] for r in sel])
             out["heading_drift_deg"][m][_key(v)] = _mean([r["drift_deg"] for r in sel])
 
@@ -87,7 +97,8 @@ def gate_metrics(cfg: GateCfg, rows: list[dict[str, Any]]) -> dict[str, Any]:
     The keys of a part not in ``cfg.parts`` are None.
     """
     keys = ("success_pct", "vel_error_mps", "yaw_rate_ratio", "heading_drift_deg", "circle_dtw_m", "swing_apex_cm")
-    out: dict[str, Any] = dict.fromkeys((*keys, "eta_r2_heldout", "failures", "stance_sink_cm", "stance_sink_peak_cm"))
+    extra = ("failures", "stance_sink_cm", "stance_sink_peak_cm", "success_course_pct")
+    out: dict[str, Any] = dict.fromkeys((*keys, "eta_r2_heldout", *extra))
     if "success" in cfg.parts:
         _forward(cfg, rows, out)
     if "yaw" in cfg.parts:
