@@ -3,12 +3,24 @@
 
 from __future__ import annotations
 
+import dataclasses
+import json
 import re
 from pathlib import Path
 
 import pytest
 
-from gmloco.deploy.mismatch.benchmark.v5 import NULLS_PER_SUITE, SEED_BASE, SUITES, TARGETS, main, suite_episodes
+from gmloco.deploy.mismatch.benchmark.v5 import (
+    FLAGS,
+    NULLS_PER_SUITE,
+    SEED_BASE,
+    SUITES,
+    TARGETS,
+    _parse,
+    main,
+    suite_episodes,
+)
+from gmloco.deploy.mismatch.benchmark.v5_cfg import V5RunCfg
 from gmloco.deploy.mismatch.effects import EFFECT_IDS, effect
 
 _PROTOCOL = Path(__file__).parents[4] / "results/mismatch_benchmark/v5/protocol.md"
@@ -46,8 +58,53 @@ def test_targets_match_the_protocol() -> None:
     assert "`unexplained` >= 80 %" in text and TARGETS["ool_unexplained"] == 0.8
 
 
-def test_bad_part_exits_2(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
-    """A malformed --part runs nothing and exits with 2, saying what it takes."""
-    assert main(["--out", str(tmp_path), "--suite", "fixed", "--part", "3/2"]) == 2
-    assert "0 <= i < n" in capsys.readouterr().err
+@pytest.mark.parametrize(
+    ("extra", "message"),
+    [
+        (["--part", "3/2"], "0 <= i < n"),
+        (["--part", "half"], "give I/N with whole numbers"),
+        (["--workers", "0"], "--workers 0 must be >= 1"),
+        (["--deadline-s", "0"], "--deadline-s 0.0 must be > 0"),
+        (["--suite", "gravel"], "invalid choice: 'gravel'"),
+    ],
+)
+def test_bad_input_exits_2(extra: list[str], message: str, tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    """A malformed or out-of-range flag runs nothing and exits with 2, saying what it takes."""
+    with pytest.raises(SystemExit) as stop:
+        main(["--out", str(tmp_path), "--suite", "fixed", *extra])
+    assert stop.value.code == 2
+    assert message in capsys.readouterr().err
     assert not any(tmp_path.iterdir())
+
+
+def _recorded_commands() -> list[list[str]]:
+    """Every v5 command written down: the protocol's and README's lines and the argv of every run file."""
+    root = _PROTOCOL.parent
+    lines = [ln for f in (_PROTOCOL, root / "README.md") for ln in f.read_text().splitlines()]
+    argvs = [ln.split("benchmark.v5", 1)[1].split() for ln in lines if "-m gmloco.deploy.mismatch.benchmark.v5 " in ln]
+    argvs += [json.loads(f.read_text())["argv"] for f in sorted(root.glob("*/runs/*.json"))]
+    return argvs
+
+
+def test_recorded_commands_parse() -> None:
+    """The flag table reads every recorded command as the hand-written parser did (suite, workers, resume)."""
+    argvs = _recorded_commands()
+    assert len(argvs) >= 6
+    for argv in argvs:
+        root, cfg = _parse(argv)
+        assert str(root) == argv[argv.index("--out") + 1] and cfg.suite == argv[argv.index("--suite") + 1]
+        assert cfg.resume == ("--resume" in argv)
+        if "--workers" in argv:
+            assert cfg.workers == int(argv[argv.index("--workers") + 1])
+        if "--deadline-s" in argv:
+            assert cfg.deadline_s == float(argv[argv.index("--deadline-s") + 1])
+
+
+def test_flags_come_from_the_config() -> None:
+    """Every generated flag sets a field of V5RunCfg and the defaults are the config's."""
+    fields = {f.name for f in dataclasses.fields(V5RunCfg)}
+    assert {flag.path for flag in FLAGS} == fields - {"suite"}
+    _, cfg = _parse(["--out", "x", "--suite", "sand"])
+    assert cfg == V5RunCfg(suite="sand")
+    _, cfg = _parse(["--out", "x", "--suite", "plane", "--only", "plane-none,plane-ool", "--list", "--score-only"])
+    assert (cfg.only, cfg.list_episodes, cfg.score_only) == (("plane-none", "plane-ool"), True, True)

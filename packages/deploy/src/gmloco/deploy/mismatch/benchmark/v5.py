@@ -19,14 +19,18 @@ import json
 import os
 import sys
 import time
+from dataclasses import replace
 from multiprocessing import Pool
 from pathlib import Path
 
 import numpy as np
 
+from gmloco.deploy.config_cli import Flag, add_flags, cfg_from_flags, check_flags, field_doc
 from gmloco.deploy.mismatch.benchmark.episodes import MID, OOL, SAND_MID_V4, SAND_OOL
+from gmloco.deploy.mismatch.benchmark.sweep import _part_spec
+from gmloco.deploy.mismatch.benchmark.v5_cfg import V5RunCfg
 
-__all__ = ["FIXED_MID_V5", "NEW_MID_V5", "NULLS_PER_SUITE", "SEED_BASE", "SUITES", "TARGETS", "suite_episodes"]
+__all__ = ["FIXED_MID_V5", "FLAGS", "NEW_MID_V5", "NULLS_PER_SUITE", "SEED_BASE", "SUITES", "TARGETS", "suite_episodes"]
 
 _LEG = 12
 _KNEE_L, _HIP_PITCH_R, _ANKLE_PITCH_R = 3, 6, 10  # leg-joint indices (G1_JOINT_NAMES order)
@@ -186,42 +190,51 @@ def _run_all(args: list[tuple], workers: int, suite: str) -> list[dict]:
     return done
 
 
+FLAGS: tuple[Flag, ...] = (
+    Flag("--workers", "workers"),
+    Flag("--part", "part", parse=_part_spec),
+    Flag("--only", "only", sep=","),
+    Flag("--resume", "resume"),
+    Flag("--deadline-s", "deadline_s"),
+    Flag("--list", "list_episodes"),
+    Flag("--score-only", "score_only"),
+)
+"""The flags generated from :class:`V5RunCfg` (``--out`` and the required ``--suite`` are the command line's own)."""
+
+
+def _parse(argv: list[str] | None) -> tuple[Path, V5RunCfg]:
+    """The results folder and run config of the arguments (exit code 2 on a malformed or out-of-range one)."""
+    p = argparse.ArgumentParser(prog="mismatch-benchmark-v5", description=__doc__)
+    p.add_argument("--out", type=Path, required=True, help="v5 results directory (suites go to OUT/<suite>)")
+    p.add_argument("--suite", choices=sorted(SUITES), required=True, help=field_doc(V5RunCfg, "suite"))
+    add_flags(p, V5RunCfg(), FLAGS)
+    a = p.parse_args(argv)
+    check_flags(p, a, V5RunCfg, FLAGS)
+    return a.out, replace(cfg_from_flags(a, V5RunCfg(), FLAGS), suite=a.suite)
+
+
 def main(argv: list[str] | None = None) -> int:
     """Run (part of) one suite, then score it and the pool; exit 2 on bad arguments."""
     from gmloco.deploy.mismatch.benchmark.sweep import _git_commit, _part
 
-    p = argparse.ArgumentParser(prog="mismatch-benchmark-v5", description=__doc__)
-    p.add_argument("--out", type=Path, required=True, help="v5 results directory (suites go to OUT/<suite>)")
-    p.add_argument("--suite", choices=sorted(SUITES), required=True)
-    p.add_argument("--workers", type=int, default=2)
-    p.add_argument("--part", default=None, help="I/N: episodes at positions I, I+N, ... of the suite's list")
-    p.add_argument("--only", default=None, help="comma-separated episode-name prefixes")
-    p.add_argument("--resume", action="store_true", help="skip episodes whose row exists")
-    p.add_argument("--deadline-s", type=float, default=None, help="start no episode after this many seconds")
-    p.add_argument("--list", action="store_true", help="print the suite's episodes and exit")
-    p.add_argument("--score-only", action="store_true", help="score the rows already written and exit")
-    a = p.parse_args(argv)
-    eps = suite_episodes(a.suite)
-    if a.list:
+    root, cfg = _parse(argv)
+    eps = suite_episodes(cfg.suite)
+    if cfg.list_episodes:
         for e in eps:
             print(e["name"], e["seed"])
         return 0
-    try:
-        eps = _part(eps, a.part)
-    except ValueError as exc:
-        print(f"error: {exc}. Nothing was run.", file=sys.stderr)
-        return 2
-    if a.only:
-        eps = [e for e in eps if any(e["name"].startswith(s) for s in a.only.split(","))]
-    out = a.out / a.suite
-    if not a.score_only:
+    eps = _part(eps, cfg.part)
+    if cfg.only:
+        eps = [e for e in eps if any(e["name"].startswith(s) for s in cfg.only)]
+    out = root / cfg.suite
+    if not cfg.score_only:
         out.mkdir(parents=True, exist_ok=True)
-        todo = [e for e in eps if not (a.resume and (out / "rows" / f"{e['name']}.json").exists())]
+        todo = [e for e in eps if not (cfg.resume and (out / "rows" / f"{e['name']}.json").exists())]
         t0 = time.time()
-        deadline = None if a.deadline_s is None else t0 + a.deadline_s
+        deadline = None if cfg.deadline_s is None else t0 + cfg.deadline_s
         args = [(e, str(out), e["duration"], None, None, deadline) for e in todo]
-        done = _run_all(args, a.workers, a.suite)
-        run = {"suite": a.suite, "argv": argv if argv is not None else sys.argv[1:], "ran": [r["name"] for r in done
+        done = _run_all(args, cfg.workers, cfg.suite)
+        run = {"suite": cfg.suite, "argv": argv if argv is not None else sys.argv[1:], "ran": [r["name"] for r in done
                if "skipped" not in r], "wall_s": time.time() - t0, "cpus": os.cpu_count(), "git": _git_commit()}  # fmt: skip
         (out / "runs").mkdir(exist_ok=True)
         _write_json(out / "runs" / f"{time.strftime('%Y%m%dT%H%M%S')}.json", run)
@@ -230,8 +243,8 @@ def main(argv: list[str] | None = None) -> int:
 
     rows = _rows(out)
     _write_json(out / "summary.json", {**score(rows), "episodes_scored": len(rows)})
-    by_suite = {s: _rows(a.out / s) for s in SUITES if (a.out / s / "rows").is_dir()}
-    _write_json(a.out / "summary_pooled.json", pooled(by_suite))
+    by_suite = {s: _rows(root / s) for s in SUITES if (root / s / "rows").is_dir()}
+    _write_json(root / "summary_pooled.json", pooled(by_suite))
     return 0
 
 
