@@ -1,5 +1,5 @@
 # SPDX-License-Identifier: Apache-2.0
-"""The ``contact`` and ``material`` config groups write the train stage's existing fields and nothing else."""
+"""The ``contact``, ``material`` and ``ppo`` config groups write the train stage's existing fields and nothing else."""
 
 from __future__ import annotations
 
@@ -96,6 +96,26 @@ def test_both_groups_together(compose: Callable[..., DictConfig]) -> None:
     assert _resolved(compose, *both) == _resolved(compose, *explicit)
     cfg = compose(*both, "train_teacher.contact_model=rigid", "train_teacher.material.preset=basalt")
     assert (cfg.train_teacher.contact_model, cfg.train_teacher.material.preset) == (ContactModelName.rigid, "basalt")
+
+
+def test_ppo_group_is_its_field_overrides(compose: Callable[..., DictConfig]) -> None:
+    """Each ``ppo=<preset>`` resolves exactly as its PpoCfg field overrides; without one, PpoCfg's defaults.
+
+    A preset is a ``# @package train_teacher.ppo`` file of PpoCfg fields; the defaults are written nowhere else.
+    """
+    from gmloco.train.teacher_student.config import PpoCfg
+
+    fields = set(PpoCfg.__dataclass_fields__)
+    for preset in group_options("ppo"):
+        text = (CONF_DIR / "ppo" / f"{preset}.yaml").read_text()
+        assert text.splitlines()[0] == "# @package train_teacher.ppo"
+        values = OmegaConf.to_container(OmegaConf.create(text))
+        assert isinstance(values, dict) and values and set(values) <= fields
+        for exp in EXPS:
+            explicit = [f"train_teacher.ppo.{k}={v}" for k, v in values.items()]
+            assert _resolved(compose, f"+exp={exp}", f"ppo={preset}") == _resolved(compose, f"+exp={exp}", *explicit)
+    assert compose("+exp=ppo_rigid").train_teacher.ppo.entropy_coef == PpoCfg().entropy_coef == 0.005
+    assert compose("+exp=ppo_rigid", "ppo=low_entropy").train_teacher.ppo.entropy_coef == 0.001
 
 
 def test_every_exp_is_listed() -> None:
