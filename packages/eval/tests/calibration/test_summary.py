@@ -107,6 +107,7 @@ def _predicted_file(tmp: Path, models: tuple[str, ...], max_points: float = 15.0
     for model in models:
         gate = tmp / f"gate_{model}.json"
         gate.write_text(json.dumps({"policy": "artifacts/gm_loco_student_td", "success_pct": {"dry_sand": {"1": 80.0}},
+                                    "success_course_pct": {"dry_sand": {"1": 80.0}},
                                     "setup": {"contact_model": model}}))  # fmt: skip
         gate_paths.append(str(gate))
     mpm = tmp / "mpm.json"

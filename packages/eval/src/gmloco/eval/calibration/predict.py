@@ -59,6 +59,10 @@ class PredictCfg:
     """MPM scenario whose speed rows are compared (the gate's forward cells walk straight)."""
     figures: bool = True
     """Write one figure per policy beside the JSON."""
+    walks: bool = True
+    """Beside each cell, how the walks differ (``mpm_walk``, ``gate_walk``: falls, unfinished courses, velocity
+    error, heading change; :mod:`gmloco.eval.calibration.walk_gap`) when the MPM summary names the policy's run
+    folders (``runs.<policy>.dirs``)."""
     only_judged_materials: bool = False
     """Compare a policy on the materials MPM has judged it on and list the others under ``not_judged_on_mpm``
     (False: a gated material without an MPM row is an error)."""
@@ -118,15 +122,39 @@ def read_mpm_speeds(path: str | Path, scenario: str = "straight") -> dict[str, d
     return out
 
 
-def _gates(paths: list[str], criterion: Criterion) -> dict[str, dict[str, dict[str, dict[str, float]]]]:
-    """Return success [%] by policy, contact model, material and speed key; one gate per policy and model."""
+def _gates(paths: list[str], criterion: Criterion) -> tuple[dict[str, Any], dict[str, dict[str, str]]]:
+    """Return success [%] by policy, contact model, material and speed key, and the file of each (policy, model)."""
     out: dict[str, dict[str, dict[str, dict[str, float]]]] = {}
+    files: dict[str, dict[str, str]] = {}
     for path in paths:
         policy, model, table = read_gate(path, criterion)
         if model in out.get(policy, {}):
             raise ValueError(f"two gate summaries of {policy} with contact model {model!r}: give one each ({path})")
         out.setdefault(policy, {})[model] = table
-    return out
+        files.setdefault(policy, {})[model] = path
+    return out, files
+
+
+def _mpm_dirs(path: Path) -> dict[str, list[str]]:
+    """Run folders of each policy in an MPM summary (``runs.<policy>.dirs``); {} for a CSV table or none."""
+    if path.suffix == ".csv":
+        return {}
+    runs = read_json_object(path, "MPM summary").get("runs")
+    if not isinstance(runs, dict):
+        return {}
+    return {p: list(r["dirs"]) for p, r in runs.items() if isinstance(r, dict) and isinstance(r.get("dirs"), list)}
+
+
+def _add_walks(table: dict[str, Any], files: dict[str, str], dirs: list[str], scenario: str) -> None:
+    """Put ``mpm_walk`` and ``gate_walk`` (per model) beside every cell of one policy's table."""
+    from gmloco.eval.calibration.walk_gap import gate_walk, mpm_walks
+
+    walks = mpm_walks(dirs, scenario)
+    bodies = {model: read_json_object(path, "gate summary") for model, path in files.items()}
+    for material, cells in table.items():
+        for speed, cell in cells.items():
+            cell["mpm_walk"] = walks.get(material, {}).get(speed)
+            cell["gate_walk"] = {model: gate_walk(body, material, speed) for model, body in bodies.items()}
 
 
 def _cell(mpm: float, predicted: dict[str, float | None], cfg: PredictCfg) -> dict[str, Any]:
@@ -173,7 +201,8 @@ def predict_success(gates: list[str], mpm: str, out: str | Path, cfg: PredictCfg
     Raises:
         ValueError: If a gate's policy or material has no MPM speed row, or no speed is in both.
     """
-    judged, predicted = read_mpm_speeds(mpm, cfg.scenario), _gates(gates, cfg.criterion)
+    judged, (predicted, files) = read_mpm_speeds(mpm, cfg.scenario), _gates(gates, cfg.criterion)
+    runs = _mpm_dirs(Path(mpm)) if cfg.walks else {}
     table: dict[str, Any] = {}
     not_judged: dict[str, list[str]] = {}
     for policy, by_model in predicted.items():
@@ -182,6 +211,8 @@ def predict_success(gates: list[str], mpm: str, out: str | Path, cfg: PredictCfg
                 f"policy {policy!r} has no MPM {cfg.scenario} speed rows in {mpm}; MPM has {sorted(judged)}"
             )
         table[policy] = _compare(policy, by_model, judged[policy], cfg)
+        if policy in runs:
+            _add_walks(table[policy], files[policy], runs[policy], cfg.scenario)
         gated = {m for t in by_model.values() for m in t}
         if gated - set(table[policy]):
             not_judged[policy] = sorted(gated - set(table[policy]))
@@ -197,6 +228,10 @@ def predict_success(gates: list[str], mpm: str, out: str | Path, cfg: PredictCfg
             "predicted_success_pct": "straight-walking success [%] of the gate in the training simulator, per model; "
             + _CRITERION_NOTE[cfg.criterion],
             "difference_points": "predicted - MPM success [percentage points]; only speeds MPM has are compared",
+            "mpm_walk": "the policy's MPM episodes of the cell: fell / course unfinished / success [%], median "
+            "velocity error [m/s] and largest heading turn from the start [deg]",
+            "gate_walk": "the gate's episodes of the cell, per model: fell / course unfinished [%], mean velocity "
+            "error [m/s], survivors' heading drift at the end [deg]",
         },
         "not_judged_on_mpm": not_judged,
         "inputs": {"gates": list(gates), "mpm": str(mpm)},
@@ -224,6 +259,7 @@ def parse_args(argv: list[str] | None) -> argparse.Namespace:
     p.add_argument("--criterion", choices=list(_GATE_KEY), default="course",
                    help="gate success compared: MPM's rule (course, default) or survival alone")  # fmt: skip
     p.add_argument("--no-figures", action="store_true")
+    p.add_argument("--no-walks", action="store_true", help="leave out the per-cell walk comparison")
     p.add_argument("--only-judged-materials", action="store_true",
                    help="compare each policy on the materials MPM judged it on; list the others (default: error)")  # fmt: skip
     return p.parse_args(argv)
@@ -237,7 +273,12 @@ def main(argv: list[str] | None = None) -> int:
             a.gate,
             a.mpm,
             a.out,
-            PredictCfg(criterion=a.criterion, figures=not a.no_figures, only_judged_materials=a.only_judged_materials),
+            PredictCfg(
+                criterion=a.criterion,
+                figures=not a.no_figures,
+                walks=not a.no_walks,
+                only_judged_materials=a.only_judged_materials,
+            ),
         )
     except (FileNotFoundError, ValueError) as e:
         print(f"error: {e}", file=sys.stderr)
