@@ -1,5 +1,5 @@
 # SPDX-License-Identifier: Apache-2.0
-"""The ``contact``, ``material`` and ``ppo`` config groups write the train stage's existing fields and nothing else."""
+"""The ``contact``, ``material``, ``ppo`` and ``eval`` config groups write existing schema fields and nothing else."""
 
 from __future__ import annotations
 
@@ -98,24 +98,46 @@ def test_both_groups_together(compose: Callable[..., DictConfig]) -> None:
     assert (cfg.train_teacher.contact_model, cfg.train_teacher.material.preset) == (ContactModelName.rigid, "basalt")
 
 
-def test_ppo_group_is_its_field_overrides(compose: Callable[..., DictConfig]) -> None:
-    """Each ``ppo=<preset>`` resolves exactly as its PpoCfg field overrides; without one, PpoCfg's defaults.
+@pytest.mark.parametrize(("group", "package"), [("ppo", "train_teacher.ppo"), ("eval", "eval_mpm")])
+def test_preset_group_is_its_field_overrides(compose: Callable[..., DictConfig], group: str, package: str) -> None:
+    """Each ``ppo=`` / ``eval=`` preset resolves exactly as its field overrides; without one, the schema's defaults.
 
-    A preset is a ``# @package train_teacher.ppo`` file of PpoCfg fields; the defaults are written nowhere else.
+    A preset is a ``# @package <section>`` file of fields of that section's schema; the defaults are written nowhere
+    else (no experiment repeats them).
     """
-    from gmloco.train.teacher_student.config import PpoCfg
-
-    fields = set(PpoCfg.__dataclass_fields__)
-    for preset in group_options("ppo"):
-        text = (CONF_DIR / "ppo" / f"{preset}.yaml").read_text()
-        assert text.splitlines()[0] == "# @package train_teacher.ppo"
+    schema = {"ppo": "PpoCfg", "eval": "G1EvalCfg"}[group]
+    module = {"ppo": "gmloco.train.teacher_student.config", "eval": "gmloco.eval.g1.config"}[group]
+    fields = set(getattr(__import__(module, fromlist=[schema]), schema).__dataclass_fields__)
+    assert group_options(group)
+    for preset in group_options(group):
+        text = (CONF_DIR / group / f"{preset}.yaml").read_text()
+        assert text.splitlines()[0] == f"# @package {package}"
         values = OmegaConf.to_container(OmegaConf.create(text))
         assert isinstance(values, dict) and values and set(values) <= fields
         for exp in EXPS:
-            explicit = [f"train_teacher.ppo.{k}={v}" for k, v in values.items()]
-            assert _resolved(compose, f"+exp={exp}", f"ppo={preset}") == _resolved(compose, f"+exp={exp}", *explicit)
-    assert compose("+exp=ppo_rigid").train_teacher.ppo.entropy_coef == PpoCfg().entropy_coef == 0.005
-    assert compose("+exp=ppo_rigid", "ppo=low_entropy").train_teacher.ppo.entropy_coef == 0.001
+            explicit = [f"{package}.{k}={_override_value(v)}" for k, v in values.items()]
+            assert _resolved(compose, f"+exp={exp}", f"{group}={preset}") == _resolved(
+                compose, f"+exp={exp}", *explicit
+            )
+
+
+def _override_value(value: Any) -> str:
+    """A YAML value as a Hydra override value (lists as ``[a,b]``)."""
+    return f"[{','.join(map(str, value))}]" if isinstance(value, list) else str(value)
+
+
+def test_presets_by_hand(compose: Callable[..., DictConfig]) -> None:
+    """No preset: PpoCfg's entropy bonus and G1EvalCfg's terrains; ``ppo=low_entropy``, ``eval=speed_table``."""
+    from gmloco.eval.g1.config import G1EvalCfg
+    from gmloco.train.teacher_student.config import PpoCfg
+
+    plain = compose("+exp=gm_loco")
+    assert plain.train_teacher.ppo.entropy_coef == PpoCfg().entropy_coef == 0.005
+    assert plain.eval_mpm.num_episodes == G1EvalCfg().num_episodes == 100
+    chosen = compose("+exp=gm_loco", "ppo=low_entropy", "eval=speed_table")
+    assert chosen.train_teacher.ppo.entropy_coef == 0.001
+    assert list(chosen.eval_mpm.terrains) == ["basalt", "dry_sand", "poppy_seed"]
+    assert [s.value for s in chosen.eval_mpm.scenarios] == ["straight"]
 
 
 def test_every_exp_is_listed() -> None:
