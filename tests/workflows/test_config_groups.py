@@ -140,6 +140,29 @@ def test_presets_by_hand(compose: Callable[..., DictConfig]) -> None:
     assert [s.value for s in chosen.eval_mpm.scenarios] == ["straight"]
 
 
+def _leaves(node: Any, prefix: str = "") -> dict[str, Any]:
+    """Dotted paths and values of the leaves of a plain container (an empty mapping is a leaf)."""
+    if isinstance(node, dict) and node:
+        return {k: v for key, sub in node.items() for k, v in _leaves(sub, f"{prefix}{key}.").items()}
+    return {prefix.rstrip("."): node}
+
+
+@pytest.mark.parametrize("exp", sorted(EXP_CONTACT_MODELS))
+def test_exp_writes_no_default(exp: str) -> None:
+    """Every value an experiment file sets differs from the schema's default there (each value written once)."""
+    text = OmegaConf.create((CONF_DIR / "exp" / f"{exp}.yaml").read_text())
+    written = _leaves({k: v for k, v in OmegaConf.to_container(text).items() if k not in ("defaults", "exp_name")})  # type: ignore[union-attr]
+    base = OmegaConf.to_container(OmegaConf.structured(PipelineCfg))  # the schema's defaults, unresolved
+    repeated = []
+    for path, value in written.items():
+        node: Any = base
+        for key in path.split("."):
+            node = node.get(key) if isinstance(node, dict) else None
+        if value == node or (hasattr(node, "value") and value == node.value):
+            repeated.append(path)
+    assert not repeated, f"{exp} repeats the schema's defaults at {repeated}"
+
+
 def test_every_exp_is_listed() -> None:
     """Each ``conf/exp`` file has its contact model written out in ``EXP_CONTACT_MODELS``."""
     assert sorted(EXP_CONTACT_MODELS) == group_options("exp")
