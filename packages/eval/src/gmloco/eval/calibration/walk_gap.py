@@ -18,6 +18,7 @@ from collections.abc import Iterable
 from pathlib import Path
 from typing import Any
 
+from gmloco.eval.calibration.predict import _speed_key
 from gmloco.eval.metrics.episodes import load_episodes
 
 __all__ = ["gate_walk", "mpm_walks"]
@@ -35,11 +36,6 @@ def _median(values: Iterable[float | None]) -> float | None:
 def _pct(count: int, total: int) -> float | None:
     """``count`` of ``total`` in percent; None for no episodes."""
     return 100.0 * count / total if total else None
-
-
-def _speed_key(v: float) -> str:
-    """Speed [m/s] as a JSON key, the gate's form: ``1``, ``1.5``."""
-    return f"{v:g}"
 
 
 def mpm_walks(dirs: list[str], scenario: str = "straight") -> dict[str, dict[str, dict[str, Any]]]:
