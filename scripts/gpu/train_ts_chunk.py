@@ -120,6 +120,13 @@ def _parse(argv: list[str] | None) -> argparse.Namespace:
         "task's, GM-Loco's 0.12); 0.30 puts the top levels below any foot, as the gate's and MPM's deep beds",
     )
     p.add_argument(
+        "--floor-levels",
+        type=int,
+        default=None,
+        help="number of levels of the floor-depth curriculum (SandFloorCfg.num_levels; default: the task's, 10); "
+        "a resumed chunk puts each env at the level nearest to the floor depth its checkpoint saved",
+    )
+    p.add_argument(
         "--allow-changed",
         action="append",
         default=[],
@@ -185,6 +192,8 @@ def _parse(argv: list[str] | None) -> argparse.Namespace:
     args = p.parse_args(argv)
     if args.floor_depth_max is not None and not 0.0 < args.floor_depth_max <= 1.0:
         p.error(f"--floor-depth-max {args.floor_depth_max}: give the deepest floor in (0, 1] m, e.g. 0.30")
+    if args.floor_levels is not None and not 2 <= args.floor_levels <= 100:
+        p.error(f"--floor-levels {args.floor_levels}: give 2 to 100 levels, e.g. 11 (2 cm steps over 0-20 cm)")
     if args.entropy_coef is not None and (args.stage != "teacher" or not args.entropy_coef >= 0):
         p.error(f"--entropy-coef {args.entropy_coef}: a number >= 0, for --stage teacher only, e.g. 0.001")
     if args.gpus:
@@ -296,6 +305,9 @@ def _task(args: argparse.Namespace) -> Any:
         task = replace(task, terrain=replace(task.terrain, floor=floor))
     if args.floor_depth_max is not None:
         floor = replace(task.terrain.floor, depth_range=(task.terrain.floor.depth_range[0], args.floor_depth_max))
+        task = replace(task, terrain=replace(task.terrain, floor=floor))
+    if args.floor_levels is not None:
+        floor = replace(task.terrain.floor, num_levels=args.floor_levels)
         task = replace(task, terrain=replace(task.terrain, floor=floor))
     weights = reward_weights(args.reward_weight)
     if weights:

@@ -99,6 +99,22 @@ def test_bad_floor_depth_max_exits_2(depth: str, capsys: pytest.CaptureFixture[s
     assert exc.value.code == 2 and "deepest floor in (0, 1] m" in capsys.readouterr().err
 
 
+def test_floor_levels_sets_the_level_count_only() -> None:
+    """--floor-levels sets the curriculum's level count; the depth range stays as given."""
+    chunk = _load()
+    base = ["--stage", "teacher", "--out", "unused", "--no-held-out", "--floor-depth-max", "0.2"]
+    floor = chunk._task(chunk._parse([*base, "--floor-levels", "11"])).terrain.floor
+    assert floor.num_levels == 11 and floor.depth_range == (0.0, 0.2)
+
+
+@pytest.mark.parametrize("levels", ["1", "0", "101"])
+def test_bad_floor_levels_exit_2(levels: str, capsys: pytest.CaptureFixture[str]) -> None:
+    """Fewer than 2 or more than 100 levels are refused with exit 2."""
+    with pytest.raises(SystemExit) as exc:
+        _load()._parse(["--stage", "teacher", "--out", "unused", "--floor-levels", levels])
+    assert exc.value.code == 2 and "give 2 to 100 levels" in capsys.readouterr().err
+
+
 def test_entropy_coef_reaches_the_teacher_algorithm_only() -> None:
     """--entropy-coef sets the teacher PPO's entropy coefficient in the rsl-rl entries; the default stays 0.005."""
     chunk = _load()

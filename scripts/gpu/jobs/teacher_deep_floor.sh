@@ -3,11 +3,14 @@
 # .devsrc/rft3d_calibrated.json = results/sand_calibration/rft3d_calibrated.json; start it with launch_job.sh SECONDS
 # and poll with jobs/poll_teacher.sh MAX_SECONDS gm_loco_teacher_calibrated.
 # The calibrated-sand teacher alone on the GPU, resumed with the survival rule of the floor-depth curriculum and
-# floors down to 30 cm: the top levels are the gate's and MPM's deep bed, where no foot meets the floor (over a 2.5 cm
+# floors down to 20 cm: the top levels are the gate's and MPM's deep bed, where no foot meets the floor (over a 2.5 cm
 # floor the teacher walks every gate cell on the calibrated sand; over the deep bed it tips over within 2 s).
 # The last ~3 minutes score the newest checkpoint on the gate's deep bed (success part, 20 episodes per cell, on the
 # GPU) into ~/chunks/gate/; GATE=0 in the environment of launch_job.sh gives them to training instead (the gate
 # then runs on a CPU afterwards).
+# The curriculum spans 0-20 cm in 11 levels (2 cm steps; poppy seed's deepest stance, 12 cm, is level 6): at 0-30 cm in
+# 10 levels the first step (3.3 cm) already sat past the teacher's frontier and the floors stayed at ~2 cm. Resumed,
+# each env starts at the level nearest to its saved floor depth.
 # The entropy coefficient drops from 0.005 to 0.001 (the student PPO's): at 0.005 the action std rose from 0.86 to
 # 1.22 over 2,048 iterations, the entropy bonus outweighing the little the GM-Loco rewards charge for noisy actions.
 set -uo pipefail
@@ -24,8 +27,9 @@ mins=$(python3 -c "import time; print(round(($end - time.time())/60 - (3.4 if $g
 echo "teacher chunk: max-minutes $mins" > ~/chunks/job.log
 python3 scripts/gpu/train_ts_chunk.py --stage teacher --run "$run" --contact-model rft3d_calibrated \
   --foot-clearance sinkage --foot-faces box --curriculum-scale 0.1 --reward-weight foot_clearance_l2=-50 \
-  --floor-promotion survival --floor-depth-max 0.30 --entropy-coef 0.001 \
+  --floor-promotion survival --floor-depth-max 0.20 --floor-levels 11 --entropy-coef 0.001 \
   --allow-changed task.terrain.floor.promotion --allow-changed task.terrain.floor.depth_range \
+  --allow-changed task.terrain.floor.num_levels \
   --allow-changed rsl_rl_overrides.algorithm.entropy_coef \
   --max-iterations 6000 --max-minutes "$mins" --post-minutes 1.0 --full-checkpoint --out ~/chunks/teacher \
   >> ~/chunks/job.log 2>&1

@@ -19,7 +19,7 @@ import mujoco
 import torch
 
 from gmloco.deploy.g1 import G1_FOOT_BODIES, G1_FOOT_SITES
-from gmloco.train.config import GranularTaskCfg, SandTerrainCfg, contact_force_threshold
+from gmloco.train.config import GranularTaskCfg, SandFloorCfg, SandTerrainCfg, contact_force_threshold
 from gmloco.train.foot_contact import FootContactTracker, SurfaceHeightFn
 
 if TYPE_CHECKING:
@@ -36,6 +36,7 @@ __all__ = [
     "SAND_FLOOR_BODY",
     "SandContact",
     "add_sand_floor",
+    "floor_levels_for_depths",
     "get_sand",
     "make_surface_height",
 ]
@@ -48,6 +49,19 @@ FOOT_SITES = G1_FOOT_SITES
 """Sole sites of the G1 (3.7 cm below the ankle-roll origin)."""
 FEET_FLOOR_SENSOR = "feet_floor_contact"
 """mjlab contact sensor between the foot bodies and the hard floor."""
+
+
+def floor_levels_for_depths(depths: torch.Tensor, floor: SandFloorCfg) -> torch.Tensor:
+    """The curriculum level of ``floor`` nearest to each floor depth [m] (clamped to the levels it has).
+
+    A checkpoint keeps each env's floor depth beside its level, so a run resumed with another depth range or level
+    count puts every env back at (nearly) the depth it had reached.
+    """
+    lo, hi = floor.depth_range
+    top = max(floor.num_levels - 1, 0)
+    if hi <= lo or top == 0:
+        return torch.zeros_like(depths, dtype=torch.long)
+    return torch.round((depths - lo) / (hi - lo) * top).long().clamp(0, top)
 
 
 def add_sand_floor(spec: mujoco.MjSpec, feet_collide: bool) -> None:
@@ -135,12 +149,17 @@ class SandContact:
     # Checkpoint state.
 
     def state_dict(self) -> dict[str, torch.Tensor]:
-        """What a checkpoint keeps of the sand: each env's floor-depth curriculum level."""
-        return {"floor_level": self.floor_level.cpu()}
+        """What a checkpoint keeps of the sand: each env's floor-depth curriculum level and floor depth [m]."""
+        return {"floor_level": self.floor_level.cpu(), "floor_depth": self.floor_depth.cpu()}
 
     def load_state_dict(self, state: dict[str, torch.Tensor]) -> None:
-        """Restore :meth:`state_dict`'s levels; a checkpoint of another env count leaves the drawn levels."""
-        levels = state["floor_level"]
+        """Restore :meth:`state_dict`'s floors; a checkpoint of another env count leaves the drawn levels.
+
+        With the depths saved, each env gets the level of its own floor range nearest to the saved depth (the range
+        or level count may have changed between chunks); an older checkpoint's bare levels are taken as they are.
+        """
+        depths = state.get("floor_depth")
+        levels = state["floor_level"] if depths is None else floor_levels_for_depths(depths, self.task.terrain.floor)
         if levels.shape[0] == self.num_envs:
             self.floor_level.copy_(levels.to(self.device))
 
