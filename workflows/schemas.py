@@ -240,8 +240,8 @@ class TrainTeacherCfg(TeacherCfg, PolicyTrainingCfg):
     history_length: int = ranged(50, ge=1)
     """N, frames of the ``history`` group the teacher encoder reads (the student reads the same N)."""
     jump: JumpSectionCfg | None = None
-    """Train the jump imitation task (``+exp=jump_rft3d|jump_rigid``, needs ``algorithm: ppo``) instead of the
-    velocity task; ``terrain`` and ``foot_clearance`` are then unused. null: the velocity task."""
+    """Train the jump imitation task (``task=jump``, as ``+exp=jump_rft3d|jump_rigid`` pick it; needs ``algorithm:
+    ppo``) instead of the velocity task; ``terrain`` and ``foot_clearance`` are then unused. null: the velocity task."""
     material: MaterialRangeCfg = field(default_factory=MaterialRangeCfg)
     """Per-env granular material of the velocity task (``gmloco.train.MaterialRangeCfg``): the ranges of mu_int,
     packing, bulk_density, ... drawn on every reset, or one ``preset`` (``train_teacher.material.mu_int=[0.3,0.6]``,
