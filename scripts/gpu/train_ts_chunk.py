@@ -49,9 +49,10 @@ CURVE_TAGS = {
     "Metrics/twist/error_heading": "heading_error",
     "Episode_Reward/track_yaw_target_exp": "reward_track_yaw_target",
     "Episode_Reward/track_ang_vel_z_exp": "reward_track_ang_vel_z",
+    "Curriculum/sand_floor_levels/depth_mean": "floor_depth_m",
 }
 """TensorBoard scalars of the curve besides the ``Loss/*`` terms (which are all taken); the yaw-tracking ones feed
-the yaw panel of ``gmloco.train.learning_curves``."""
+the yaw panel of ``gmloco.train.learning_curves``, the floor depth its floor panel."""
 
 
 def _parse(argv: list[str] | None) -> argparse.Namespace:

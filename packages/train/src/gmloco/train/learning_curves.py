@@ -34,6 +34,7 @@ PANELS: tuple[tuple[str, tuple[str, ...], bool], ...] = (
     ("action std [-]", ("action_std",), False),
     ("eta R^2 (batch)", ("loss_eta_r2",), False),
     ("yaw tracking", ("yaw_rate_error", "heading_error", "reward_track_yaw_target", "reward_track_ang_vel_z"), False),
+    ("hard floor depth, mean [m]", ("floor_depth_m",), False),
 )
 """(y label, curve columns, log scale) per panel; a panel is drawn when one of its columns has a finite value."""
 
