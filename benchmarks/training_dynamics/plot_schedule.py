@@ -6,7 +6,7 @@
         --summary teacher_from_scratch=artifacts/gm_loco_teacher_yaw/summary.json --iterations 150 \
         --out results/training_dynamics/action_scale_ab/schedule.png
 
-``--bench`` reads a ``scripts/gpu/bench_tasks.py`` JSON (its one task's ``curve``); ``--summary`` reads a
+``--bench`` reads a ``benchmarks/gpu/bench_tasks.py`` JSON (its one task's ``curve``); ``--summary`` reads a
 ``train_ts_chunk.py`` summary (``curve`` with ``loss_learning_rate``, ``action_std``, ``mean_reward``). Each
 run is drawn over its first ``--iterations`` iterations. Exit 2 on a missing file or key.
 """

@@ -8,6 +8,6 @@ set -euo pipefail
 cd "$(git rev-parse --show-toplevel)"
 mkdir -p .devsrc
 grep -qx ".devsrc/" .git/info/exclude 2>/dev/null || echo ".devsrc/" >> .git/info/exclude
-git archive --format=tar HEAD packages scripts workflows conf pyproject.toml > .devsrc/src.tar
+git archive --format=tar HEAD packages scripts benchmarks/gpu workflows conf pyproject.toml > .devsrc/src.tar
 git rev-parse --short HEAD > .devsrc/COMMIT
 echo "$(du -h .devsrc/src.tar | cut -f1) snapshot of $(cat .devsrc/COMMIT) in .devsrc/src.tar"

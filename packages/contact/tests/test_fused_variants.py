@@ -1,7 +1,7 @@
 # SPDX-License-Identifier: Apache-2.0
 """Fused 3D-RFT kernel variants (register caps, without per-point outputs): same results bit for bit.
 
-The variants exist for benchmarks (scripts/gpu/bench_contact.py ``--variants``). Each must give what the default
+The variants exist for benchmarks (benchmarks/gpu/bench_contact.py ``--variants``). Each must give what the default
 kernels give: wrench, per-point outputs and state compared with ``assert_array_equal`` over a substep sequence with
 pressing, unloading (elastic branch), sliding, lift-off and a non-finite foot. On the CPU the register caps are
 no-ops (the CPU build ignores them), so there the check covers the variant plumbing; the GPU benchmark records each variant's difference to the default (``max_rel_diff_vs_default``).

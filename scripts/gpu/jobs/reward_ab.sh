@@ -13,7 +13,7 @@ nvidia-smi --query-gpu=name,memory.total --format=csv > ~/chunks/gpu.txt 2>&1
 iters=${REWARD_AB_ITERATIONS:-80}
 run() {  # NAME, then bench_tasks.py arguments
   local name=$1; shift
-  ( WARP_CACHE_PATH=$HOME/.wc_ab_$name timeout "$(( end - $(date +%s) - 20 ))" python3 scripts/gpu/bench_tasks.py \
+  ( WARP_CACHE_PATH=$HOME/.wc_ab_$name timeout "$(( end - $(date +%s) - 20 ))" python3 benchmarks/gpu/bench_tasks.py \
       --tasks Gmloco-Velocity-Rigid-Flat-G1 --import gmloco.train.tasks.registry --num-envs 4096 \
       --iterations "$iters" --sim-steps 50 "$@" --out ~/chunks/reward_ab/$name.json > ~/chunks/reward_ab/$name.log 2>&1
     echo "rc $?" >> ~/chunks/reward_ab/$name.log ) &

@@ -18,7 +18,7 @@ cp .devsrc/rft3d_calibrated.json results/sand_calibration/rft3d_calibrated.json
 nvidia-smi --query-gpu=name,memory.total --format=csv > ~/chunks/gpu.txt 2>&1
 for variant in stock uniform; do
   extra=(); [ "$variant" = uniform ] && extra=(--uniform-action-scale 0.25)
-  ( WARP_CACHE_PATH=$HOME/.wc_ab_$variant timeout "$(( end - $(date +%s) - 60 ))" python3 scripts/gpu/bench_tasks.py \
+  ( WARP_CACHE_PATH=$HOME/.wc_ab_$variant timeout "$(( end - $(date +%s) - 60 ))" python3 benchmarks/gpu/bench_tasks.py \
       --tasks Mjlab-Velocity-Flat-Unitree-G1 --num-envs 4096 --iterations 150 --sim-steps 50 "${extra[@]}" \
       --out ~/chunks/lr_ab/$variant.json > ~/chunks/lr_ab/$variant.log 2>&1; echo "rc $?" >> ~/chunks/lr_ab/$variant.log ) &
 done

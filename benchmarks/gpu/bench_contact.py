@@ -1,6 +1,6 @@
 """Contact-kernel cost per launch and its share of one G1 MuJoCo Warp physics step, measured in one run.
 
-    source scripts/gpu/env.sh && python3 scripts/gpu/bench_contact.py --num-worlds 4096 --out runs/bench_contact
+    source scripts/gpu/env.sh && python3 benchmarks/gpu/bench_contact.py --num-worlds 4096 --out runs/bench_contact
 
 For every contact model and collider size (sole 5x5 = 25 points, six-face 5x5 = 150 points per foot) it times
 ``model.compute`` (the stateless part that runs inside the passive callback) and, for stateful models,
@@ -32,7 +32,7 @@ after compute() and then compute_and_update_state() from the benchmark state (0 
 the default ones (both capped at 96): a repeat measurement in the same run. A variant comparison on the GPU, e.g.
 (about 3 min, mostly NVRTC compiles)::
 
-    python3 scripts/gpu/bench_contact.py --models rft3d --paths fused --variants all --skip-sim \
+    python3 benchmarks/gpu/bench_contact.py --models rft3d --paths fused --variants all --skip-sim \
         --reps 1000 --repeat 5 --warm-s 0.5 --out $OUT/variants
 
 Timing: ``--repeat`` timed graph launches per call, the median recorded as ``<call>_s`` (all of them as

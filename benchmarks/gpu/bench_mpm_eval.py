@@ -9,7 +9,7 @@ accepted setting (3 cm, 500 iterations, 5 ms frames) is measured with ``g1_eval_
 (``results/mpm_eval/convergence/accepted_setting/sweep.jsonl``). Kept for its naive / window / multi comparison (``BENCHMARKS.md``).
 
     source scripts/gpu/env.sh
-    python scripts/gpu/bench_mpm_eval.py --out $OUT/bench --max-minutes 8.5
+    python benchmarks/gpu/bench_mpm_eval.py --out $OUT/bench --max-minutes 8.5
 
 Every case builds a ``G1MpmScene`` (dry sand, the policy walking at 1.0 / 1.5 / 2.0 / 2.5 m/s cycled over robots),
 captures a frame graph when it can, steps ``--frames`` frames and records frames/s. A 10 s episode is 1000 frames,

@@ -1,5 +1,5 @@
 # SPDX-License-Identifier: Apache-2.0
-"""scripts/gpu/bench_mpm_eval.py: case order, the convergence verdicts on hand-made results, a tiny CPU run."""
+"""benchmarks/gpu/bench_mpm_eval.py: case order, the convergence verdicts on hand-made results, a tiny CPU run."""
 
 from __future__ import annotations
 
@@ -12,7 +12,7 @@ from typing import Any
 
 import pytest
 
-SCRIPTS = Path(__file__).resolve().parents[2] / "scripts" / "gpu"
+SCRIPTS = Path(__file__).resolve().parents[2] / "benchmarks" / "gpu"
 POLICY = Path(__file__).resolve().parents[2] / "artifacts" / "ppo_rft3d" / "policy.onnx"
 
 

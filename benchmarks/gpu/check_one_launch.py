@@ -1,6 +1,6 @@
 """GPU check of the one-launch contact coupling: same rollout as the two-launch path, under CUDA graphs.
 
-    python3 scripts/gpu/check_one_launch.py --num-envs 256 --steps 100 --out check.json
+    python3 benchmarks/gpu/check_one_launch.py --num-envs 256 --steps 100 --out check.json
 
 Builds the 3D-RFT G1 task twice (``ContactCoupling.one_launch`` True / False; the coupling is rebuilt before the
 env's first step), steps both with the same fixed random actions and compares base positions, joint positions

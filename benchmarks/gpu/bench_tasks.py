@@ -2,7 +2,7 @@
 
 Runs every task in one process so the numbers compare (same device, same driver, same warm-up):
 
-    python scripts/gpu/bench_tasks.py --tasks Mjlab-Velocity-Flat-Unitree-G1 Gmloco-Velocity-Granular-G1 \
+    python benchmarks/gpu/bench_tasks.py --tasks Mjlab-Velocity-Flat-Unitree-G1 Gmloco-Velocity-Granular-G1 \
         --import gmloco.train.tasks.registry --num-envs 4096 --iterations 40 --out $OUT/bench.json
 
 For each task it reports

@@ -1,5 +1,5 @@
 # SPDX-License-Identifier: Apache-2.0
-"""scripts/gpu/bench_contact.py on the CPU with tiny worlds: every record, one JSON, time box and resume."""
+"""benchmarks/gpu/bench_contact.py on the CPU with tiny worlds: every record, one JSON, time box and resume."""
 
 from __future__ import annotations
 
@@ -11,8 +11,8 @@ from tests.contact.by_path import load_module
 
 
 def bench_module() -> ModuleType:
-    """Import scripts/gpu/bench_contact.py by path."""
-    return load_module("bench_contact_script", "scripts/gpu/bench_contact.py")
+    """Import benchmarks/gpu/bench_contact.py by path."""
+    return load_module("bench_contact_script", "benchmarks/gpu/bench_contact.py")
 
 
 def test_bench_writes_every_record_and_resumes(tmp_path: Path) -> None:
