@@ -3,6 +3,9 @@
 
 python -m gmloco.eval.calibration --material dry_sand --out results/sand_calibration/dataset/
 python -m gmloco.eval.calibration --material dry_sand --out /tmp/calib --smoke --device cpu
+python -m gmloco.eval.calibration --material basalt --experiments twist --device cuda:0 --out /tmp/twist
+
+The last records only the yaw-torque probe (``twist``: a loaded sole turned about the vertical) on MPM sand.
 """
 
 from __future__ import annotations

@@ -3,6 +3,9 @@
 
 One ``.npz`` per material: every experiment's arrays as ``<experiment>/<field>`` and a JSON header ``meta``. The split
 is drawn from ``split_seed`` when the dataset is built, before any fitting, and stored in the header.
+
+The torque about the sole centre (``<experiment>/torque`` [N m], [T, 3]) is optional: a file without it reads as
+records with an empty torque (forces only), and the fit then has no torque residual for them.
 """
 
 from __future__ import annotations
@@ -34,6 +37,8 @@ SCHEMA_VERSION = 1
 UNITS: dict[str, str] = {"length": "m", "time": "s", "force": "N", "angle": "rad", "mass": "kg"}
 """Units every dataset is written in."""
 RECORD_FIELDS = tuple(f.name for f in fields(SoleRecord))
+OPTIONAL_FIELDS = ("torque",)
+"""Record fields a dataset file may lack (the record keeps its default)."""
 
 
 class ContractError(ValueError):
@@ -118,7 +123,8 @@ def load_dataset(path: str | Path) -> CalibrationDataset:
         if meta.get("schema_version") != SCHEMA_VERSION:
             raise ContractError("version", f"{path} has schema {meta.get('schema_version')}, reader {SCHEMA_VERSION}")
         names = sorted({k.split("/")[0] for k in z.files if "/" in k})
-        records = {n: SoleRecord(**{f: z[f"{n}/{f}"] for f in RECORD_FIELDS}) for n in names}
+        records = {n: SoleRecord(**{f: z[f"{n}/{f}"] for f in RECORD_FIELDS
+                                    if f not in OPTIONAL_FIELDS or f"{n}/{f}" in z.files}) for n in names}  # fmt: skip
     known = {f.name for f in fields(SoleProtocolCfg)}
     params: dict[str, Any] = {k: tuple(v) if isinstance(v, list) else v for k, v in meta["protocol"].items()}
     protocol = SoleProtocolCfg(**{k: v for k, v in params.items() if k in known})
@@ -148,6 +154,8 @@ def check_contract(ds: CalibrationDataset, robot: str, rate_hz: float | None) ->
             raise ContractError("rate", f"record {name!r} is not sampled every frame_dt = {dt} s")
         if np.abs(rec.force).max(initial=0.0) > 1e5:
             raise ContractError("units", f"record {name!r} has forces above 1e5 N: not newtons?")
+        if len(rec.torque) and not rec.has_torque:
+            raise ContractError("torque", f"record {name!r} has a torque of shape {rec.torque.shape}, not [T, 3]")
     missing = set(ds.records) ^ set(ds.split)
     if missing:
         raise ContractError("split", f"records and split disagree on {sorted(missing)}")

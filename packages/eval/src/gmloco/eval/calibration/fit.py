@@ -6,6 +6,13 @@ kinematics; ``scipy.optimize.least_squares`` minimizes the force residual over t
 single-stance weight. The fit is accepted only if the held-out RMS force error falls below that of the published
 3D-RFT by ``min_improvement``; only then is a new default written.
 
+Yaw torque: records that carry the torque about the sole centre (the ``twist`` experiment turns a loaded sole about
+the vertical) add a torque-about-z residual, ``torque_weight`` (tau_z,model - tau_z,data) / (W l), W the single-stance
+weight [N] and l the sole's half-length [m]: a torque error reads as the lateral force error at the sole's toe in
+units of the weight, the same scale as the force residual. tau_z comes only from horizontal element forces, so it
+informs ``lateral_scale`` where the presses cannot. Torque errors are reported per split; acceptance stays on the
+held-out force error. Records without a torque (datasets recorded with forces only) add no torque residual.
+
 The datum: an MPM grid lets a sole feel the sand before it reaches the nominal bed top (the top particles' mass
 reaches grid nodes up to about a voxel above it), so at sole scale MPM carries load at negative nominal depth. The
 fit therefore also fits the height of the surface the sole feels, ``datum`` [m] above the nominal top, in every
@@ -26,7 +33,7 @@ from gmloco.contact import MATERIAL_PRESETS, ContactRFT3DCfg, RftExtensionsCfg
 from gmloco.contact.extensions_io import save_rft_extensions
 from gmloco.deploy.atomic_io import atomic_write_json
 from gmloco.eval.calibration.dataset import CalibrationDataset, ContractError, check_contract, file_sha256
-from gmloco.eval.calibration.rft_sand import centred_sole_collider, replay_record
+from gmloco.eval.calibration.rft_sand import centred_sole_collider, replay_wrench
 
 __all__ = [
     "DATUM_BOUNDS",
@@ -36,7 +43,9 @@ __all__ = [
     "dataset_material",
     "fit_extensions",
     "replay_forces",
+    "replay_wrenches",
     "split_error",
+    "torque_scale",
 ]
 
 FIT_BOUNDS: dict[str, tuple[float, float, float]] = {
@@ -85,6 +94,13 @@ class SandFitCfg:
     """Relative held-out error reduction required to accept the fit [-] (0: any reduction)."""
     fit_datum: bool = True
     """Fit the felt surface's height above the nominal bed top in every variant (False: datum 0)."""
+    torque_weight: float = 1.0
+    """Weight of the yaw-torque residual against the force residual [-] (0: forces only); see :func:`torque_scale`."""
+
+    def __post_init__(self) -> None:
+        """Raise ValueError on a negative torque weight."""
+        if not self.torque_weight >= 0.0:
+            raise ValueError(f"torque_weight must be >= 0, got {self.torque_weight}")
 
 
 @dataclass
@@ -98,7 +114,8 @@ class SandFitResult:
     error_after: dict[str, float]
     """RMS force error [N] of the fitted model per split."""
     per_record: dict[str, dict[str, float]]
-    """Before / after RMS force error [N] per record, with its split."""
+    """Before / after RMS force error [N] per record, with its split; records with a torque add ``torque_before`` /
+    ``torque_after``, their RMS yaw-torque error [N m]."""
     accepted: bool
     """Held-out error improved by at least ``min_improvement`` on the published model (at its own datum when fitted)."""
     cost: float
@@ -109,6 +126,11 @@ class SandFitResult:
     """RMS force error [N] of the published 3D-RFT per split at its own fitted datum (None: datum not fitted)."""
     datum_before: float = 0.0
     """The published model's own fitted datum [m]."""
+    torque_error_before: dict[str, float] | None = None
+    """RMS yaw-torque error [N m] of the published 3D-RFT per split over records with a torque (NaN: none in a
+    split); None when no record has a torque."""
+    torque_error_after: dict[str, float] | None = None
+    """RMS yaw-torque error [N m] of the fitted model per split (as ``torque_error_before``)."""
 
 
 def dataset_material(ds: CalibrationDataset) -> Any:
@@ -133,31 +155,64 @@ def _extensions(x: np.ndarray, cfg: SandFitCfg, plastic: bool) -> RftExtensionsC
     return RftExtensionsCfg(**values)
 
 
-def replay_forces(
+def replay_wrenches(
     ds: CalibrationDataset, ext: RftExtensionsCfg, cfg: SandFitCfg, names: list[str], datum: float = 0.0
 ) -> dict[str, np.ndarray]:
-    """Return the model force [N] [T, 3] of each named record (its recorded kinematics, fresh memory).
+    """Return the model wrench [T, 6] of each named record: force [N], torque about the sole centre [N m].
 
-    ``datum`` [m]: the felt surface's height above the nominal bed top; the sole is replayed that much deeper.
+    The recorded kinematics drive a fresh memory. ``datum`` [m]: the felt surface's height above the nominal bed
+    top; the sole is replayed that much deeper (the lever arms about its centre do not change).
     """
     model = ContactRFT3DCfg(at_rest=cfg.at_rest, extensions=ext)
     col = centred_sole_collider(ds.protocol, "box", cfg.resolution)
     mat = dataset_material(ds)
     shift = np.array([0.0, 0.0, datum])
     records = {n: replace(ds.records[n], pos=ds.records[n].pos - shift) if datum else ds.records[n] for n in names}
-    return {n: replay_record(records[n], col, model, mat, ds.protocol.frame_dt) for n in names}
+    return {n: replay_wrench(records[n], col, model, mat, ds.protocol.frame_dt) for n in names}
+
+
+def replay_forces(
+    ds: CalibrationDataset, ext: RftExtensionsCfg, cfg: SandFitCfg, names: list[str], datum: float = 0.0
+) -> dict[str, np.ndarray]:
+    """Return the model force [N] [T, 3] of each named record (:func:`replay_wrenches`' force)."""
+    return {n: w[:, :3] for n, w in replay_wrenches(ds, ext, cfg, names, datum).items()}
+
+
+def torque_scale(ds: CalibrationDataset) -> float:
+    """Return the yaw-torque residual's unit W l [N m]: single-stance weight times the sole's half-length."""
+    return ds.protocol.weight * 0.5 * ds.protocol.sole_size[0]
+
+
+def _rms_by_split(ds: CalibrationDataset, sq: dict[str, np.ndarray]) -> dict[str, float]:
+    """Return the RMS over each split's frames of per-frame squared errors ``sq`` (NaN for a split without any)."""
+    out = {}
+    for split in ("fit", "heldout"):
+        err = [sq[n] for n in sq if ds.split[n] == split]
+        out[split] = float(np.sqrt(np.mean(np.concatenate(err)))) if err else float("nan")
+    return out
+
+
+def _split_errors(
+    ds: CalibrationDataset, ext: RftExtensionsCfg, cfg: SandFitCfg, datum: float = 0.0
+) -> tuple[dict[str, float], dict[str, float], dict[str, float] | None, dict[str, float]]:
+    """Return RMS errors of a model on the dataset at ``datum`` [m].
+
+    Returns (force [N] per split, force per record, yaw torque [N m] per split or None when no record has a torque,
+    yaw torque per record with a torque).
+    """
+    wrenches = replay_wrenches(ds, ext, cfg, list(ds.records), datum)
+    sq_f = {n: np.sum((w[:, :3] - ds.records[n].force) ** 2, -1) for n, w in wrenches.items()}
+    sq_t = {n: (w[:, 5] - ds.records[n].torque[:, 2]) ** 2 for n, w in wrenches.items() if ds.records[n].has_torque}
+    per_f = {n: float(np.sqrt(np.mean(e))) for n, e in sq_f.items()}
+    per_t = {n: float(np.sqrt(np.mean(e))) for n, e in sq_t.items()}
+    return _rms_by_split(ds, sq_f), per_f, _rms_by_split(ds, sq_t) if sq_t else None, per_t
 
 
 def split_error(
     ds: CalibrationDataset, ext: RftExtensionsCfg, cfg: SandFitCfg, datum: float = 0.0
 ) -> tuple[dict, dict]:
     """Return (RMS force error [N] per split, per record) of a model on the dataset at ``datum`` [m]."""
-    forces = replay_forces(ds, ext, cfg, list(ds.records), datum)
-    per = {n: float(np.sqrt(np.mean(np.sum((forces[n] - ds.records[n].force) ** 2, -1)))) for n in forces}
-    out = {}
-    for split in ("fit", "heldout"):
-        err = [np.sum((forces[n] - ds.records[n].force) ** 2, -1) for n in forces if ds.split[n] == split]
-        out[split] = float(np.sqrt(np.mean(np.concatenate(err)))) if err else float("nan")
+    out, per, _, _ = _split_errors(ds, ext, cfg, datum)
     return out, per
 
 
@@ -170,14 +225,20 @@ def _fit_one(ds: CalibrationDataset, cfg: SandFitCfg, plastic: bool) -> tuple[Rf
 
     names = [n for n in ds.records if ds.split[n] == "fit"]
     data = np.concatenate([ds.records[n].force for n in names])
-    scale = ds.protocol.weight
+    twisted = [n for n in names if ds.records[n].has_torque] if cfg.torque_weight > 0.0 else []
+    data_tz = np.concatenate([ds.records[n].torque[:, 2] for n in twisted]) if twisted else np.zeros(0)
+    scale, scale_tz = ds.protocol.weight, torque_scale(ds) / cfg.torque_weight if twisted else 1.0
     n_terms = len(cfg.params)
 
     def residual(x: np.ndarray) -> np.ndarray:
-        """Force residual of the fit records over the single-stance weight [-]."""
+        """Force residual of the fit records over W, then the weighted yaw-torque residual over W l [-]."""
         datum = float(x[n_terms]) if cfg.fit_datum else 0.0
-        forces = replay_forces(ds, _extensions(x[:n_terms], cfg, plastic), cfg, names, datum)
-        return ((np.concatenate([forces[n] for n in names]) - data) / scale).ravel()
+        wrenches = replay_wrenches(ds, _extensions(x[:n_terms], cfg, plastic), cfg, names, datum)
+        force = ((np.concatenate([wrenches[n][:, :3] for n in names]) - data) / scale).ravel()
+        if not twisted:
+            return force
+        torque = (np.concatenate([wrenches[n][:, 5] for n in twisted]) - data_tz) / scale_tz
+        return np.concatenate([force, torque])
 
     bounds = [FIT_BOUNDS[p] for p in cfg.params] + ([DATUM_BOUNDS] if cfg.fit_datum else [])
     lo, hi, x0 = (np.array([b[i] for b in bounds], dtype=float) for i in range(3))
@@ -198,16 +259,20 @@ def fit_extensions(ds: CalibrationDataset, cfg: SandFitCfg) -> SandFitResult:
     choices = {"off": [False], "on": [True], "both": [False, True]}[cfg.plastic_unloading]
     fits = [_fit_one(ds, cfg, plastic) for plastic in choices]
     ext, cost, datum = min(fits, key=lambda f: f[1])
-    before, per_before = split_error(ds, RftExtensionsCfg(), cfg)
+    before, per_before, torque_before, per_torque_before = _split_errors(ds, RftExtensionsCfg(), cfg)
     aligned, datum_before = None, 0.0
     if cfg.fit_datum:
         _, _, datum_before = _fit_one(ds, replace(cfg, params=()), plastic=False)
         aligned, _ = split_error(ds, RftExtensionsCfg(), cfg, datum_before)
-    after, per_after = split_error(ds, ext, cfg, datum)
-    per = {n: {"split": ds.split[n], "before": per_before[n], "after": per_after[n]} for n in ds.records}
+    after, per_after, torque_after, per_torque_after = _split_errors(ds, ext, cfg, datum)
+    per: dict[str, dict[str, Any]] = {n: {"split": ds.split[n], "before": per_before[n], "after": per_after[n]}
+                                      for n in ds.records}  # fmt: skip
+    for n in per_torque_before:
+        per[n].update(torque_before=per_torque_before[n], torque_after=per_torque_after[n])
     baseline = aligned if aligned is not None else before  # the terms must beat the published model at its datum
     accepted = bool(after["heldout"] < (1.0 - cfg.min_improvement) * baseline["heldout"])
-    return SandFitResult(ext, before, after, per, accepted, cost, datum, aligned, datum_before)
+    return SandFitResult(ext, before, after, per, accepted, cost, datum, aligned, datum_before, torque_before,
+                         torque_after)  # fmt: skip
 
 
 def write_report(result: SandFitResult, path: str | Path, provenance: dict[str, Any]) -> Path:
@@ -218,6 +283,7 @@ def write_report(result: SandFitResult, path: str | Path, provenance: dict[str, 
             "force_error_after": result.error_after, "per_record": result.per_record,
             "extensions": asdict(result.extensions), "cost": result.cost, "datum_m": result.datum,
             "force_error_before_aligned": result.error_before_aligned, "datum_before_m": result.datum_before,
+            "torque_z_error_before": result.torque_error_before, "torque_z_error_after": result.torque_error_after,
             **provenance}  # fmt: skip
     return atomic_write_json(path, body)
 

@@ -28,6 +28,12 @@ def parse_args(argv: list[str] | None) -> argparse.Namespace:
     p.add_argument("--params", nargs="+", default=list(SandFitCfg().params), choices=list(FIT_BOUNDS))
     p.add_argument("--plastic-unloading", choices=["off", "on", "both"], default="both")
     p.add_argument("--at-rest", choices=["none", "unloading"], default="unloading")
+    p.add_argument(
+        "--torque-weight",
+        type=float,
+        default=SandFitCfg().torque_weight,
+        help="weight of the yaw-torque residual against the force residual (0: forces only)",
+    )
     p.add_argument("--min-improvement", type=float, default=0.0, help="relative held-out error reduction required")
     p.add_argument("--out", required=True, help="fit report JSON")
     p.add_argument("--write-default", default=None, help="write the fitted terms here if the fit is accepted")
@@ -37,9 +43,10 @@ def parse_args(argv: list[str] | None) -> argparse.Namespace:
 def main(argv: list[str] | None = None) -> int:
     """Fit, report, and write the default only for an accepted fit; return the exit code."""
     a = parse_args(argv)
-    cfg = SandFitCfg(params=tuple(a.params), plastic_unloading=a.plastic_unloading, at_rest=a.at_rest,
-                     robot=a.robot, rate_hz=a.rate_hz, min_improvement=a.min_improvement)  # fmt: skip
     try:
+        cfg = SandFitCfg(params=tuple(a.params), plastic_unloading=a.plastic_unloading, at_rest=a.at_rest,
+                         robot=a.robot, rate_hz=a.rate_hz, min_improvement=a.min_improvement,
+                         torque_weight=a.torque_weight)  # fmt: skip
         ds = load_dataset(a.dataset)
         result = fit_extensions(ds, cfg)
     except (ContractError, FileNotFoundError, ValueError) as e:
@@ -50,7 +57,8 @@ def main(argv: list[str] | None = None) -> int:
     write_report(result, a.out, provenance)
     written = write_default(result, a.write_default, a.dataset, cfg) if a.write_default else None
     summary = {"accepted": result.accepted, "heldout_before_N": result.error_before["heldout"],
-               "heldout_after_N": result.error_after["heldout"], "default_written": str(written) if written else None}  # fmt: skip
+               "heldout_after_N": result.error_after["heldout"], "default_written": str(written) if written else None,
+               "torque_z_error_after_Nm": result.torque_error_after}  # fmt: skip
     print(json.dumps(summary, indent=1))
     if not result.accepted:
         print("held-out force error did not improve: the fitted terms were NOT written as a default", file=sys.stderr)

@@ -5,6 +5,14 @@ The sole is a *kinematic* collider body (zero effective mass: its motion is pres
 :mod:`gmloco.eval.rft_fit.plate`; the force of the sand on it is the sum of its collider-node impulses divided by the
 frame time (``kernels_coupling.eval_body_sand_wrench``). The bed, material mapping and solver are the evaluation's
 (:mod:`gmloco.eval.mpm`), so the calibration measures the same sand the policies are judged on.
+
+Torque: the MPM coupling exposes per-node impulses and their grid-node positions, and ``eval_body_sand_wrench`` sums
+them into the body wrench (force, torque about the body's CoM, world axes). The sand reports that torque moved to the
+sole-box centre, tau_c = tau_com + (x_com - x_c) x F; the sole's CoM is its body origin (the box centre), so the
+shift is zero in practice. The lever arms are those of the collider's grid nodes, so the torque carries the grid's
+resolution (one voxel) in its arm. The twist experiment's yaw torque on MPM sand is a GPU run::
+
+    python -m gmloco.eval.calibration --material basalt --experiments twist --device cuda:0 --out <folder>
 """
 
 from __future__ import annotations
@@ -86,11 +94,16 @@ class MpmSoleSand:
             """Collider velocities (linear, angular), the MPM state's ``body_qd``."""
             self.state.body_q, self.state.body_qd = self.body_q, self.body_qd
             self.wrench = wp.zeros(self.colliders.body_count, dtype=wp.spatial_vectorf)
+            self.body_com = np.asarray(self.colliders.body_com.numpy()[self.body], dtype=np.float64)  # pyright: ignore[reportOptionalMemberAccess]
+            """The sole's CoM in its body frame [m], [3] (the wrench's torque is about it)."""
         self.build_s = time.perf_counter() - t0
         self.step_s = 0.0
 
     def __call__(self, pos: np.ndarray, rot: np.ndarray, lin_vel: np.ndarray, ang_vel: np.ndarray) -> np.ndarray:
-        """Step one frame with the sole at (pos, rot) moving at (lin_vel, ang_vel); return the sand force [N] [3]."""
+        """Step one frame with the sole at (pos, rot) moving at (lin_vel, ang_vel); return the sand wrench [6].
+
+        The wrench is the force [N] and the torque about the sole-box centre ``pos`` [N m], world axes.
+        """
         from gmloco.eval.mpm.kernels_coupling import eval_body_sand_wrench
         from gmloco.eval.rft_fit.plate import _quat_xyzw
 
@@ -108,9 +121,11 @@ class MpmSoleSand:
             eval_body_sand_wrench(self.mpm.collider_body_index, self.colliders.body_com, self.dt,  # pyright: ignore[reportArgumentType]
                                   self.mpm.collect_collider_impulses(self.state), self.body_q,
                                   self.wrench)  # fmt: skip
-        force = np.asarray(self.wrench.numpy()[self.body, :3], dtype=np.float64)
+        wrench = np.asarray(self.wrench.numpy()[self.body], dtype=np.float64)
+        force = wrench[:3]
+        torque = wrench[3:] + np.cross(np.asarray(rot) @ self.body_com, force)  # about the CoM -> about the centre
         self.step_s += time.perf_counter() - t0
-        return force
+        return np.concatenate([force, torque])
 
     def check(self) -> None:
         """Raise if Newton's sparse grid ran out of capacity during the run."""
