@@ -133,27 +133,24 @@ def experiment_phases(name: str, cfg: SoleProtocolCfg) -> list[PhaseCfg]:
     yaw = cfg.twist_angle / cfg.twist_rate * s
     table: dict[str, list[PhaseCfg]] = {
         "press": [press, hold],
-        "tilt": [
-            half,
-            hold,
-            PhaseCfg("pitch", turn, rate=cfg.tilt_rate),
-            PhaseCfg("pitch", 2 * turn, rate=-cfg.tilt_rate),
-            PhaseCfg("pitch", turn, rate=cfg.tilt_rate),
-        ],
+        "tilt": [half, hold, *_swing("pitch", turn, cfg.tilt_rate)],
         "drag": [half, hold, PhaseCfg("move", 1.0 * s, velocity=(cfg.drag_speed, 0.0, 0.0)), hold],
         "liftoff": [press, hold, lift],
         "repeat": [p for _ in range(cfg.repeats) for p in (press, hold, lift)],
-        "twist": [
-            press,
-            hold,
-            PhaseCfg("yaw", yaw, rate=cfg.twist_rate),
-            PhaseCfg("yaw", 2 * yaw, rate=-cfg.twist_rate),
-            PhaseCfg("yaw", yaw, rate=cfg.twist_rate),
-        ],
+        "twist": [press, hold, *_swing("yaw", yaw, cfg.twist_rate)],
     }
     if name not in table:
         raise ValueError(f"unknown experiment {name!r}: choose from {EXPERIMENTS}")
     return table[name]
+
+
+def _swing(kind: PhaseKind, duration: float, rate: float) -> list[PhaseCfg]:
+    """Turn by ``rate * duration``, back twice as far, and forward again to the start (``pitch`` or ``yaw``)."""
+    return [
+        PhaseCfg(kind, duration, rate=rate),
+        PhaseCfg(kind, 2 * duration, rate=-rate),
+        PhaseCfg(kind, duration, rate=rate),
+    ]
 
 
 @dataclass
