@@ -41,4 +41,4 @@ mkdir -p ~/chunks/gate "artifacts/${run}_newest"
     --parts success --contact-model rft3d_calibrated --device cuda:0 --out ~/chunks/gate/deep_bed.json \
     > ~/chunks/gate/deep_bed.log 2>&1
 echo "gate rc $?" >> ~/chunks/job.log
-touch ~/chunks/DONE
+[ "${NESTED:-0}" = 1 ] || touch ~/chunks/DONE  # a wrapper job (NESTED=1) marks DONE itself
