@@ -128,6 +128,15 @@ def _parse(argv: list[str] | None) -> argparse.Namespace:
         "a resumed chunk puts each env at the level nearest to the floor depth its checkpoint saved",
     )
     p.add_argument(
+        "--rft-extension-range",
+        action="append",
+        default=[],
+        metavar="NAME=LO,HI",
+        help="draw one fitted term of rft3d_calibrated per env from U[LO, HI] on reset (repeatable; "
+        "GranularTaskCfg.rft_extension_ranges; NAME one of the per-world RftExtensionsCfg fields), e.g. "
+        "added_mass=1,10; default: the fitted values",
+    )
+    p.add_argument(
         "--allow-changed",
         action="append",
         default=[],
@@ -197,6 +206,14 @@ def _parse(argv: list[str] | None) -> argparse.Namespace:
         p.error(f"--floor-levels {args.floor_levels}: give 2 to 100 levels, e.g. 11 (2 cm steps over 0-20 cm)")
     if args.entropy_coef is not None and (args.stage != "teacher" or not args.entropy_coef >= 0):
         p.error(f"--entropy-coef {args.entropy_coef}: a number >= 0, for --stage teacher only, e.g. 0.001")
+    args.rft_extension_ranges = {}
+    for item in args.rft_extension_range:
+        if (parsed := extension_range(item)) is None:
+            p.error(
+                f"--rft-extension-range {item!r}: expected NAME=LO,HI with NAME in {', '.join(_ext_columns())} and "
+                "0 <= LO <= HI, e.g. added_mass=1,10"
+            )
+        args.rft_extension_ranges[parsed[0]] = parsed[1]
     if args.gpus:
         from gmloco.train.multi_gpu import cuda_device_count, gpus_problem
 
@@ -275,6 +292,26 @@ def _curriculum_scale(args: argparse.Namespace) -> float | None:
     return None
 
 
+def _ext_columns() -> tuple[str, ...]:
+    """The per-world fitted-term names that the DR may draw (``gmloco.contact.kernels_rft3d_ext.EXT_COLUMNS``)."""
+    from gmloco.contact.kernels_rft3d_ext import EXT_COLUMNS
+
+    return EXT_COLUMNS
+
+
+def extension_range(item: str) -> tuple[str, tuple[float, float]] | None:
+    """Parse ``NAME=LO,HI`` into ``(NAME, (LO, HI))``; None when malformed, unknown or not 0 <= LO <= HI."""
+    name, sep, values = item.partition("=")
+    parts = values.split(",")
+    if not sep or name not in _ext_columns() or len(parts) != 2:
+        return None
+    try:
+        lo, hi = float(parts[0]), float(parts[1])
+    except ValueError:
+        return None
+    return (name, (lo, hi)) if 0.0 <= lo <= hi else None
+
+
 def reward_weights(items: list[str]) -> dict[str, float]:
     """Parse ``--reward-weight NAME=WEIGHT`` items into ``GranularTaskCfg.reward_weights``; exit on a malformed one."""
     out: dict[str, float] = {}
@@ -310,6 +347,8 @@ def _task(args: argparse.Namespace) -> Any:
     if args.floor_levels is not None:
         floor = replace(task.terrain.floor, num_levels=args.floor_levels)
         task = replace(task, terrain=replace(task.terrain, floor=floor))
+    if args.rft_extension_ranges:
+        task = replace(task, rft_extension_ranges=dict(args.rft_extension_ranges))
     weights = reward_weights(args.reward_weight)
     if weights:
         task = replace(task, reward_weights=weights)

@@ -115,6 +115,23 @@ def test_bad_floor_levels_exit_2(levels: str, capsys: pytest.CaptureFixture[str]
     assert exc.value.code == 2 and "give 2 to 100 levels" in capsys.readouterr().err
 
 
+def test_rft_extension_range_reaches_the_task() -> None:
+    """--rft-extension-range NAME=LO,HI becomes GranularTaskCfg.rft_extension_ranges; none keeps the fitted values."""
+    chunk = _load()
+    base = ["--stage", "teacher", "--out", "unused", "--no-held-out", "--contact-model", "rft3d_calibrated"]
+    assert chunk._task(chunk._parse(base)).rft_extension_ranges == {}
+    args = chunk._parse([*base, "--rft-extension-range", "added_mass=1,10", "--rft-extension-range", "overburden=0,2"])
+    assert chunk._task(args).rft_extension_ranges == {"added_mass": (1.0, 10.0), "overburden": (0.0, 2.0)}
+
+
+@pytest.mark.parametrize("item", ["added_mass", "added_mass=10,1", "added_mass=-1,2", "mass=1,2", "added_mass=1,x"])
+def test_bad_rft_extension_range_exits_2(item: str, capsys: pytest.CaptureFixture[str]) -> None:
+    """A malformed, unknown or inverted range is refused with exit 2 and names the fields."""
+    with pytest.raises(SystemExit) as exc:
+        _load()._parse(["--stage", "teacher", "--out", "unused", "--rft-extension-range", item])
+    assert exc.value.code == 2 and "expected NAME=LO,HI" in capsys.readouterr().err
+
+
 def test_entropy_coef_reaches_the_teacher_algorithm_only() -> None:
     """--entropy-coef sets the teacher PPO's entropy coefficient in the rsl-rl entries; the default stays 0.005."""
     chunk = _load()

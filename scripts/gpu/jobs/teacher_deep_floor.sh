@@ -11,6 +11,9 @@
 # The curriculum spans 0-20 cm in 11 levels (2 cm steps; poppy seed's deepest stance, 12 cm, is level 6): at 0-30 cm in
 # 10 levels the first step (3.3 cm) already sat past the teacher's frontier and the floors stayed at ~2 cm. Resumed,
 # each env starts at the level nearest to its saved floor depth.
+# The added mass of the fitted sand is drawn per env from U[0.5, 10] instead of the fit's 10 (at its bound): in
+# results/sand_calibration/walk_gap_terms/ the fit's value makes dry sand too stiff under a walking foot (stance 2 cm
+# against MPM's 8), 0 too soft at 1.5 m/s (27 cm), and MPM's walks lie between.
 # The entropy coefficient drops from 0.005 to 0.001 (the student PPO's): at 0.005 the action std rose from 0.86 to
 # 1.22 over 2,048 iterations, the entropy bonus outweighing the little the GM-Loco rewards charge for noisy actions.
 set -uo pipefail
@@ -28,6 +31,7 @@ echo "teacher chunk: max-minutes $mins" > ~/chunks/job.log
 python3 scripts/gpu/train_ts_chunk.py --stage teacher --run "$run" --contact-model rft3d_calibrated \
   --foot-clearance sinkage --foot-faces box --curriculum-scale 0.1 --reward-weight foot_clearance_l2=-50 \
   --floor-promotion survival --floor-depth-max 0.20 --floor-levels 11 --entropy-coef 0.001 \
+  --rft-extension-range added_mass=0.5,10 --allow-changed task.rft_extension_ranges \
   --allow-changed task.terrain.floor.promotion --allow-changed task.terrain.floor.depth_range \
   --allow-changed task.terrain.floor.num_levels \
   --allow-changed rsl_rl_overrides.algorithm.entropy_coef \
