@@ -4,8 +4,8 @@
 # to resume, and .devsrc/rft3d_calibrated.json = results/sand_calibration/rft3d_calibrated.json; start it with
 # launch_job.sh SECONDS and poll with jobs/poll_teacher.sh MAX_SECONDS gm_loco_student_calibrated.
 # The TCN student distilled (DAgger + PPO) from the calibrated-sand teacher on the teacher's own sand and floor
-# curriculum (survival rule, floors 0-20 cm in 2 cm steps) and added-mass DR (U[0.5, 10]); the post-training checks export policy.onnx with its
-# deploy metadata and check it against torch.
+# curriculum (survival rule, floors 0-20 cm in 2 cm steps) and added-mass DR (U[0.5, 10]); the post-training checks
+# export policy.onnx with its deploy metadata and check it against torch.
 set -uo pipefail
 end=$1
 run=gm_loco_student_calibrated
