@@ -15,7 +15,7 @@ from gmloco.contact import ColliderBoxCfg, ColliderPoints, ContactRFT3DCfg, Mate
 from gmloco.contact.reference.rft3d_extensions import ExtState, advance_ext_state, rft3d_extended_forces
 from gmloco.eval.calibration.protocol import SoleProtocolCfg, SoleRecord, SoleSand
 
-__all__ = ["centred_sole_collider", "replay_record", "replay_wrench", "rft_sole_sand"]
+__all__ = ["centred_sole_collider", "replay_wrench", "rft_sole_sand"]
 
 
 def centred_sole_collider(protocol: SoleProtocolCfg, faces: str = "box", resolution: int = 5) -> ColliderPoints:
@@ -51,10 +51,3 @@ def replay_wrench(
     cfg = replace(cfg, extensions=replace(cfg.extensions, dt=dt))
     sand = rft_sole_sand(collider, cfg, material)
     return np.stack([sand(*k) for k in zip(record.pos, record.rot, record.lin_vel, record.ang_vel, strict=True)])
-
-
-def replay_record(
-    record: SoleRecord, collider: ColliderPoints, cfg: ContactRFT3DCfg, material: MaterialCfg, dt: float
-) -> np.ndarray:
-    """Return the model's force along a recorded experiment [N], [T, 3] (:func:`replay_wrench`'s force)."""
-    return replay_wrench(record, collider, cfg, material, dt)[:, :3]
