@@ -84,6 +84,36 @@ def test_fit_worse_on_heldout_is_refused(tmp_path: Path) -> None:
     assert not (tmp_path / "d.json").exists()
 
 
+def test_fixed_term_is_held_and_the_rest_fitted(tmp_path: Path) -> None:
+    """A term held at a value (--fixed) stays there: at the true value the free terms recover theirs (1 %), at a wrong
+    one the fit costs more."""
+    ds = load_dataset(_build(tmp_path, TRUTH, "truth"))
+    cfg = SandFitCfg(params=("depth_exponent", "lateral_scale"), fixed=(("overburden", 1.5),),
+                     plastic_unloading="off", at_rest="none")  # fmt: skip
+    result = fit_extensions(ds, cfg)
+    assert result.extensions.overburden == 1.5
+    np.testing.assert_allclose(
+        [result.extensions.depth_exponent, result.extensions.lateral_scale], [1.3, 0.2], rtol=1e-2
+    )
+    held_wrong = fit_extensions(ds, replace(cfg, fixed=(("overburden", 0.0),)))
+    assert held_wrong.extensions.overburden == 0.0 and held_wrong.cost > 100.0 * max(result.cost, 1e-12)
+
+
+@pytest.mark.parametrize(
+    ("fixed", "message"),
+    [("mud=1", "unknown"), ("overburden=50", "outside its fit bounds"), ("lateral_scale=1", "both fixed and fitted")],
+)
+def test_bad_fixed_term_exits_2(tmp_path: Path, capsys: pytest.CaptureFixture[str], fixed: str, message: str) -> None:
+    """A fixed term that is unknown, out of bounds or also fitted: exit 2 naming it, nothing written."""
+    path = _build(tmp_path, RftExtensionsCfg(), "plain")
+    args = ["--dataset", str(path), "--out", str(tmp_path / "fit.json"), "--params", "lateral_scale", "--fixed", fixed]
+    assert fit_main(args) == 2
+    assert message in capsys.readouterr().err and not (tmp_path / "fit.json").exists()
+    with pytest.raises(SystemExit) as e:
+        fit_main(["--dataset", str(path), "--out", str(tmp_path / "fit.json"), "--fixed", "added_mass"])
+    assert e.value.code == 2
+
+
 @pytest.mark.parametrize(
     ("change", "name"),
     [({"robot": "h1"}, "robot"), ({"units": {"force": "kN"}}, "units"), ({"rate": 50.0}, "rate")],

@@ -96,11 +96,24 @@ class SandFitCfg:
     """Fit the felt surface's height above the nominal bed top in every variant (False: datum 0)."""
     torque_weight: float = 1.0
     """Weight of the yaw-torque residual against the force residual [-] (0: forces only); see :func:`torque_scale`."""
+    fixed: tuple[tuple[str, float], ...] = ()
+    """Terms held at a value instead of fitted, as (name, value) pairs in the term's own unit (e.g. the added mass a
+    set of walks identifies where the sole data leave it at a bound); a name may not be in ``params`` too."""
 
     def __post_init__(self) -> None:
-        """Raise ValueError on a negative torque weight."""
+        """Raise ValueError on a negative torque weight or a fixed term that is unknown, fitted or out of bounds."""
         if not self.torque_weight >= 0.0:
             raise ValueError(f"torque_weight must be >= 0, got {self.torque_weight}")
+        for name, value in self.fixed:
+            if name not in FIT_BOUNDS:
+                raise ValueError(f"fixed term {name!r} is unknown: choose from {list(FIT_BOUNDS)}")
+            if name in self.params:
+                raise ValueError(f"term {name!r} is both fixed and fitted: drop it from params")
+            lo, hi, _ = FIT_BOUNDS[name]
+            if name != "depth_saturation" and not lo <= value <= hi:
+                raise ValueError(f"fixed {name}={value} lies outside its fit bounds [{lo}, {hi}]")
+            if not value >= 0.0:
+                raise ValueError(f"fixed {name}={value} must be >= 0")
 
 
 @dataclass
@@ -150,6 +163,7 @@ def _extensions(x: np.ndarray, cfg: SandFitCfg, plastic: bool) -> RftExtensionsC
     if "depth_saturation" in values:
         inv = values.pop("depth_saturation")
         values["depth_saturation"] = 1.0 / inv if inv > 1e-9 else 0.0
+    values.update(dict(cfg.fixed))
     if plastic:
         values.update(plastic_unloading=True, footprint_radius=cfg.footprint_radius)
     return RftExtensionsCfg(**values)

@@ -4,6 +4,9 @@
 python -m gmloco.eval.calibration.fit_cli --dataset results/sand_calibration/dataset/dry_sand.npz
         --robot g1 --rate-hz 100 --out results/sand_calibration/fit_dry_sand.json
         --write-default results/sand_calibration/rft3d_calibrated.json
+
+``--params`` names the fitted terms; ``--fixed NAME=VALUE`` holds others at a value (the rest keep the published
+model's, i.e. off).
 """
 
 from __future__ import annotations
@@ -15,6 +18,17 @@ from dataclasses import asdict
 
 from gmloco.eval.calibration.dataset import ContractError, file_sha256, load_dataset
 from gmloco.eval.calibration.fit import FIT_BOUNDS, SandFitCfg, fit_extensions, write_default, write_report
+
+
+def _fixed_term(text: str) -> tuple[str, float]:
+    """Parse ``NAME=VALUE`` of ``--fixed`` (argparse exits 2 on a malformed one)."""
+    name, sep, value = text.partition("=")
+    try:
+        if not sep:
+            raise ValueError
+        return name.strip(), float(value)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"expected NAME=VALUE (e.g. added_mass=1), got {text!r}") from None
 
 
 def parse_args(argv: list[str] | None) -> argparse.Namespace:
@@ -34,6 +48,15 @@ def parse_args(argv: list[str] | None) -> argparse.Namespace:
         default=SandFitCfg().torque_weight,
         help="weight of the yaw-torque residual against the force residual (0: forces only)",
     )
+    p.add_argument(
+        "--fixed",
+        type=_fixed_term,
+        action="append",
+        default=[],
+        metavar="NAME=VALUE",
+        help="hold a term at a value instead of fitting it (repeatable; not also in --params), e.g. the added mass "
+        "that walks identify: --fixed added_mass=1",
+    )
     p.add_argument("--min-improvement", type=float, default=0.0, help="relative held-out error reduction required")
     p.add_argument("--out", required=True, help="fit report JSON")
     p.add_argument("--write-default", default=None, help="write the fitted terms here if the fit is accepted")
@@ -46,7 +69,7 @@ def main(argv: list[str] | None = None) -> int:
     try:
         cfg = SandFitCfg(params=tuple(a.params), plastic_unloading=a.plastic_unloading, at_rest=a.at_rest,
                          robot=a.robot, rate_hz=a.rate_hz, min_improvement=a.min_improvement,
-                         torque_weight=a.torque_weight)  # fmt: skip
+                         torque_weight=a.torque_weight, fixed=tuple(a.fixed))  # fmt: skip
         ds = load_dataset(a.dataset)
         result = fit_extensions(ds, cfg)
     except (ContractError, FileNotFoundError, ValueError) as e:
