@@ -23,7 +23,7 @@ into the calibrated default.
 
 from __future__ import annotations
 
-from dataclasses import asdict, dataclass, replace
+from dataclasses import asdict, dataclass, fields, replace
 from pathlib import Path
 from typing import Any, Literal
 
@@ -41,7 +41,9 @@ __all__ = [
     "SandFitCfg",
     "SandFitResult",
     "dataset_material",
+    "fit_datum",
     "fit_extensions",
+    "held_terms",
     "replay_forces",
     "replay_wrenches",
     "split_error",
@@ -260,6 +262,26 @@ def _fit_one(ds: CalibrationDataset, cfg: SandFitCfg, plastic: bool) -> tuple[Rf
         return _extensions(x0, cfg, plastic), 0.5 * float(np.sum(residual(x0) ** 2)), 0.0
     res = least_squares(residual, x0, bounds=(lo, hi), x_scale=np.maximum(hi - lo, 1e-3) / 10, diff_step=1e-4)
     return _extensions(res.x[:n_terms], cfg, plastic), float(res.cost), float(res.x[n_terms]) if cfg.fit_datum else 0.0
+
+
+def held_terms(ext: RftExtensionsCfg) -> tuple[tuple[str, float], ...]:
+    """Return the fit terms of ``ext`` as :attr:`SandFitCfg.fixed` pairs; ValueError if it sets any other term."""
+    default = RftExtensionsCfg()
+    others = {f.name for f in fields(RftExtensionsCfg)} - set(FIT_BOUNDS) - {"dt", "plastic_unloading",
+                                                                             "footprint_radius"}  # fmt: skip
+    changed = sorted(n for n in others if getattr(ext, n) != getattr(default, n))
+    if changed:
+        raise ValueError(f"terms {changed} cannot be held in a fit (only {sorted(FIT_BOUNDS)} and plastic unloading)")
+    return tuple((n, float(getattr(ext, n))) for n in FIT_BOUNDS)
+
+
+def fit_datum(ds: CalibrationDataset, ext: RftExtensionsCfg, cfg: SandFitCfg) -> float:
+    """Return the datum [m] that fits the dataset's fit split best with every term of ``ext`` held.
+
+    ``cfg`` gives the replay settings (at-rest mode, resolution); its ``params`` and ``fixed`` are replaced.
+    """
+    held = replace(cfg, params=(), fixed=held_terms(ext), footprint_radius=ext.footprint_radius, fit_datum=True)
+    return _fit_one(ds, held, plastic=ext.plastic_unloading)[2]
 
 
 def fit_extensions(ds: CalibrationDataset, cfg: SandFitCfg) -> SandFitResult:

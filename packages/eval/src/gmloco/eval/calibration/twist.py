@@ -1,0 +1,172 @@
+# SPDX-License-Identifier: Apache-2.0
+"""How hard a loaded sole's sand resists a turn about the vertical: MPM's ``twist`` records against 3D-RFT models.
+
+The ``twist`` experiment presses the G1 sole to the single-stance load, holds it, then turns it +a, -2a, +a about
+the vertical at a constant depth. Per record this reads the load before the turn and, for each of the three turns,
+the mean yaw torque [N m] (its sign opposes the turn when the sand resists), its peak magnitude, and the vertical
+force left at the turn's end: a sand that yields under the twist loses its support. Each model (the published
+3D-RFT and fitted extension terms) replays the same kinematics at the datum fitted for it on the same material's
+dataset (the height of the surface the sole feels; see :mod:`gmloco.eval.calibration.fit`), so a stiff medium the
+sole barely enters is compared where the model carries load at all::
+
+    python -m gmloco.eval.calibration.twist --dataset results/sand_calibration/dataset/with_twist/dry_sand.npz
+        --model calibrated=results/sand_calibration/rft3d_calibrated.json --out results/sand_calibration/twist
+
+writes ``summary.json`` and ``fig_twist.png`` there (exit 2 on a dataset without a twist record or a bad model).
+"""
+
+from __future__ import annotations
+
+import argparse
+import sys
+from dataclasses import asdict
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from gmloco.contact import RftExtensionsCfg
+from gmloco.contact.extensions_io import load_rft_extensions
+from gmloco.deploy.atomic_io import atomic_write_json
+from gmloco.eval.calibration.dataset import CalibrationDataset, load_dataset
+from gmloco.eval.calibration.fit import SandFitCfg, fit_datum, held_terms, replay_wrenches
+
+__all__ = ["TURN_PHASES", "main", "model_twist", "twist_response"]
+
+TURN_PHASES: tuple[int, int, int] = (2, 3, 4)
+"""Phase indices of the three turns in a twist record (0 press, 1 hold)."""
+RECORD = "twist"
+
+
+def twist_response(force: np.ndarray, torque_z: np.ndarray, phase: np.ndarray) -> dict[str, Any]:
+    """Return the twist's load and per-turn response of one sand.
+
+    Args:
+        force: Sand force on the sole [N], [T, 3].
+        torque_z: Yaw torque about the sole centre [N m], [T].
+        phase: Phase index per frame, [T] (1 the hold, :data:`TURN_PHASES` the turns).
+
+    Returns:
+        ``load_N`` (mean F_z over the hold) and per turn (``turn_1``..``turn_3``): ``torque_mean_Nm``,
+        ``torque_peak_Nm`` (largest magnitude), ``force_z_end_N`` (F_z at the turn's last frame) and
+        ``support_kept`` (that over the load).
+    """
+    hold = phase == 1
+    if not hold.any() or not all((phase == k).any() for k in TURN_PHASES):
+        raise ValueError("not a twist record: it needs a hold phase (1) and three turns (phases 2-4)")
+    load = float(np.mean(force[hold, 2]))
+    out: dict[str, Any] = {"load_N": load}
+    for i, k in enumerate(TURN_PHASES, start=1):
+        sel = phase == k
+        tz = torque_z[sel]
+        out[f"turn_{i}"] = {
+            "torque_mean_Nm": float(np.mean(tz)),
+            "torque_peak_Nm": float(tz[np.argmax(np.abs(tz))]),
+            "force_z_end_N": float(force[sel, 2][-1]),
+            "support_kept": float(force[sel, 2][-1] / load) if load > 0.0 else float("nan"),
+        }
+    return out
+
+
+def model_twist(ds: CalibrationDataset, ext: RftExtensionsCfg, cfg: SandFitCfg) -> tuple[np.ndarray, float]:
+    """Return a model's wrench [T, 6] along the dataset's twist record and the datum [m] it was replayed at.
+
+    The datum is fitted on the dataset's fit split with every term of the model held (:func:`fit.fit_datum`).
+    """
+    datum = fit_datum(ds, ext, cfg)
+    return replay_wrenches(ds, ext, cfg, [RECORD], datum)[RECORD], datum
+
+
+def _figure(series: dict[str, dict[str, dict[str, np.ndarray]]], path: Path) -> None:
+    """Draw F_z and tau_z over time per material (columns) for the sand and each model."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    mats = list(series)
+    fig, axes = plt.subplots(2, len(mats), figsize=(4.2 * len(mats), 5.6), squeeze=False, sharex="col")
+    for j, mat in enumerate(mats):
+        for i, (label, s) in enumerate(series[mat].items()):
+            wide = 2.5 if i == 0 else 1.2
+            kw = {"color": f"C{i}" if i else "k", "lw": wide, "alpha": 0.6 if i == 0 else 1.0, "label": label}
+            axes[0, j].plot(s["time"], s["force_z"], **kw)
+            axes[1, j].plot(s["time"], s["torque_z"], **kw)
+        turns = series[mat][next(iter(series[mat]))]
+        for ax in axes[:, j]:
+            for k in TURN_PHASES:
+                t = turns["time"][turns["phase"] == k]
+                ax.axvspan(t[0], t[-1], color="0.9" if k % 2 else "0.8", zorder=0)
+            ax.grid(alpha=0.3)
+        axes[0, j].set(title=mat, ylabel="F_z [N]")
+        axes[1, j].set(xlabel="time [s] (shaded: turns +, -, +)", ylabel="tau_z about the sole centre [N m]")
+    axes[0, 0].legend(fontsize=7)
+    fig.suptitle("A loaded G1 sole turned about the vertical: MPM against 3D-RFT models", fontsize=10)
+    fig.tight_layout()
+    tmp = path.with_suffix(".tmp.png")
+    fig.savefig(tmp, dpi=100)
+    plt.close(fig)
+    tmp.replace(path)
+
+
+def parse_args(argv: list[str] | None) -> argparse.Namespace:
+    """Parse the command line."""
+    p = argparse.ArgumentParser(
+        prog="python -m gmloco.eval.calibration.twist", description=(__doc__ or "").splitlines()[0]
+    )
+    p.add_argument("--dataset", action="append", required=True, help="<material>.npz with a twist record")
+    p.add_argument("--model", action="append", default=[], metavar="LABEL=PATH",
+                   help="fitted extension terms (an extensions file or a fit report); the published 3D-RFT is always "
+                   "included")  # fmt: skip
+    p.add_argument("--out", required=True, help="folder of summary.json and fig_twist.png")
+    return p.parse_args(argv)
+
+
+def main(argv: list[str] | None = None) -> int:
+    """Measure every dataset's twist against every model; exit 2 on bad input."""
+    a = parse_args(argv)
+    cfg = SandFitCfg()
+    try:
+        models: dict[str, tuple[RftExtensionsCfg, str]] = {"published 3D-RFT": (RftExtensionsCfg(), "")}
+        for spec in a.model:
+            label, sep, path = spec.partition("=")
+            if not sep or not label:
+                raise ValueError(f"--model expects LABEL=PATH, got {spec!r}")
+            models[label] = (load_rft_extensions(path), path)
+            held_terms(models[label][0])
+        datasets = {}
+        for path in a.dataset:
+            ds = load_dataset(path)
+            if RECORD not in ds.records or not ds.records[RECORD].has_torque:
+                raise ValueError(f"{path}: no twist record with a torque; rebuild it with python -m "
+                                 "gmloco.eval.calibration --experiments twist")  # fmt: skip
+            datasets[path] = ds
+    except (OSError, ValueError) as e:
+        print(f"error: {e}", file=sys.stderr)
+        return 2
+    out = Path(a.out)
+    out.mkdir(parents=True, exist_ok=True)
+    summary: dict[str, Any] = {"models": {k: {"path": p, "extensions": asdict(e)} for k, (e, p) in models.items()},
+                               "materials": {}}  # fmt: skip
+    series: dict[str, dict[str, dict[str, np.ndarray]]] = {}
+    for path, ds in datasets.items():
+        rec = ds.records[RECORD]
+        row = {"dataset": path, "source": ds.source, "split": ds.split[RECORD],
+               ds.source: twist_response(rec.force, rec.torque[:, 2], rec.phase)}  # fmt: skip
+        series[ds.material] = {ds.source: {"time": rec.time, "phase": rec.phase, "force_z": rec.force[:, 2],
+                                           "torque_z": rec.torque[:, 2]}}  # fmt: skip
+        for label, (ext, _) in models.items():
+            wrench, datum = model_twist(ds, ext, cfg)
+            row[label] = {"datum_m": datum, **twist_response(wrench[:, :3], wrench[:, 5], rec.phase)}
+            series[ds.material][label] = {"time": rec.time, "phase": rec.phase, "force_z": wrench[:, 2],
+                                          "torque_z": wrench[:, 5]}  # fmt: skip
+            print(f"{ds.material}: {label} replayed at datum {100 * datum:.2f} cm", flush=True)
+        summary["materials"][ds.material] = row
+    atomic_write_json(out / "summary.json", summary)
+    _figure(series, out / "fig_twist.png")
+    print(f"{out}/summary.json, fig_twist.png: {len(datasets)} materials, {len(models)} models")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

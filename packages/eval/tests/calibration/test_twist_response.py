@@ -1,0 +1,64 @@
+# SPDX-License-Identifier: Apache-2.0
+"""The twist study: per-turn torque and support of a sand, and its command line, on float64 3D-RFT data."""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from gmloco.contact import RftExtensionsCfg
+from gmloco.contact.extensions_io import save_rft_extensions
+from gmloco.eval.calibration.build import CalibrationBuildCfg, build_dataset
+from gmloco.eval.calibration.dataset import load_dataset
+from gmloco.eval.calibration.protocol import SoleProtocolCfg
+from gmloco.eval.calibration.twist import main, twist_response
+
+FAST = SoleProtocolCfg(time_scale=0.5)
+TRUTH = RftExtensionsCfg(lateral_scale=0.3)
+
+
+def _dataset(tmp: Path, experiments: tuple[str, ...] = ("press", "twist")) -> Path:
+    """Reference-sand dataset of dry sand with the lateral scale 0.3."""
+    cfg = CalibrationBuildCfg(out_dir=str(tmp), sand="rft3d_reference", protocol=FAST, reference_extensions=TRUTH,
+                              experiments=experiments)  # fmt: skip
+    return build_dataset(cfg)[0]
+
+
+def test_response_opposes_each_turn_and_reads_the_load(tmp_path: Path) -> None:
+    """The resisting torque changes sign with the turn (+, -, +); the hold carries the single-stance load."""
+    rec = load_dataset(_dataset(tmp_path)).records["twist"]
+    r = twist_response(rec.force, rec.torque[:, 2], rec.phase)
+    assert r["load_N"] == pytest.approx(FAST.weight, rel=0.1)
+    signs = [np.sign(r[f"turn_{i}"]["torque_mean_Nm"]) for i in (1, 2, 3)]
+    assert signs == [-1.0, 1.0, -1.0]
+    assert all(abs(r[f"turn_{i}"]["torque_peak_Nm"]) >= abs(r[f"turn_{i}"]["torque_mean_Nm"]) for i in (1, 2, 3))
+    with pytest.raises(ValueError, match="not a twist record"):
+        twist_response(rec.force, rec.torque[:, 2], np.zeros_like(rec.phase))
+
+
+def test_cli_replays_the_true_terms_exactly(tmp_path: Path) -> None:
+    """A model with the data's own terms reproduces the data's twist at datum ~0; the published model resists 1/0.3 x."""
+    path = _dataset(tmp_path / "ds")
+    terms = save_rft_extensions(TRUTH, tmp_path / "truth.json", {"made_by": "test"})
+    assert main(["--dataset", str(path), "--model", f"truth={terms}", "--out", str(tmp_path / "out")]) == 0
+    row = json.loads((tmp_path / "out" / "summary.json").read_text())["materials"]["dry_sand"]
+    data, truth, published = row["rft3d_reference"], row["truth"], row["published 3D-RFT"]
+    assert abs(truth["datum_m"]) < 1e-3
+    for i in (1, 2, 3):
+        t = f"turn_{i}"
+        assert truth[t]["torque_mean_Nm"] == pytest.approx(data[t]["torque_mean_Nm"], rel=0.05)
+        assert abs(published[t]["torque_mean_Nm"]) > 2.0 * abs(data[t]["torque_mean_Nm"])
+    assert (tmp_path / "out" / "fig_twist.png").stat().st_size > 10_000
+
+
+def test_bad_input_exits_2(tmp_path: Path) -> None:
+    """A dataset without a twist record, a model without LABEL=, or a missing terms file: exit 2."""
+    press_only = _dataset(tmp_path / "p", ("press",))
+    assert main(["--dataset", str(press_only), "--out", str(tmp_path / "o")]) == 2
+    twist = _dataset(tmp_path / "t")
+    assert main(["--dataset", str(twist), "--model", "no_label", "--out", str(tmp_path / "o")]) == 2
+    assert main(["--dataset", str(twist), "--model", f"x={tmp_path / 'none.json'}", "--out", str(tmp_path / "o")]) == 2
+    assert not (tmp_path / "o" / "summary.json").exists()
