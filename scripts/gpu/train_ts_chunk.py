@@ -137,6 +137,14 @@ def _parse(argv: list[str] | None) -> argparse.Namespace:
         "added_mass=1,10; default: the fitted values",
     )
     p.add_argument(
+        "--soft-share",
+        type=float,
+        default=None,
+        help="share of the material draws whose rho_c comes from MaterialRangeCfg.soft_rho_c (500-800 kg/m^3, "
+        "poppy seed's 638 inside) instead of packing x bulk density (default: the task's, 0, GM-Loco's draw); a "
+        "resumed run names task.material.soft_share in --allow-changed",
+    )
+    p.add_argument(
         "--allow-changed",
         action="append",
         default=[],
@@ -206,6 +214,8 @@ def _parse(argv: list[str] | None) -> argparse.Namespace:
         p.error(f"--floor-levels {args.floor_levels}: give 2 to 100 levels, e.g. 11 (2 cm steps over 0-20 cm)")
     if args.entropy_coef is not None and (args.stage != "teacher" or not args.entropy_coef >= 0):
         p.error(f"--entropy-coef {args.entropy_coef}: a number >= 0, for --stage teacher only, e.g. 0.001")
+    if args.soft_share is not None and not 0.0 <= args.soft_share <= 1.0:
+        p.error(f"--soft-share {args.soft_share}: give a share in [0, 1], e.g. 0.25")
     args.rft_extension_ranges = {}
     for item in args.rft_extension_range:
         if (parsed := extension_range(item)) is None:
@@ -349,6 +359,8 @@ def _task(args: argparse.Namespace) -> Any:
         task = replace(task, terrain=replace(task.terrain, floor=floor))
     if args.rft_extension_ranges:
         task = replace(task, rft_extension_ranges=dict(args.rft_extension_ranges))
+    if args.soft_share is not None:
+        task = replace(task, material=replace(task.material, soft_share=args.soft_share))
     weights = reward_weights(args.reward_weight)
     if weights:
         task = replace(task, reward_weights=weights)

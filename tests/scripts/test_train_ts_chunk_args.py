@@ -148,3 +148,19 @@ def test_bad_entropy_coef_exits_2(argv: list[str], capsys: pytest.CaptureFixture
     with pytest.raises(SystemExit) as exc:
         _load()._parse([*argv, "--out", "unused"])
     assert exc.value.code == 2 and "--entropy-coef" in capsys.readouterr().err
+
+
+def test_soft_share_reaches_the_material_draw() -> None:
+    """--soft-share sets MaterialRangeCfg.soft_share; without it the task keeps GM-Loco's draw (0)."""
+    chunk = _load()
+    base = ["--stage", "teacher", "--out", "unused", "--no-held-out"]
+    assert chunk._task(chunk._parse(base)).material.soft_share == 0.0
+    assert chunk._task(chunk._parse([*base, "--soft-share", "0.25"])).material.soft_share == 0.25
+
+
+@pytest.mark.parametrize("share", ["-0.1", "1.5"])
+def test_bad_soft_share_exits_2(share: str, capsys: pytest.CaptureFixture[str]) -> None:
+    """A share outside [0, 1] is refused with exit 2."""
+    with pytest.raises(SystemExit) as exc:
+        _load()._parse(["--stage", "teacher", "--out", "unused", "--soft-share", share])
+    assert exc.value.code == 2 and "share in [0, 1]" in capsys.readouterr().err

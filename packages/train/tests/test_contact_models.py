@@ -4,6 +4,7 @@
 from __future__ import annotations
 
 import numpy as np
+import pytest
 import torch
 
 import gmloco.contact as gc
@@ -47,3 +48,34 @@ def test_preset_and_pinned_materials_go_the_same_way() -> None:
     writer.draw(torch.tensor([3, 5]))
     np.testing.assert_allclose(model.mu_int.numpy()[[3, 5]], mu[[3, 5]].numpy())
     _assert_eta_follows(model)
+
+
+def test_soft_share_draws_that_share_from_the_soft_range() -> None:
+    """soft_share=0.5 puts ~half the draws in soft_rho_c (the product of uniforms alone: ~8 % below 800 kg/m^3)."""
+    n = 4000
+    model = gc.make_contact_model(gc.ContactRFT3DCfg(), n, 2, "cpu")
+    torch.manual_seed(0)
+    MaterialWriter(model, MaterialRangeCfg(), "cpu").draw(torch.arange(n))
+    plain = model.rho_c.numpy().copy()
+    assert 0.05 < (plain < 800.0).mean() < 0.11
+    writer = MaterialWriter(model, MaterialRangeCfg(soft_share=0.5, soft_rho_c=(550.0, 750.0)), "cpu")
+    writer.draw(torch.arange(n))
+    rho = model.rho_c.numpy()
+    soft = (rho >= 550.0) & (rho <= 750.0)
+    assert 0.5 < soft.mean() < 0.6  # the soft half plus the plain draws that land there anyway
+    assert rho.min() >= 500.0 - 1e-3  # nothing below either range
+    _assert_eta_follows(model)
+
+
+@pytest.mark.parametrize(
+    ("bad", "field"),
+    [
+        (MaterialRangeCfg(soft_share=1.5), "soft_share"),
+        (MaterialRangeCfg(soft_share=0.2, soft_rho_c=(800.0, 500.0)), "soft_rho_c"),
+    ],
+)
+def test_bad_soft_share_is_refused(bad: MaterialRangeCfg, field: str) -> None:
+    """A share outside [0, 1] or an empty soft range is a ValueError naming the field."""
+    model = gc.make_contact_model(gc.ContactRFT3DCfg(), W, 2, "cpu")
+    with pytest.raises(ValueError, match=field):
+        MaterialWriter(model, bad, "cpu")

@@ -61,6 +61,12 @@ class MaterialRangeCfg:
     """Uniform range of the cone models' flank stress per depth [N/m^3] (cone models only)."""
     preset: str | None = None
     """Name in ``gmloco.contact.MATERIAL_PRESETS``; when set every env uses it and nothing is drawn."""
+    soft_share: float = 0.0
+    """Share of the draws [0, 1] whose rho_c comes from U[``soft_rho_c``] instead of packing x bulk density (the
+    rest unchanged). The product of the two uniforms puts ~8 % of the draws below 800 kg/m^3, where poppy seed
+    (638 kg/m^3) lies; 0 keeps GM-Loco's draw."""
+    soft_rho_c: tuple[float, float] = (500.0, 800.0)
+    """rho_c range [kg/m^3] of the soft share."""
     held_out_rho_c: tuple[float, float] | None = None
     """rho_c range [kg/m^3] of a (rho_c, mu_int) rectangle the DR never draws: materials held out for evaluation
     (``gmloco.train.teacher_student.heldout``); None (or ``held_out_mu_int`` None): no hole."""

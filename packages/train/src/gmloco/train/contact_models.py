@@ -142,6 +142,12 @@ class MaterialWriter:
         validate_material_arrays(
             lo_hi(ranges.packing) * lo_hi(ranges.bulk_density), lo_hi(ranges.mu_int), lo_hi(ranges.mu_surf)
         )
+        if not 0.0 <= ranges.soft_share <= 1.0:
+            raise ValueError(f"material soft_share={ranges.soft_share}: give a share in [0, 1], e.g. 0.25")
+        if ranges.soft_share > 0.0:
+            lo, hi = ranges.soft_rho_c
+            if not 0.0 < lo <= hi:
+                raise ValueError(f"material soft_rho_c={ranges.soft_rho_c}: give 0 < low <= high [kg/m^3]")
         names = ("rho_c", "mu_int", "mu_surf", "eta", "sigma_flat", "sigma_cone")
         self.views = {n: wp.to_torch(getattr(model, n)) for n in names if hasattr(model, n)}
         if self.extension_ranges:
@@ -182,6 +188,9 @@ class MaterialWriter:
             material = {k: torch.full((n,), float(getattr(self.preset, k)), device=self.device) for k in names}
         else:
             rho_c = self._uniform(r.packing, n) * self._uniform(r.bulk_density, n)
+            if r.soft_share > 0.0:
+                soft = torch.rand(n, device=self.device) < r.soft_share
+                rho_c = torch.where(soft, self._uniform(r.soft_rho_c, n), rho_c)
             mu_int = self._uniform(r.mu_int, n)
             if self.held_out is not None:
                 from gmloco.train.teacher_student.heldout import redraw_outside
