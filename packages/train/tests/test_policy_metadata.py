@@ -124,6 +124,16 @@ def test_task_saved_before_the_floor_rule_reads_as_the_distance_rule() -> None:
     assert rebuilt.terrain.floor.promotion == "distance" and rebuilt.foot_faces == "box"
 
 
+def test_task_saved_before_the_soft_share_reads_as_gm_locos_draw() -> None:
+    """A train_cfg task without the material's soft share (saved before the field) is read with none (0)."""
+    from gmloco.train.tasks.g1_granular.upgrade_metadata import task_from_dict
+
+    task = asdict(g1_granular_task())
+    del task["material"]["soft_share"], task["material"]["soft_rho_c"]
+    rebuilt = task_from_dict(json.loads(json.dumps(task)))
+    assert rebuilt.material == g1_granular_task().material and rebuilt.material.soft_share == 0.0
+
+
 def test_upgrade_refuses_disagreeing_facts(tmp_path: Path) -> None:
     """A file whose history length differs from its train_cfg.json is not upgraded."""
     _v1_policy(tmp_path, history=40)

@@ -47,7 +47,11 @@ _NESTED: dict[str, type] = {"terrain": SandTerrainCfg, "floor": SandFloorCfg, "m
 """Dataclass-valued fields of the task config."""
 
 
-_ADDED_LATER: dict[str, Any] = {"task.terrain.floor.promotion": "distance"}
+_ADDED_LATER: dict[str, Any] = {
+    "task.terrain.floor.promotion": "distance",
+    "task.material.soft_share": 0.0,
+    "task.material.soft_rho_c": (500.0, 800.0),
+}
 """Task fields added after runs were saved, with the value that reproduces every run saved without them (the only
 behaviour there was): such a field is filled in, never guessed for any other key."""
 
