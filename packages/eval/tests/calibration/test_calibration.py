@@ -85,8 +85,10 @@ def test_fit_worse_on_heldout_is_refused(tmp_path: Path) -> None:
 
 
 def test_fixed_term_is_held_and_the_rest_fitted(tmp_path: Path) -> None:
-    """A term held at a value (--fixed) stays there: at the true value the free terms recover theirs (1 %), at a wrong
-    one the fit costs more."""
+    """A term held at a value (--fixed) stays there.
+
+    At the true value the free terms recover theirs (1 %); at a wrong one the fit costs more.
+    """
     ds = load_dataset(_build(tmp_path, TRUTH, "truth"))
     cfg = SandFitCfg(params=("depth_exponent", "lateral_scale"), fixed=(("overburden", 1.5),),
                      plastic_unloading="off", at_rest="none")  # fmt: skip

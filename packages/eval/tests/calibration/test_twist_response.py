@@ -14,13 +14,13 @@ from gmloco.contact.extensions_io import save_rft_extensions
 from gmloco.eval.calibration.build import CalibrationBuildCfg, build_dataset
 from gmloco.eval.calibration.dataset import load_dataset
 from gmloco.eval.calibration.protocol import SoleProtocolCfg
-from gmloco.eval.calibration.twist import main, twist_response
+from gmloco.eval.calibration.twist import drag_response, main, twist_response
 
 FAST = SoleProtocolCfg(time_scale=0.5)
 TRUTH = RftExtensionsCfg(lateral_scale=0.3)
 
 
-def _dataset(tmp: Path, experiments: tuple[str, ...] = ("press", "twist")) -> Path:
+def _dataset(tmp: Path, experiments: tuple[str, ...] = ("press", "drag", "twist")) -> Path:
     """Reference-sand dataset of dry sand with the lateral scale 0.3."""
     cfg = CalibrationBuildCfg(out_dir=str(tmp), sand="rft3d_reference", protocol=FAST, reference_extensions=TRUTH,
                               experiments=experiments)  # fmt: skip
@@ -52,6 +52,21 @@ def test_cli_replays_the_true_terms_exactly(tmp_path: Path) -> None:
         assert truth[t]["torque_mean_Nm"] == pytest.approx(data[t]["torque_mean_Nm"], rel=0.05)
         assert abs(published[t]["torque_mean_Nm"]) > 2.0 * abs(data[t]["torque_mean_Nm"])
     assert (tmp_path / "out" / "fig_twist.png").stat().st_size > 10_000
+    drag = row["drag"]
+    assert drag["truth"]["support_kept"] == pytest.approx(drag["rft3d_reference"]["support_kept"], rel=0.05)
+    assert drag["rft3d_reference"]["load_N"] == pytest.approx(0.5 * FAST.weight, rel=0.2)  # pressed to half the load
+    assert (tmp_path / "out" / "fig_drag.png").stat().st_size > 10_000
+
+
+def test_drag_response_reads_the_support_left_after_the_slide() -> None:
+    """Synthetic drag: 100 N before, a slide at 10 N sideways, 25 N after: a quarter of the support kept."""
+    phase = np.repeat([0, 1, 2, 3], 5)
+    force = np.zeros((20, 3))
+    force[phase == 1, 2], force[phase == 2, 0], force[phase == 2, 2], force[phase == 3, 2] = 100.0, 10.0, 40.0, 25.0
+    r = drag_response(force, phase)
+    assert (r["load_N"], r["drag_force_N"], r["support_after_N"], r["support_kept"]) == (100.0, 10.0, 25.0, 0.25)
+    with pytest.raises(ValueError, match="not a drag record"):
+        drag_response(force, np.zeros(20, dtype=int))
 
 
 def test_bad_input_exits_2(tmp_path: Path) -> None:

@@ -13,6 +13,11 @@ sole barely enters is compared where the model carries load at all::
         --model calibrated=results/sand_calibration/rft3d_calibrated.json --out results/sand_calibration/twist
 
 writes ``summary.json`` and ``fig_twist.png`` there (exit 2 on a dataset without a twist record or a bad model).
+
+The ``drag`` record asks the same of a slide: the sole, pressed to half the load and held, moves 10 cm sideways at
+constant depth and rests again. :func:`drag_response` reads the load before the slide, the mean horizontal force
+during it and the support left in the rest after it (``fig_drag.png``): a sand whose support returns when the sole
+stops forgets the slide; one whose support stays low keeps it.
 """
 
 from __future__ import annotations
@@ -31,11 +36,14 @@ from gmloco.deploy.atomic_io import atomic_write_json
 from gmloco.eval.calibration.dataset import CalibrationDataset, load_dataset
 from gmloco.eval.calibration.fit import SandFitCfg, fit_datum, held_terms, replay_wrenches
 
-__all__ = ["TURN_PHASES", "main", "model_twist", "twist_response"]
+__all__ = ["DRAG_PHASES", "TURN_PHASES", "drag_response", "main", "twist_response"]
 
 TURN_PHASES: tuple[int, int, int] = (2, 3, 4)
 """Phase indices of the three turns in a twist record (0 press, 1 hold)."""
+DRAG_PHASES: tuple[int, int, int] = (1, 2, 3)
+"""Phase indices of a drag record's hold before the slide, the slide and the rest after it (0 the press)."""
 RECORD = "twist"
+DRAG = "drag"
 
 
 def twist_response(force: np.ndarray, torque_z: np.ndarray, phase: np.ndarray) -> dict[str, Any]:
@@ -68,45 +76,85 @@ def twist_response(force: np.ndarray, torque_z: np.ndarray, phase: np.ndarray) -
     return out
 
 
-def model_twist(ds: CalibrationDataset, ext: RftExtensionsCfg, cfg: SandFitCfg) -> tuple[np.ndarray, float]:
-    """Return a model's wrench [T, 6] along the dataset's twist record and the datum [m] it was replayed at.
+def drag_response(force: np.ndarray, phase: np.ndarray) -> dict[str, float]:
+    """Return the load before a drag record's slide, its drag force and the support left after it.
 
-    The datum is fitted on the dataset's fit split with every term of the model held (:func:`fit.fit_datum`).
+    Args:
+        force: Sand force on the sole [N], [T, 3].
+        phase: Phase index per frame, [T] (:data:`DRAG_PHASES`: hold, slide, rest).
+
+    Returns:
+        ``load_N`` (mean F_z of the hold), ``drag_force_N`` (mean horizontal force magnitude during the slide),
+        ``force_z_end_of_slide_N``, ``support_after_N`` (mean F_z of the rest) and ``support_kept`` (that over the
+        load).
     """
+    before, slide, after = (phase == k for k in DRAG_PHASES)
+    if not (before.any() and slide.any() and after.any()):
+        raise ValueError("not a drag record: it needs a hold (1), a slide (2) and a rest (3)")
+    load = float(np.mean(force[before, 2]))
+    support = float(np.mean(force[after, 2]))
+    return {
+        "load_N": load,
+        "drag_force_N": float(np.mean(np.hypot(force[slide, 0], force[slide, 1]))),
+        "force_z_end_of_slide_N": float(force[slide, 2][-1]),
+        "support_after_N": support,
+        "support_kept": support / load if load > 0.0 else float("nan"),
+    }
+
+
+def _replay(ds: CalibrationDataset, ext: RftExtensionsCfg, cfg: SandFitCfg) -> tuple[dict[str, np.ndarray], float]:
+    """Return a model's wrenches along the twist (and drag, if recorded) records and its fitted datum [m]."""
     datum = fit_datum(ds, ext, cfg)
-    return replay_wrenches(ds, ext, cfg, [RECORD], datum)[RECORD], datum
+    names = [RECORD] + ([DRAG] if DRAG in ds.records else [])
+    return replay_wrenches(ds, ext, cfg, names, datum), datum
 
 
-def _figure(series: dict[str, dict[str, dict[str, np.ndarray]]], path: Path) -> None:
-    """Draw F_z and tau_z over time per material (columns) for the sand and each model."""
+def _figure(
+    series: dict[str, dict[str, dict[str, np.ndarray]]],
+    path: Path,
+    rows: tuple[tuple[str, str], ...] = (("force_z", "F_z [N]"), ("torque_z", "tau_z about the sole centre [N m]")),
+    spans: tuple[int, ...] = TURN_PHASES,
+    title: str = "A loaded G1 sole turned about the vertical: MPM against 3D-RFT models",
+    shaded: str = "turns +, -, +",
+) -> None:
+    """Draw each of ``rows`` (series key, axis label) over time per material (columns) for the sand and each model."""
     import matplotlib
 
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
     mats = list(series)
-    fig, axes = plt.subplots(2, len(mats), figsize=(4.2 * len(mats), 5.6), squeeze=False, sharex="col")
+    fig, axes = plt.subplots(len(rows), len(mats), figsize=(4.2 * len(mats), 2.8 * len(rows)), squeeze=False,
+                             sharex="col")  # fmt: skip
     for j, mat in enumerate(mats):
         for i, (label, s) in enumerate(series[mat].items()):
             wide = 2.5 if i == 0 else 1.2
             kw = {"color": f"C{i}" if i else "k", "lw": wide, "alpha": 0.6 if i == 0 else 1.0, "label": label}
-            axes[0, j].plot(s["time"], s["force_z"], **kw)
-            axes[1, j].plot(s["time"], s["torque_z"], **kw)
-        turns = series[mat][next(iter(series[mat]))]
+            for r, (key, _) in enumerate(rows):
+                axes[r, j].plot(s["time"], s[key], **kw)
+        first = series[mat][next(iter(series[mat]))]
         for ax in axes[:, j]:
-            for k in TURN_PHASES:
-                t = turns["time"][turns["phase"] == k]
+            for k in spans:
+                t = first["time"][first["phase"] == k]
                 ax.axvspan(t[0], t[-1], color="0.9" if k % 2 else "0.8", zorder=0)
             ax.grid(alpha=0.3)
-        axes[0, j].set(title=mat, ylabel="F_z [N]")
-        axes[1, j].set(xlabel="time [s] (shaded: turns +, -, +)", ylabel="tau_z about the sole centre [N m]")
+        for r, (_, label) in enumerate(rows):
+            axes[r, j].set(ylabel=label)
+        axes[0, j].set(title=mat)
+        axes[-1, j].set(xlabel=f"time [s] (shaded: {shaded})")
     axes[0, 0].legend(fontsize=7)
-    fig.suptitle("A loaded G1 sole turned about the vertical: MPM against 3D-RFT models", fontsize=10)
+    fig.suptitle(title, fontsize=10)
     fig.tight_layout()
     tmp = path.with_suffix(".tmp.png")
     fig.savefig(tmp, dpi=100)
     plt.close(fig)
     tmp.replace(path)
+
+
+def _series(rec: Any, force: np.ndarray, torque_z: np.ndarray | None = None) -> dict[str, np.ndarray]:
+    """Time series of one sand along a record, for the figures."""
+    out = {"time": rec.time, "phase": rec.phase, "force_z": force[:, 2], "force_xy": np.hypot(force[:, 0], force[:, 1])}
+    return out if torque_z is None else {**out, "torque_z": torque_z}
 
 
 def parse_args(argv: list[str] | None) -> argparse.Namespace:
@@ -149,21 +197,32 @@ def main(argv: list[str] | None = None) -> int:
     summary: dict[str, Any] = {"models": {k: {"path": p, "extensions": asdict(e)} for k, (e, p) in models.items()},
                                "materials": {}}  # fmt: skip
     series: dict[str, dict[str, dict[str, np.ndarray]]] = {}
+    drags: dict[str, dict[str, dict[str, np.ndarray]]] = {}
     for path, ds in datasets.items():
-        rec = ds.records[RECORD]
+        rec, drag = ds.records[RECORD], ds.records.get(DRAG)
         row = {"dataset": path, "source": ds.source, "split": ds.split[RECORD],
                ds.source: twist_response(rec.force, rec.torque[:, 2], rec.phase)}  # fmt: skip
-        series[ds.material] = {ds.source: {"time": rec.time, "phase": rec.phase, "force_z": rec.force[:, 2],
-                                           "torque_z": rec.torque[:, 2]}}  # fmt: skip
+        series[ds.material] = {ds.source: _series(rec, rec.force, rec.torque[:, 2])}
+        drag_row: dict[str, Any] = {}
+        if drag is not None:
+            drag_row[ds.source] = drag_response(drag.force, drag.phase)
+            drags[ds.material] = {ds.source: _series(drag, drag.force)}
         for label, (ext, _) in models.items():
-            wrench, datum = model_twist(ds, ext, cfg)
-            row[label] = {"datum_m": datum, **twist_response(wrench[:, :3], wrench[:, 5], rec.phase)}
-            series[ds.material][label] = {"time": rec.time, "phase": rec.phase, "force_z": wrench[:, 2],
-                                          "torque_z": wrench[:, 5]}  # fmt: skip
+            wrenches, datum = _replay(ds, ext, cfg)
+            w = wrenches[RECORD]
+            row[label] = {"datum_m": datum, **twist_response(w[:, :3], w[:, 5], rec.phase)}
+            series[ds.material][label] = _series(rec, w[:, :3], w[:, 5])
+            if drag is not None:
+                drag_row[label] = drag_response(wrenches[DRAG][:, :3], drag.phase)
+                drags[ds.material][label] = _series(drag, wrenches[DRAG][:, :3])
             print(f"{ds.material}: {label} replayed at datum {100 * datum:.2f} cm", flush=True)
-        summary["materials"][ds.material] = row
+        summary["materials"][ds.material] = {**row, "drag": drag_row or None}
     atomic_write_json(out / "summary.json", summary)
     _figure(series, out / "fig_twist.png")
+    if drags:
+        _figure(drags, out / "fig_drag.png", rows=(("force_z", "F_z [N]"), ("force_xy", "|F_xy| [N]")),
+                spans=(DRAG_PHASES[1],), title="A loaded G1 sole slid 10 cm sideways at constant depth, then at rest",
+                shaded="the slide")  # fmt: skip
     print(f"{out}/summary.json, fig_twist.png: {len(datasets)} materials, {len(models)} models")
     return 0
 
