@@ -98,7 +98,7 @@ def main() -> None:
         ax.set_ylabel(label)
         ax.grid(axis="y", alpha=0.3)
     axes[0].legend(fontsize=7)
-    fig.suptitle(f"{POLICY} on the 30 cm calibrated dry-sand bed: one fitted term changed at a time", fontsize=10)
+    fig.suptitle(f"{POLICY} on the 30 cm calibrated dry-sand bed: the fitted terms varied, and refits", fontsize=10)
     tmp = RESULTS_HOME / "fig_walk_gap_terms.tmp.png"
     fig.savefig(tmp, dpi=120)
     os.replace(tmp, RESULTS_HOME / "fig_walk_gap_terms.png")
