@@ -16,7 +16,7 @@ import sys
 from dataclasses import replace
 
 from gmloco.eval.calibration.build import CalibrationBuildCfg, build_dataset, smoke_build_cfg
-from gmloco.eval.calibration.protocol import EXPERIMENTS
+from gmloco.eval.calibration.protocol import EXPERIMENTS, PROBE_EXPERIMENTS
 
 
 def parse_args(argv: list[str] | None) -> argparse.Namespace:
@@ -25,7 +25,9 @@ def parse_args(argv: list[str] | None) -> argparse.Namespace:
     p.add_argument("--material", default="dry_sand", help="MATERIAL_PRESETS name")
     p.add_argument("--out", default="results/sand_calibration/dataset", help="output folder of <material>.npz")
     p.add_argument("--sand", choices=["mpm", "rft3d_reference"], default="mpm")
-    p.add_argument("--experiments", nargs="+", default=list(EXPERIMENTS), choices=EXPERIMENTS)
+    p.add_argument("--experiments", nargs="+", default=list(EXPERIMENTS), choices=EXPERIMENTS + PROBE_EXPERIMENTS,
+                   help="default: every experiment of the fit's datasets; the probes (slide_repress, twist_repress) "
+                   "go into a dataset of their own")  # fmt: skip
     p.add_argument("--split-seed", type=int, default=0, help="seed of the fit / held-out split")
     p.add_argument("--voxel-size", type=float, default=None, help="MPM voxel size [m] (default 0.02)")
     p.add_argument("--max-iterations", type=int, default=None, help="MPM rheology iterations (default 250)")

@@ -12,7 +12,7 @@ from typing import Any, Literal
 from gmloco.contact import MATERIAL_PRESETS, ContactRFT3DCfg, RftExtensionsCfg
 from gmloco.eval.calibration.dataset import CalibrationDataset, assign_split, save_dataset
 from gmloco.eval.calibration.mpm_sand import MpmSoleSandCfg, mpm_sole_smoke_cfg
-from gmloco.eval.calibration.protocol import EXPERIMENTS, SoleProtocolCfg, SoleSand, run_experiment
+from gmloco.eval.calibration.protocol import EXPERIMENTS, PROBE_EXPERIMENTS, SoleProtocolCfg, SoleSand, run_experiment
 
 __all__ = ["CalibrationBuildCfg", "build_dataset", "smoke_build_cfg"]
 
@@ -82,9 +82,9 @@ def build_dataset(cfg: CalibrationBuildCfg) -> tuple[Path, dict[str, Any]]:
     """
     if cfg.material not in MATERIAL_PRESETS:
         raise ValueError(f"unknown material {cfg.material!r}: choose from {sorted(MATERIAL_PRESETS)}")
-    unknown = set(cfg.experiments) - set(EXPERIMENTS)
+    unknown = set(cfg.experiments) - set(EXPERIMENTS + PROBE_EXPERIMENTS)
     if unknown:
-        raise ValueError(f"unknown experiments {sorted(unknown)}: choose from {EXPERIMENTS}")
+        raise ValueError(f"unknown experiments {sorted(unknown)}: choose from {EXPERIMENTS + PROBE_EXPERIMENTS}")
     t_all = time.perf_counter()
     records, timings = {}, {}
     for name in cfg.experiments:

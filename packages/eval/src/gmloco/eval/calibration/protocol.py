@@ -1,6 +1,8 @@
 # SPDX-License-Identifier: Apache-2.0
 """Sole-scale calibration experiments: a kinematic G1 sole driven through press, tilt, drag, lift-off, repeat, twist.
 
+The probes (:data:`PROBE_EXPERIMENTS`) press the sole again after a slide or a turn.
+
 Every experiment is a list of phases; each frame a phase turns the sole's pose and the sand force of the previous
 frame into the sole's velocity (force feedback only in ``press``: the load ramps until the vertical sand force
 reaches its target, e.g. the single-stance G1 weight). The same controller drives any sand: Newton MPM
@@ -29,6 +31,7 @@ import numpy as np
 __all__ = [
     "EXPERIMENTS",
     "G1_MASS",
+    "PROBE_EXPERIMENTS",
     "PhaseCfg",
     "SoleProtocolCfg",
     "SoleRecord",
@@ -45,6 +48,11 @@ GRAVITY = 9.81
 """Gravitational acceleration [m/s^2]."""
 EXPERIMENTS: tuple[str, ...] = ("press", "press_fast", "tilt", "drag", "drag_fast", "liftoff", "repeat", "twist")
 """Experiment names, in dataset order (``_fast``: 4x the press / drag speed, for rate dependence)."""
+PROBE_EXPERIMENTS: tuple[str, ...] = ("slide_repress", "twist_repress")
+"""Experiments outside the default set, recorded into datasets of their own (adding them to :data:`EXPERIMENTS`
+would redraw the fit / held-out split of every dataset): the sole pressed to the single-stance load slides 5 cm at
+``drag_speed`` (or turns +``twist_angle`` about the vertical) at constant depth, rests, and is pressed again until
+the sand carries the load. The extra depth that takes is what a slip or a turn costs a stance foot."""
 
 PhaseKind = Literal["press", "hold", "move", "pitch", "yaw"]
 
@@ -138,9 +146,12 @@ def experiment_phases(name: str, cfg: SoleProtocolCfg) -> list[PhaseCfg]:
         "liftoff": [press, hold, lift],
         "repeat": [p for _ in range(cfg.repeats) for p in (press, hold, lift)],
         "twist": [press, hold, *_swing("yaw", yaw, cfg.twist_rate)],
-    }
+        "slide_repress": [press, hold, PhaseCfg("move", 0.5 * s, velocity=(cfg.drag_speed, 0.0, 0.0)), hold, press,
+                          hold],
+        "twist_repress": [press, hold, PhaseCfg("yaw", yaw, rate=cfg.twist_rate), hold, press, hold],
+    }  # fmt: skip
     if name not in table:
-        raise ValueError(f"unknown experiment {name!r}: choose from {EXPERIMENTS}")
+        raise ValueError(f"unknown experiment {name!r}: choose from {EXPERIMENTS + PROBE_EXPERIMENTS}")
     return table[name]
 
 

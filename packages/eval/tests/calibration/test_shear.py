@@ -1,5 +1,5 @@
 # SPDX-License-Identifier: Apache-2.0
-"""The twist study: per-turn torque and support of a sand, and its command line, on float64 3D-RFT data."""
+"""The shear study: twist torque, support after a slide, re-press depth, and its command line, on float64 3D-RFT data."""
 
 from __future__ import annotations
 
@@ -13,8 +13,8 @@ from gmloco.contact import RftExtensionsCfg
 from gmloco.contact.extensions_io import save_rft_extensions
 from gmloco.eval.calibration.build import CalibrationBuildCfg, build_dataset
 from gmloco.eval.calibration.dataset import load_dataset
-from gmloco.eval.calibration.protocol import SoleProtocolCfg
-from gmloco.eval.calibration.twist import drag_response, main, twist_response
+from gmloco.eval.calibration.protocol import PROBE_EXPERIMENTS, SoleProtocolCfg
+from gmloco.eval.calibration.shear import drag_response, main, resupport_response, twist_response
 
 FAST = SoleProtocolCfg(time_scale=0.5)
 TRUTH = RftExtensionsCfg(lateral_scale=0.3)
@@ -70,10 +70,44 @@ def test_drag_response_reads_the_support_left_after_the_slide() -> None:
 
 
 def test_bad_input_exits_2(tmp_path: Path) -> None:
-    """A dataset without a twist record, a model without LABEL=, or a missing terms file: exit 2."""
+    """No dataset, one without a twist (or probe) record, a model without LABEL=, or a missing terms file: exit 2."""
     press_only = _dataset(tmp_path / "p", ("press",))
     assert main(["--dataset", str(press_only), "--out", str(tmp_path / "o")]) == 2
+    assert main(["--probes", str(press_only), "--out", str(tmp_path / "o")]) == 2
+    assert main(["--out", str(tmp_path / "o")]) == 2
     twist = _dataset(tmp_path / "t")
     assert main(["--dataset", str(twist), "--model", "no_label", "--out", str(tmp_path / "o")]) == 2
     assert main(["--dataset", str(twist), "--model", f"x={tmp_path / 'none.json'}", "--out", str(tmp_path / "o")]) == 2
     assert not (tmp_path / "o" / "summary.json").exists()
+
+
+def test_probe_on_the_reference_needs_no_extra_depth(tmp_path: Path) -> None:
+    """3D-RFT gives a slid or turned sole its support back at rest: re-pressing it needs < 1 mm; the CLI agrees."""
+    cfg = CalibrationBuildCfg(out_dir=str(tmp_path / "probes"), sand="rft3d_reference", protocol=FAST,
+                              reference_extensions=TRUTH, experiments=PROBE_EXPERIMENTS)  # fmt: skip
+    path = build_dataset(cfg)[0]
+    ds = load_dataset(path)
+    for name in PROBE_EXPERIMENTS:
+        rec = ds.records[name]
+        r = resupport_response(rec.depth, rec.force, rec.phase)
+        assert r["reloaded"] and abs(r["extra_depth_m"]) < 1e-3 and r["load_N"] == pytest.approx(FAST.weight, rel=0.1)
+    terms = save_rft_extensions(TRUTH, tmp_path / "truth.json", {"made_by": "test"})
+    assert main(["--probes", str(path), "--model", f"truth={terms}", "--out", str(tmp_path / "out")]) == 0
+    rows = json.loads((tmp_path / "out" / "summary.json").read_text())["probes"]["dry_sand"]
+    for name in PROBE_EXPERIMENTS:
+        assert rows[name]["truth"]["extra_depth_m"] == pytest.approx(
+            rows[name]["rft3d_reference"]["extra_depth_m"], abs=1e-9
+        )
+    assert (tmp_path / "out" / "fig_resupport.png").stat().st_size > 5_000
+
+
+def test_resupport_response_reads_the_extra_depth() -> None:
+    """Synthetic probe: loaded at 2 cm, support 30 N after the slide, loaded again at 5 cm: 3 cm extra."""
+    phase = np.repeat([0, 1, 2, 3, 4, 5], 4)
+    depth = np.select([phase <= 3, phase == 4], [0.02, 0.035], 0.05)
+    force = np.zeros((24, 3))
+    force[:, 2] = np.select([phase == 3, phase == 2], [30.0, 100.0], 343.0)
+    r = resupport_response(depth, force, phase)
+    assert r["extra_depth_m"] == pytest.approx(0.03) and r["support_after_move_N"] == 30.0 and r["reloaded"]
+    with pytest.raises(ValueError, match="not a probe record"):
+        resupport_response(depth, force, np.zeros(24, dtype=int))

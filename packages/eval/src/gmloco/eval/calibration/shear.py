@@ -1,5 +1,5 @@
 # SPDX-License-Identifier: Apache-2.0
-"""How hard a loaded sole's sand resists a turn about the vertical: MPM's ``twist`` records against 3D-RFT models.
+"""A loaded sole under shear: MPM's twist, drag and re-press records against 3D-RFT models.
 
 The ``twist`` experiment presses the G1 sole to the single-stance load, holds it, then turns it +a, -2a, +a about
 the vertical at a constant depth. Per record this reads the load before the turn and, for each of the three turns,
@@ -9,8 +9,8 @@ force left at the turn's end: a sand that yields under the twist loses its suppo
 dataset (the height of the surface the sole feels; see :mod:`gmloco.eval.calibration.fit`), so a stiff medium the
 sole barely enters is compared where the model carries load at all::
 
-    python -m gmloco.eval.calibration.twist --dataset results/sand_calibration/dataset/with_twist/dry_sand.npz
-        --model calibrated=results/sand_calibration/rft3d_calibrated.json --out results/sand_calibration/twist
+    python -m gmloco.eval.calibration.shear --dataset results/sand_calibration/dataset/with_twist/dry_sand.npz
+        --model calibrated=results/sand_calibration/rft3d_calibrated.json --out results/sand_calibration/shear
 
 writes ``summary.json`` and ``fig_twist.png`` there (exit 2 on a dataset without a twist record or a bad model).
 
@@ -18,25 +18,32 @@ The ``drag`` record asks the same of a slide: the sole, pressed to half the load
 constant depth and rests again. :func:`drag_response` reads the load before the slide, the mean horizontal force
 during it and the support left in the rest after it (``fig_drag.png``): a sand whose support returns when the sole
 stops forgets the slide; one whose support stays low keeps it.
+
+``--probes`` names datasets of the probe experiments (``protocol.PROBE_EXPERIMENTS``: the loaded sole slides 5 cm
+or turns, rests, and is pressed again until the sand carries the load). :func:`resupport_response` reads the extra
+depth the second press needed; each model runs the same experiment closed-loop on its own sand (its extra depth is
+its own, no replay), into ``summary.json``'s ``probes`` and ``fig_resupport.png``.
 """
 
 from __future__ import annotations
 
 import argparse
 import sys
-from dataclasses import asdict
+from dataclasses import asdict, replace
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 
-from gmloco.contact import RftExtensionsCfg
+from gmloco.contact import ContactRFT3DCfg, RftExtensionsCfg
 from gmloco.contact.extensions_io import load_rft_extensions
 from gmloco.deploy.atomic_io import atomic_write_json
 from gmloco.eval.calibration.dataset import CalibrationDataset, load_dataset
-from gmloco.eval.calibration.fit import SandFitCfg, fit_datum, held_terms, replay_wrenches
+from gmloco.eval.calibration.fit import SandFitCfg, dataset_material, fit_datum, held_terms, replay_wrenches
+from gmloco.eval.calibration.protocol import PROBE_EXPERIMENTS, SoleRecord, run_experiment
+from gmloco.eval.calibration.rft_sand import centred_sole_collider, rft_sole_sand
 
-__all__ = ["DRAG_PHASES", "TURN_PHASES", "drag_response", "main", "twist_response"]
+__all__ = ["DRAG_PHASES", "TURN_PHASES", "drag_response", "main", "resupport_response", "twist_response"]
 
 TURN_PHASES: tuple[int, int, int] = (2, 3, 4)
 """Phase indices of the three turns in a twist record (0 press, 1 hold)."""
@@ -102,6 +109,85 @@ def drag_response(force: np.ndarray, phase: np.ndarray) -> dict[str, float]:
     }
 
 
+def resupport_response(depth: np.ndarray, force: np.ndarray, phase: np.ndarray) -> dict[str, Any]:
+    """Return what re-pressing a sole after a slide or a turn took (phases: press, hold, move, rest, press, hold).
+
+    Args:
+        depth: Depth of the sole's lowest point [m], [T].
+        force: Sand force on the sole [N], [T, 3].
+        phase: Phase index per frame, [T] (the second press may have no frame: the sand already carried the load).
+
+    Returns:
+        ``load_N`` (mean F_z of the first hold), ``support_after_move_N`` (mean F_z of the rest after the move),
+        ``depth_loaded_m`` and ``depth_reloaded_m`` (mean depths of the two holds), ``extra_depth_m`` (their
+        difference) and ``reloaded`` (whether the last hold carries 95 % of the first one's load).
+    """
+    first, rest, last = phase == 1, phase == 3, phase == 5
+    if not (first.any() and rest.any() and last.any()):
+        raise ValueError("not a probe record: it needs holds at phases 1, 3 and 5 (see protocol.PROBE_EXPERIMENTS)")
+    load = float(np.mean(force[first, 2]))
+    d0, d1 = float(np.mean(depth[first])), float(np.mean(depth[last]))
+    return {
+        "load_N": load,
+        "support_after_move_N": float(np.mean(force[rest, 2])),
+        "depth_loaded_m": d0,
+        "depth_reloaded_m": d1,
+        "extra_depth_m": d1 - d0,
+        "reloaded": bool(np.mean(force[last, 2]) >= 0.95 * load),
+    }
+
+
+def _model_probe(ds: CalibrationDataset, name: str, ext: RftExtensionsCfg, cfg: SandFitCfg) -> SoleRecord:
+    """Run probe ``name`` closed-loop on a model's float64 sand (the dataset's protocol, sole and material)."""
+    model = ContactRFT3DCfg(at_rest=cfg.at_rest, extensions=replace(ext, dt=ds.protocol.frame_dt))
+    sand = rft_sole_sand(centred_sole_collider(ds.protocol, "box", cfg.resolution), model, dataset_material(ds))
+    return run_experiment(name, ds.protocol, sand)
+
+
+def _probes(paths: list[str], models: dict[str, tuple[RftExtensionsCfg, str]], cfg: SandFitCfg, out: Path) -> dict:
+    """Summarise every probe record of the datasets against each model's own run; draw ``fig_resupport.png``."""
+    rows: dict[str, dict[str, Any]] = {}
+    for path in paths:
+        ds = load_dataset(path)
+        for name in (n for n in ds.records if n in PROBE_EXPERIMENTS):
+            rec = ds.records[name]
+            row = {"dataset": path, ds.source: resupport_response(rec.depth, rec.force, rec.phase)}
+            for label, (ext, _) in models.items():
+                run = _model_probe(ds, name, ext, cfg)
+                row[label] = resupport_response(run.depth, run.force, run.phase)
+            rows.setdefault(ds.material, {})[name] = row
+    if rows:
+        _fig_resupport(rows, out / "fig_resupport.png")
+    return rows
+
+
+def _fig_resupport(rows: dict[str, dict[str, Any]], path: Path) -> None:
+    """Bars of the extra depth [cm] a re-press needed, per material and probe, for the sand and each model."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    cells = [(m, n) for m, probes in rows.items() for n in probes]
+    labels = [k for k in rows[cells[0][0]][cells[0][1]] if k != "dataset"]
+    fig, ax = plt.subplots(figsize=(1.6 + 1.6 * len(cells), 3.4))
+    width = 0.8 / len(labels)
+    for i, label in enumerate(labels):
+        xs = [c + (i - (len(labels) - 1) / 2) * width for c in range(len(cells))]
+        ax.bar(xs, [100 * rows[m][n][label]["extra_depth_m"] for m, n in cells], width, label=label,
+               color="k" if i == 0 else f"C{i}")  # fmt: skip
+    ax.set_xticks(range(len(cells)), [f"{m}\n{n}" for m, n in cells], fontsize=8)
+    ax.set_ylabel("extra depth to carry the load again [cm]")
+    ax.grid(axis="y", alpha=0.3)
+    ax.legend(fontsize=7)
+    ax.set_title("A loaded sole slid 5 cm or turned 15 deg, then pressed again", fontsize=10)
+    fig.tight_layout()
+    tmp = path.with_suffix(".tmp.png")
+    fig.savefig(tmp, dpi=100)
+    plt.close(fig)
+    tmp.replace(path)
+
+
 def _replay(ds: CalibrationDataset, ext: RftExtensionsCfg, cfg: SandFitCfg) -> tuple[dict[str, np.ndarray], float]:
     """Return a model's wrenches along the twist (and drag, if recorded) records and its fitted datum [m]."""
     datum = fit_datum(ds, ext, cfg)
@@ -160,9 +246,10 @@ def _series(rec: Any, force: np.ndarray, torque_z: np.ndarray | None = None) -> 
 def parse_args(argv: list[str] | None) -> argparse.Namespace:
     """Parse the command line."""
     p = argparse.ArgumentParser(
-        prog="python -m gmloco.eval.calibration.twist", description=(__doc__ or "").splitlines()[0]
+        prog="python -m gmloco.eval.calibration.shear", description=(__doc__ or "").splitlines()[0]
     )
-    p.add_argument("--dataset", action="append", required=True, help="<material>.npz with a twist record")
+    p.add_argument("--dataset", action="append", default=[], help="<material>.npz with a twist record")
+    p.add_argument("--probes", action="append", default=[], help="<material>.npz of probe experiments (re-press)")
     p.add_argument("--model", action="append", default=[], metavar="LABEL=PATH",
                    help="fitted extension terms (an extensions file or a fit report); the published 3D-RFT is always "
                    "included")  # fmt: skip
@@ -182,6 +269,12 @@ def main(argv: list[str] | None = None) -> int:
                 raise ValueError(f"--model expects LABEL=PATH, got {spec!r}")
             models[label] = (load_rft_extensions(path), path)
             held_terms(models[label][0])
+        if not a.dataset and not a.probes:
+            raise ValueError("give --dataset (a twist record) or --probes (probe records), or both")
+        for path in a.probes:
+            if not any(n in PROBE_EXPERIMENTS for n in load_dataset(path).records):
+                raise ValueError(f"{path}: no probe record; record one with python -m gmloco.eval.calibration "
+                                 f"--experiments {' '.join(PROBE_EXPERIMENTS)}")  # fmt: skip
         datasets = {}
         for path in a.dataset:
             ds = load_dataset(path)
@@ -217,13 +310,15 @@ def main(argv: list[str] | None = None) -> int:
                 drags[ds.material][label] = _series(drag, wrenches[DRAG][:, :3])
             print(f"{ds.material}: {label} replayed at datum {100 * datum:.2f} cm", flush=True)
         summary["materials"][ds.material] = {**row, "drag": drag_row or None}
+    summary["probes"] = _probes(a.probes, models, cfg, out) or None
     atomic_write_json(out / "summary.json", summary)
-    _figure(series, out / "fig_twist.png")
+    if series:
+        _figure(series, out / "fig_twist.png")
     if drags:
         _figure(drags, out / "fig_drag.png", rows=(("force_z", "F_z [N]"), ("force_xy", "|F_xy| [N]")),
                 spans=(DRAG_PHASES[1],), title="A loaded G1 sole slid 10 cm sideways at constant depth, then at rest",
                 shaded="the slide")  # fmt: skip
-    print(f"{out}/summary.json, fig_twist.png: {len(datasets)} materials, {len(models)} models")
+    print(f"{out}/summary.json: {len(datasets)} twist datasets, {len(a.probes)} probe datasets, {len(models)} models")
     return 0
 
 
