@@ -62,7 +62,7 @@ class RftExtensionsCfg:
     """Candidate terms beyond 3D-RFT (Agarwal, Goldman & Kamrin, PNAS 2023); every default is the published 3D-RFT.
 
     Each term is off at its neutral value and then leaves the force bit for bit unchanged (the kernels skip it).
-    The per-world values (all fields but ``footprint_radius`` and ``dt``) can be domain-randomized through
+    The per-world values (all fields but ``footprint_radius``, the loosening pair and ``dt``) can be domain-randomized through
     ``ContactRFT3D.set_extensions``. Reference: :mod:`gmloco.contact.reference.rft3d_extensions`.
     """
 
@@ -90,8 +90,17 @@ class RftExtensionsCfg:
     """(e) Added mass of the moving grains: a penetrating (v_z < 0), submerged, downward-facing element gets
     F_z = c_am rho_c |n_z| dS (v_z^2 - d a_z), i.e. -d(m_a v_z)/dt with m_a = c_am rho_c |n_z| dS d
     (Katsuragi & Durian 2007 inertial drag) and a_z by finite difference over ``dt`` [-]; 0 = off."""
+    loosening_depth: float = 0.0
+    """(f) Loosening by horizontal travel: an element that has travelled u metres sideways while submerged meets the
+    sand as if it were ``loosening_depth`` (1 - exp(-u / loosening_length)) [m] shallower, in loading and at rest
+    alike, so support lost to a slide or a turn comes back only by sinking further (MPM sand keeps 14-29 % of its
+    support at rest after a 10 cm slide, 3D-RFT all of it: ``results/sand_calibration/shear/``). Travel resets out of
+    the sand. 0 = off. Float64 reference only: the Warp models refuse a non-zero value."""
+    loosening_length: float = 0.05
+    """(f) Horizontal travel over which the loosening approaches ``loosening_depth`` [m]."""
     dt: float = 0.005
-    """Physics step of the finite-difference acceleration of ``added_mass`` [s] (state update once per step)."""
+    """Physics step of the finite-difference acceleration of ``added_mass`` and of the travel of ``loosening_depth``
+    [s] (state update once per step)."""
 
     def __post_init__(self) -> None:
         """Refuse values outside each term's physical range (a message per field)."""
@@ -104,6 +113,8 @@ class RftExtensionsCfg:
             "footprint_radius": self.footprint_radius >= 0.0,
             "overburden": self.overburden >= 0.0,
             "added_mass": self.added_mass >= 0.0,
+            "loosening_depth": self.loosening_depth >= 0.0,
+            "loosening_length": self.loosening_length > 0.0,
             "dt": self.dt > 0.0,
         }
         for name, ok in checks.items():
@@ -115,12 +126,14 @@ class RftExtensionsCfg:
     def is_off(self) -> bool:
         """Whether every term is at its neutral value (the model is the published 3D-RFT)."""
         return self == RftExtensionsCfg(depth_ref=self.depth_ref, unloading_tolerance=self.unloading_tolerance,
-                                        dt=self.dt)  # fmt: skip
+                                        loosening_length=self.loosening_length, dt=self.dt)  # fmt: skip
 
     @property
     def stateful(self) -> bool:
         """Whether a term reads per-element memory (z_max, footprint, previous velocity)."""
-        return self.plastic_unloading or self.footprint_radius > 0.0 or self.added_mass > 0.0
+        return (
+            self.plastic_unloading or self.footprint_radius > 0.0 or self.added_mass > 0.0 or self.loosening_depth > 0.0
+        )
 
 
 @dataclass(frozen=True)

@@ -7,7 +7,7 @@ and the calibration fitter drives :func:`replay_foot_forces` with recorded foot 
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 
@@ -25,6 +25,7 @@ __all__ = [
     "advance_ext_state",
     "ext_depth_law",
     "ext_vertical_forces",
+    "loosening_shift",
     "replay_foot_forces",
     "rft3d_extended_forces",
 ]
@@ -84,12 +85,21 @@ class ExtState:
     """Previous step's element velocity [m/s], [N, 3]."""
     ema_tau: np.ndarray = field(default_factory=lambda: np.zeros(0))
     """Velocity-reversal counter tau_r [-], [N]."""
+    travel: np.ndarray = field(default_factory=lambda: np.zeros(0))
+    """Horizontal travel while submerged since the element entered the sand [m], [N] (``loosening_depth``)."""
 
     @classmethod
     def zeros(cls, num_points: int) -> ExtState:
         """Return the reset state of ``num_points`` elements."""
         z3 = np.zeros((num_points, 3))
-        return cls(np.zeros(num_points), z3.copy(), z3.copy(), z3.copy(), np.zeros(num_points))
+        return cls(np.zeros(num_points), z3.copy(), z3.copy(), z3.copy(), np.zeros(num_points), np.zeros(num_points))
+
+
+def loosening_shift(travel: np.ndarray, ext: RftExtensionsCfg) -> np.ndarray:
+    """Return how much shallower each element meets the sand after its horizontal travel [m], [N] (term (f))."""
+    if ext.loosening_depth <= 0.0:
+        return np.zeros_like(np.asarray(travel, dtype=np.float64))
+    return ext.loosening_depth * (1.0 - np.exp(-np.asarray(travel, dtype=np.float64) / ext.loosening_length))
 
 
 def rft3d_extended_forces(
@@ -111,6 +121,10 @@ def rft3d_extended_forces(
     ext = cfg.extensions
     if cfg.at_rest not in ("none", "unloading"):
         raise ValueError(f"reference replay supports at_rest 'none' or 'unloading', not {cfg.at_rest!r}")
+    if ext.loosening_depth > 0.0:  # (f): the element meets the sand that much shallower, in loading and at rest
+        shift = loosening_shift(state.travel, ext)
+        points = np.asarray(points, dtype=np.float64) + shift[:, None] * np.array([0.0, 0.0, 1.0])
+        state = replace(state, depth_max=np.maximum(state.depth_max - shift, 0.0))
     depth = surface_z - np.asarray(points, dtype=np.float64)[:, 2]
     law = None if ext.depth_exponent == 1.0 and ext.depth_saturation == 0.0 else (lambda d: ext_depth_law(d, ext))
     mat = {"rho_c": material.rho_c, "mu_int": material.mu_int, "mu_surf": material.mu_surf}
@@ -155,7 +169,12 @@ def advance_ext_state(
     reversal = np.sum(velocities * state.vel_prev, axis=1) < 0.0
     tau = np.where(reversal & (state.ema_tau < 1.0), np.minimum(1.0, state.ema_tau + cfg.ema_rate), state.ema_tau)
     tau = np.where(depth > 0.0, tau, 0.0)
-    return ExtState(depth_max, footprint, anchor, np.asarray(velocities, dtype=np.float64).copy(), tau)
+    travel = state.travel if len(state.travel) == len(depth) else np.zeros_like(depth)
+    if cfg.extensions.loosening_depth > 0.0:
+        v = np.asarray(velocities, dtype=np.float64)
+        step = np.hypot(v[:, 0], v[:, 1]) * cfg.extensions.dt
+        travel = np.where(depth > 0.0, travel + step, 0.0)
+    return ExtState(depth_max, footprint, anchor, np.asarray(velocities, dtype=np.float64).copy(), tau, travel)
 
 
 def replay_foot_forces(

@@ -57,6 +57,8 @@ FIT_BOUNDS: dict[str, tuple[float, float, float]] = {
     "lateral_scale": (0.0, 2.0, 1.0),
     "overburden": (0.0, 10.0, 0.0),
     "added_mass": (0.0, 10.0, 0.0),
+    "loosening_depth": (0.0, 0.05, 0.0),
+    "loosening_length": (0.005, 0.5, 0.05),
 }
 """(lower, upper, neutral start) of each fitted value; ``depth_saturation`` is fitted as 1 / d_s [1/m] (0 = off).
 

@@ -1,0 +1,75 @@
+# SPDX-License-Identifier: Apache-2.0
+"""Term (f) of RftExtensionsCfg, loosening by horizontal travel, on the float64 reference (no Warp kernel yet)."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from gmloco.contact import MATERIAL_PRESETS, ContactRFT3DCfg, RftExtensionsCfg, make_contact_model
+from gmloco.contact.reference.rft3d_extensions import (
+    ExtState,
+    advance_ext_state,
+    loosening_shift,
+    rft3d_extended_forces,
+)
+
+LOOSE = RftExtensionsCfg(loosening_depth=0.01, loosening_length=0.05, dt=0.01)
+
+
+def _sole() -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """A flat 10 x 4 cm plate of 4 x 4 downward-facing elements at the origin (points, normals, areas)."""
+    xs, ys = np.meshgrid(np.linspace(-0.04, 0.04, 4), np.linspace(-0.015, 0.015, 4))
+    pts = np.stack([xs.ravel(), ys.ravel(), np.zeros(16)], 1)
+    return pts, np.tile([0.0, 0.0, -1.0], (16, 1)), np.full(16, 0.1 * 0.04 / 16)
+
+
+def _support_after_slide(ext: RftExtensionsCfg, slide_m: float, depth: float = 0.02) -> tuple[float, float]:
+    """Press a plate to ``depth``, slide it ``slide_m`` at constant depth, stop; return (F_z before, F_z at rest after)."""
+    cfg = ContactRFT3DCfg(at_rest="unloading", extensions=ext)
+    pts, normals, areas = _sole()
+    mat = MATERIAL_PRESETS["dry_sand"]
+    state = ExtState.zeros(16)
+    down, side, rest = np.array([0.0, 0.0, -0.05]), np.array([0.1, 0.0, 0.0]), np.zeros(3)
+    z, x, fz = 0.0, 0.0, 0.0
+    phases = [(down, round(depth / 0.05 / ext.dt)), (rest, 5), (side, round(slide_m / 0.1 / ext.dt)), (rest, 5)]
+    out = []
+    for vel, steps in phases:
+        for _ in range(steps):
+            p = pts + np.array([x, 0.0, -z])
+            v = np.tile(vel, (16, 1))
+            fz = float(rft3d_extended_forces(p, normals, v, areas, state, cfg, mat)[:, 2].sum())
+            state = advance_ext_state(state, p, normals, v, cfg)
+            z, x = z - vel[2] * ext.dt, x + vel[0] * ext.dt
+        out.append(fz)
+    return out[1], out[3]
+
+
+def test_off_by_default_and_neutral() -> None:
+    """loosening_depth 0 is the published model (is_off, not stateful); the plate keeps its support after a slide."""
+    assert RftExtensionsCfg(loosening_length=0.2).is_off and not RftExtensionsCfg().stateful
+    before, after = _support_after_slide(RftExtensionsCfg(dt=0.01), 0.1)
+    assert before > 0.0 and after == pytest.approx(before, rel=1e-9)
+
+
+def test_a_slide_costs_support_that_grows_with_travel() -> None:
+    """With loosening the support at rest after a slide falls below the support before, more after a longer slide."""
+    before, after_short = _support_after_slide(LOOSE, 0.02)
+    _, after_long = _support_after_slide(LOOSE, 0.10)
+    assert 0.0 < after_long < after_short < before
+
+
+def test_shift_follows_its_law() -> None:
+    """Shift = d_l (1 - exp(-u / L)): 0 at no travel, d_l (1 - 1/e) at u = L, below d_l always."""
+    u = np.array([0.0, 0.05, 10.0])
+    np.testing.assert_allclose(loosening_shift(u, LOOSE), [0.0, 0.01 * (1 - np.exp(-1.0)), 0.01], rtol=1e-12)
+    np.testing.assert_array_equal(loosening_shift(u, RftExtensionsCfg()), 0.0)
+
+
+def test_bad_values_and_the_warp_model_refuse() -> None:
+    """A negative depth or a non-positive length is refused; the Warp model refuses the term (reference only)."""
+    for bad in ({"loosening_depth": -0.01}, {"loosening_length": 0.0}):
+        with pytest.raises(ValueError, match="loosening"):
+            RftExtensionsCfg(**bad)
+    with pytest.raises(NotImplementedError, match="float64 reference only"):
+        make_contact_model(ContactRFT3DCfg(extensions=LOOSE), 1, 1, "cpu")
