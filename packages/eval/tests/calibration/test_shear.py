@@ -75,6 +75,7 @@ def test_bad_input_exits_2(tmp_path: Path) -> None:
     assert main(["--dataset", str(press_only), "--out", str(tmp_path / "o")]) == 2
     assert main(["--probes", str(press_only), "--out", str(tmp_path / "o")]) == 2
     assert main(["--out", str(tmp_path / "o")]) == 2
+    assert main(["--predict", "mud", "--out", str(tmp_path / "o")]) == 2
     twist = _dataset(tmp_path / "t")
     assert main(["--dataset", str(twist), "--model", "no_label", "--out", str(tmp_path / "o")]) == 2
     assert main(["--dataset", str(twist), "--model", f"x={tmp_path / 'none.json'}", "--out", str(tmp_path / "o")]) == 2
@@ -99,6 +100,17 @@ def test_probe_on_the_reference_needs_no_extra_depth(tmp_path: Path) -> None:
             rows[name]["rft3d_reference"]["extra_depth_m"], abs=1e-9
         )
     assert (tmp_path / "out" / "fig_resupport.png").stat().st_size > 5_000
+
+
+def test_prediction_needs_no_record_and_sees_the_loosening(tmp_path: Path) -> None:
+    """--predict runs each model's probes on a material alone; a loosening model needs extra depth, 3D-RFT none."""
+    loose = save_rft_extensions(RftExtensionsCfg(loosening_depth=0.01, loosening_length=0.02), tmp_path / "l.json",
+                                {"made_by": "test"})  # fmt: skip
+    assert main(["--predict", "dry_sand", "--model", f"loose={loose}", "--out", str(tmp_path / "out")]) == 0
+    pred = json.loads((tmp_path / "out" / "summary.json").read_text())["probe_predictions"]["dry_sand"]
+    slide = pred["slide_repress"]
+    assert abs(slide["published 3D-RFT"]["extra_depth_m"]) < 1e-3
+    assert slide["loose"]["extra_depth_m"] > 0.003 and slide["loose"]["reloaded"]
 
 
 def test_resupport_response_reads_the_extra_depth() -> None:

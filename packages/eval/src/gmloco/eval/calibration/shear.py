@@ -22,7 +22,9 @@ stops forgets the slide; one whose support stays low keeps it.
 ``--probes`` names datasets of the probe experiments (``protocol.PROBE_EXPERIMENTS``: the loaded sole slides 5 cm
 or turns, rests, and is pressed again until the sand carries the load). :func:`resupport_response` reads the extra
 depth the second press needed; each model runs the same experiment closed-loop on its own sand (its extra depth is
-its own, no replay), into ``summary.json``'s ``probes`` and ``fig_resupport.png``.
+its own, no replay), into ``summary.json``'s ``probes`` and ``fig_resupport.png``. ``--predict MATERIAL`` writes
+each model's probe responses with no MPM record (``probe_predictions``): a prediction made before the MPM probes
+are recorded.
 """
 
 from __future__ import annotations
@@ -35,15 +37,23 @@ from typing import Any
 
 import numpy as np
 
-from gmloco.contact import ContactRFT3DCfg, RftExtensionsCfg
+from gmloco.contact import MATERIAL_PRESETS, ContactRFT3DCfg, MaterialCfg, RftExtensionsCfg
 from gmloco.contact.extensions_io import load_rft_extensions
 from gmloco.deploy.atomic_io import atomic_write_json
 from gmloco.eval.calibration.dataset import CalibrationDataset, load_dataset
 from gmloco.eval.calibration.fit import SandFitCfg, dataset_material, fit_datum, held_terms, replay_wrenches
-from gmloco.eval.calibration.protocol import PROBE_EXPERIMENTS, SoleRecord, run_experiment
+from gmloco.eval.calibration.protocol import PROBE_EXPERIMENTS, SoleProtocolCfg, SoleRecord, run_experiment
 from gmloco.eval.calibration.rft_sand import centred_sole_collider, rft_sole_sand
 
-__all__ = ["DRAG_PHASES", "TURN_PHASES", "drag_response", "main", "resupport_response", "twist_response"]
+__all__ = [
+    "DRAG_PHASES",
+    "TURN_PHASES",
+    "drag_response",
+    "main",
+    "predict_probes",
+    "resupport_response",
+    "twist_response",
+]
 
 TURN_PHASES: tuple[int, int, int] = (2, 3, 4)
 """Phase indices of the three turns in a twist record (0 press, 1 hold)."""
@@ -137,11 +147,30 @@ def resupport_response(depth: np.ndarray, force: np.ndarray, phase: np.ndarray) 
     }
 
 
-def _model_probe(ds: CalibrationDataset, name: str, ext: RftExtensionsCfg, cfg: SandFitCfg) -> SoleRecord:
-    """Run probe ``name`` closed-loop on a model's float64 sand (the dataset's protocol, sole and material)."""
-    model = ContactRFT3DCfg(at_rest=cfg.at_rest, extensions=replace(ext, dt=ds.protocol.frame_dt))
-    sand = rft_sole_sand(centred_sole_collider(ds.protocol, "box", cfg.resolution), model, dataset_material(ds))
-    return run_experiment(name, ds.protocol, sand)
+def _model_probe(
+    protocol: SoleProtocolCfg, material: MaterialCfg, name: str, ext: RftExtensionsCfg, cfg: SandFitCfg
+) -> SoleRecord:
+    """Run probe ``name`` closed-loop on a model's float64 sand (``protocol``'s sole and frame time, ``material``)."""
+    model = ContactRFT3DCfg(at_rest=cfg.at_rest, extensions=replace(ext, dt=protocol.frame_dt))
+    sand = rft_sole_sand(centred_sole_collider(protocol, "box", cfg.resolution), model, material)
+    return run_experiment(name, protocol, sand)
+
+
+def predict_probes(materials: list[str], models: dict[str, tuple[RftExtensionsCfg, str]], cfg: SandFitCfg) -> dict:
+    """Return each model's probe responses per material at the default protocol, with no MPM record needed.
+
+    Written before the MPM probes are recorded, this is the models' prediction, to be held against them.
+    """
+    out: dict[str, Any] = {}
+    for mat in materials:
+        if mat not in MATERIAL_PRESETS:
+            raise ValueError(f"unknown material {mat!r}: choose from {sorted(MATERIAL_PRESETS)}")
+        for name in PROBE_EXPERIMENTS:
+            for label, (ext, _) in models.items():
+                run = _model_probe(SoleProtocolCfg(), MATERIAL_PRESETS[mat], name, ext, cfg)
+                out.setdefault(mat, {}).setdefault(name, {})[label] = resupport_response(run.depth, run.force,
+                                                                                         run.phase)  # fmt: skip
+    return out
 
 
 def _probes(paths: list[str], models: dict[str, tuple[RftExtensionsCfg, str]], cfg: SandFitCfg, out: Path) -> dict:
@@ -153,7 +182,7 @@ def _probes(paths: list[str], models: dict[str, tuple[RftExtensionsCfg, str]], c
             rec = ds.records[name]
             row = {"dataset": path, ds.source: resupport_response(rec.depth, rec.force, rec.phase)}
             for label, (ext, _) in models.items():
-                run = _model_probe(ds, name, ext, cfg)
+                run = _model_probe(ds.protocol, dataset_material(ds), name, ext, cfg)
                 row[label] = resupport_response(run.depth, run.force, run.phase)
             rows.setdefault(ds.material, {})[name] = row
     if rows:
@@ -250,6 +279,8 @@ def parse_args(argv: list[str] | None) -> argparse.Namespace:
     )
     p.add_argument("--dataset", action="append", default=[], help="<material>.npz with a twist record")
     p.add_argument("--probes", action="append", default=[], help="<material>.npz of probe experiments (re-press)")
+    p.add_argument("--predict", action="append", default=[], metavar="MATERIAL",
+                   help="each model's probe responses on this material with no MPM record (a prediction)")  # fmt: skip
     p.add_argument("--model", action="append", default=[], metavar="LABEL=PATH",
                    help="fitted extension terms (an extensions file or a fit report); the published 3D-RFT is always "
                    "included")  # fmt: skip
@@ -269,8 +300,11 @@ def main(argv: list[str] | None = None) -> int:
                 raise ValueError(f"--model expects LABEL=PATH, got {spec!r}")
             models[label] = (load_rft_extensions(path), path)
             held_terms(models[label][0])
-        if not a.dataset and not a.probes:
-            raise ValueError("give --dataset (a twist record) or --probes (probe records), or both")
+        if not a.dataset and not a.probes and not a.predict:
+            raise ValueError("give --dataset (a twist record), --probes (probe records) or --predict MATERIAL")
+        unknown = sorted(set(a.predict) - set(MATERIAL_PRESETS))
+        if unknown:
+            raise ValueError(f"--predict {unknown}: unknown material; choose from {sorted(MATERIAL_PRESETS)}")
         for path in a.probes:
             if not any(n in PROBE_EXPERIMENTS for n in load_dataset(path).records):
                 raise ValueError(f"{path}: no probe record; record one with python -m gmloco.eval.calibration "
@@ -311,6 +345,7 @@ def main(argv: list[str] | None = None) -> int:
             print(f"{ds.material}: {label} replayed at datum {100 * datum:.2f} cm", flush=True)
         summary["materials"][ds.material] = {**row, "drag": drag_row or None}
     summary["probes"] = _probes(a.probes, models, cfg, out) or None
+    summary["probe_predictions"] = predict_probes(a.predict, models, cfg) or None
     atomic_write_json(out / "summary.json", summary)
     if series:
         _figure(series, out / "fig_twist.png")
