@@ -110,7 +110,7 @@ def test_prediction_needs_no_record_and_sees_the_loosening(tmp_path: Path) -> No
     pred = json.loads((tmp_path / "out" / "summary.json").read_text())["probe_predictions"]["dry_sand"]
     slide = pred["slide_repress"]
     assert abs(slide["published 3D-RFT"]["extra_depth_m"]) < 1e-3
-    assert slide["loose"]["extra_depth_m"] > 0.003 and slide["loose"]["reloaded"]
+    assert slide["loose"]["extra_depth_m"] > 0.003 and slide["loose"]["reloaded"] and slide["loose"]["loaded"]
 
 
 def test_resupport_response_reads_the_extra_depth() -> None:
@@ -121,5 +121,7 @@ def test_resupport_response_reads_the_extra_depth() -> None:
     force[:, 2] = np.select([phase == 3, phase == 2], [30.0, 100.0], 343.0)
     r = resupport_response(depth, force, phase)
     assert r["extra_depth_m"] == pytest.approx(0.03) and r["support_after_move_N"] == 30.0 and r["reloaded"]
+    assert "loaded" not in r and resupport_response(depth, force, phase, 343.0)["loaded"]
+    assert not resupport_response(depth, force, phase, 1000.0)["loaded"]  # the sand never carried that load
     with pytest.raises(ValueError, match="not a probe record"):
         resupport_response(depth, force, np.zeros(24, dtype=int))

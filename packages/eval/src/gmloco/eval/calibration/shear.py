@@ -119,18 +119,23 @@ def drag_response(force: np.ndarray, phase: np.ndarray) -> dict[str, float]:
     }
 
 
-def resupport_response(depth: np.ndarray, force: np.ndarray, phase: np.ndarray) -> dict[str, Any]:
+def resupport_response(
+    depth: np.ndarray, force: np.ndarray, phase: np.ndarray, target_load: float | None = None
+) -> dict[str, Any]:
     """Return what re-pressing a sole after a slide or a turn took (phases: press, hold, move, rest, press, hold).
 
     Args:
         depth: Depth of the sole's lowest point [m], [T].
         force: Sand force on the sole [N], [T, 3].
         phase: Phase index per frame, [T] (the second press may have no frame: the sand already carried the load).
+        target_load: The presses' target [N] (the protocol's weight); None leaves ``loaded`` out.
 
     Returns:
         ``load_N`` (mean F_z of the first hold), ``support_after_move_N`` (mean F_z of the rest after the move),
         ``depth_loaded_m`` and ``depth_reloaded_m`` (mean depths of the two holds), ``extra_depth_m`` (their
-        difference) and ``reloaded`` (whether the last hold carries 95 % of the first one's load).
+        difference), ``reloaded`` (whether the last hold carries 95 % of the first one's load) and, with
+        ``target_load``, ``loaded`` (whether the first press reached 95 % of it: a sand that cannot carry the load
+        makes both presses run to their time limit, and the extra depth then measures nothing).
     """
     first, rest, last = phase == 1, phase == 3, phase == 5
     if not (first.any() and rest.any() and last.any()):
@@ -144,6 +149,7 @@ def resupport_response(depth: np.ndarray, force: np.ndarray, phase: np.ndarray) 
         "depth_reloaded_m": d1,
         "extra_depth_m": d1 - d0,
         "reloaded": bool(np.mean(force[last, 2]) >= 0.95 * load),
+        **({} if target_load is None else {"loaded": bool(load >= 0.95 * target_load)}),
     }
 
 
@@ -168,8 +174,8 @@ def predict_probes(materials: list[str], models: dict[str, tuple[RftExtensionsCf
         for name in PROBE_EXPERIMENTS:
             for label, (ext, _) in models.items():
                 run = _model_probe(SoleProtocolCfg(), MATERIAL_PRESETS[mat], name, ext, cfg)
-                out.setdefault(mat, {}).setdefault(name, {})[label] = resupport_response(run.depth, run.force,
-                                                                                         run.phase)  # fmt: skip
+                response = resupport_response(run.depth, run.force, run.phase, SoleProtocolCfg().weight)
+                out.setdefault(mat, {}).setdefault(name, {})[label] = response
     return out
 
 
@@ -180,10 +186,10 @@ def _probes(paths: list[str], models: dict[str, tuple[RftExtensionsCfg, str]], c
         ds = load_dataset(path)
         for name in (n for n in ds.records if n in PROBE_EXPERIMENTS):
             rec = ds.records[name]
-            row = {"dataset": path, ds.source: resupport_response(rec.depth, rec.force, rec.phase)}
+            row = {"dataset": path, ds.source: resupport_response(rec.depth, rec.force, rec.phase, ds.protocol.weight)}
             for label, (ext, _) in models.items():
                 run = _model_probe(ds.protocol, dataset_material(ds), name, ext, cfg)
-                row[label] = resupport_response(run.depth, run.force, run.phase)
+                row[label] = resupport_response(run.depth, run.force, run.phase, ds.protocol.weight)
             rows.setdefault(ds.material, {})[name] = row
     if rows:
         _fig_resupport(rows, out / "fig_resupport.png")
