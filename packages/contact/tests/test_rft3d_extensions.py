@@ -38,6 +38,7 @@ TERMS: dict[str, RftExtensionsCfg] = {
     "plastic_unloading": RftExtensionsCfg(plastic_unloading=True, footprint_radius=0.05),
     "overburden": RftExtensionsCfg(overburden=2.0),
     "added_mass": RftExtensionsCfg(added_mass=1.5),
+    "loosening": RftExtensionsCfg(loosening_depth=0.01, loosening_length=0.02),
     "all": RftExtensionsCfg(
         depth_exponent=0.8,
         depth_saturation=0.04,

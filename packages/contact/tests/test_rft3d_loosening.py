@@ -1,12 +1,15 @@
 # SPDX-License-Identifier: Apache-2.0
-"""Term (f) of RftExtensionsCfg, loosening by horizontal travel, on the float64 reference (no Warp kernel yet)."""
+"""Term (f) of RftExtensionsCfg, loosening by horizontal travel, on the float64 reference.
+
+The kernels' parity with the reference is in test_rft3d_extensions.py.
+"""
 
 from __future__ import annotations
 
 import numpy as np
 import pytest
 
-from gmloco.contact import MATERIAL_PRESETS, ContactRFT3DCfg, RftExtensionsCfg, make_contact_model
+from gmloco.contact import MATERIAL_PRESETS, ContactRFT3DCfg, RftExtensionsCfg
 from gmloco.contact.reference.rft3d_extensions import (
     ExtState,
     advance_ext_state,
@@ -66,10 +69,8 @@ def test_shift_follows_its_law() -> None:
     np.testing.assert_array_equal(loosening_shift(u, RftExtensionsCfg()), 0.0)
 
 
-def test_bad_values_and_the_warp_model_refuse() -> None:
-    """A negative depth or a non-positive length is refused; the Warp model refuses the term (reference only)."""
+def test_bad_values_are_refused() -> None:
+    """A negative depth or a non-positive length is refused, naming the field."""
     for bad in ({"loosening_depth": -0.01}, {"loosening_length": 0.0}):
         with pytest.raises(ValueError, match="loosening"):
             RftExtensionsCfg(**bad)
-    with pytest.raises(NotImplementedError, match="float64 reference only"):
-        make_contact_model(ContactRFT3DCfg(extensions=LOOSE), 1, 1, "cpu")

@@ -95,7 +95,7 @@ class RftExtensionsCfg:
     sand as if it were ``loosening_depth`` (1 - exp(-u / loosening_length)) [m] shallower, in loading and at rest
     alike, so support lost to a slide or a turn comes back only by sinking further (MPM sand keeps 14-29 % of its
     support at rest after a 10 cm slide, 3D-RFT all of it: ``results/sand_calibration/shear/``). Travel resets out of
-    the sand. 0 = off. Float64 reference only: the Warp models refuse a non-zero value."""
+    the sand. 0 = off. Not domain-randomized per world (one value per model)."""
     loosening_length: float = 0.05
     """(f) Horizontal travel over which the loosening approaches ``loosening_depth`` [m]."""
     dt: float = 0.005

@@ -22,6 +22,7 @@ from gmloco.contact.kernels_rft3d_ext import (
     RftExtParams,
     ext_depth_law,
     ext_lateral,
+    ext_loosening_shift,
     ext_vertical_force,
     ext_within_crater,
 )
@@ -31,6 +32,7 @@ from gmloco.contact.kernels_state import (
     AtRestParams,
     ElementState,
     advance_element_state,
+    advance_travel,
     at_rest_filter,
     crater_friction,
     elastic_depth,
@@ -255,6 +257,12 @@ def rft3d_element_force_ext(
     area = m.areas[p]
     xi = media_scaling(mat[0], mat[1], m.gravity)
     depth_max = state.depth_max[w, f, p]
+    if ext.loosening != 0:  # (f) loosening: the element meets the sand this much shallower, loading and at rest
+        shift = ext_loosening_shift(state.travel[w, f, p], ext)
+        depth = depth - shift
+        depth_max = wp.max(depth_max - shift, 0.0)
+        if depth <= 0.0:
+            return wp.vec3(0.0)
     force = wp.vec3(0.0)
     if ext_within_crater(depth, depth_max, ext, w):
         force = wp.vec3(0.0)  # (c) plastic unloading: no force until z_max is re-reached
@@ -482,6 +490,8 @@ def _rft3d_foot_wrench_kernel(
                 # (registers, see above); unused for a non-finite foot (depth 0: no anchor update)
                 xn = foot_point_kinematics(pos, rot, lin_vel, ang_vel, model.points_b[p], model.normals_b[p])
                 advance_element_state(state_out, model.rest, 0, w, f, p, xn[0], xn[1], kin[2], depth, force)
+                if wp.static(ext):
+                    advance_travel(state_out, model.rest, w, f, p, kin[2], depth)
         wrench = foot_wrench_block_sum(wp.spatial_vector(force_sum, torque_sum), pos, rot, com, lane, nan_count_out)
         if lane == 0:
             wrench_out[w, f] = wrench

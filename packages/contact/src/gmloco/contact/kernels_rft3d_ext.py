@@ -2,7 +2,7 @@
 """Candidate terms beyond 3D-RFT (``RftExtensionsCfg``) as Warp functions.
 
 Depth law, lateral scale, plastic unloading, overburden,
-added mass. Each is skipped when off, so the published force is unchanged bit for bit.
+added mass, loosening by horizontal travel. Each is skipped when off, so the published force is unchanged bit for bit.
 
 Per-world values live in one array ``values[world % values.shape[0], column]`` (shared or domain-randomized, MuJoCo
 Warp's batch-modulo rule); the on/off flags are by-value struct fields fixed at model build time.
@@ -20,6 +20,7 @@ __all__ = [
     "RftExtParams",
     "ext_depth_law",
     "ext_lateral",
+    "ext_loosening_shift",
     "ext_vertical_force",
     "ext_within_crater",
     "make_ext_params",
@@ -56,6 +57,9 @@ class RftExtParams:
     added_mass: int
     values: wp.array2d[float]
     dt: float
+    loosening: int
+    loosening_depth: float
+    loosening_length: float
 
 
 @wp.func
@@ -119,6 +123,17 @@ def ext_vertical_force(
     return f_z
 
 
+@wp.func
+def ext_loosening_shift(travel: float, ext: RftExtParams) -> float:
+    """Return how much shallower an element meets the sand after ``travel`` [m] sideways while submerged [m].
+
+    d_l (1 - exp(-u / L)) (term (f), ``RftExtensionsCfg.loosening_depth``); 0 when off.
+    """
+    if ext.loosening == 0:
+        return 0.0
+    return ext.loosening_depth * (1.0 - wp.exp(-travel / ext.loosening_length))
+
+
 def rft_ext_values(cfg: Any) -> np.ndarray:
     """Return the per-world value row of an ``RftExtensionsCfg`` in :data:`EXT_COLUMNS` order, [1, 7]."""
     return np.array([[float(getattr(cfg, name)) for name in EXT_COLUMNS]], dtype=np.float64)
@@ -134,4 +149,7 @@ def make_ext_params(cfg: Any, values: wp.array) -> Any:  # an RftExtParams insta
     ext.added_mass = int(cfg.added_mass > 0.0)
     ext.values = values
     ext.dt = float(cfg.dt)
+    ext.loosening = int(cfg.loosening_depth > 0.0)
+    ext.loosening_depth = float(cfg.loosening_depth)
+    ext.loosening_length = float(cfg.loosening_length)
     return ext

@@ -20,6 +20,7 @@ __all__ = [
     "ElementState",
     "advance_element_state",
     "advance_stick_anchor",
+    "advance_travel",
     "at_rest_filter",
     "crater_friction",
     "elastic_depth",
@@ -53,6 +54,7 @@ class AtRestParams:
     ema_rate: float
     stick_distance: float
     footprint_radius: float
+    loosening_dt: float
 
 
 @wp.struct
@@ -65,6 +67,7 @@ class ElementState:
     vel_prev: wp.array3d[wp.vec3]
     anchor: wp.array3d[wp.vec3]
     footprint: wp.array3d[wp.vec3]
+    travel: wp.array3d[float]
 
 
 @wp.func
@@ -258,6 +261,20 @@ def advance_element_state(
         state.force_prev[w, f, p] = force
 
 
+@wp.func
+def advance_travel(state: ElementState, rest: AtRestParams, w: int, f: int, p: int, vel: wp.vec3, depth: float) -> None:
+    """Add element [w, f, p]'s horizontal travel this substep while submerged, |v_xy| dt [m]; 0 out of the sand.
+
+    The memory of ``RftExtensionsCfg.loosening_depth``; nothing is read or written while it is off
+    (``rest.loosening_dt`` 0).
+    """
+    if rest.loosening_dt > 0.0:
+        travel = 0.0
+        if depth > 0.0:
+            travel = state.travel[w, f, p] + wp.sqrt(vel[0] * vel[0] + vel[1] * vel[1]) * rest.loosening_dt
+        state.travel[w, f, p] = travel
+
+
 def rft_element_model(model: Any) -> list:
     """Return the ``# Model:`` arguments the RFT element kernels share, in their order.
 
@@ -316,6 +333,7 @@ def state_update_kernel(
     if rest.mode == AT_REST_EMA:
         force = point_force_in[w, f, p]
     advance_element_state(state_out, rest, vertical_only, w, f, p, x, n, vel, depth, force)
+    advance_travel(state_out, rest, w, f, p, vel, depth)
 
 
 def eval_state_update(model: Any, inputs: tuple, vertical_only: int) -> None:
@@ -357,6 +375,7 @@ def reset_state_kernel(
     state_out.vel_prev[w, f, p] = wp.vec3(0.0)
     state_out.anchor[w, f, p] = wp.vec3(0.0)
     state_out.footprint[w, f, p] = wp.vec3(0.0)
+    state_out.travel[w, f, p] = 0.0
 
 
 def eval_reset_state(model: Any, world_ids: wp.array) -> None:

@@ -67,6 +67,7 @@ def make_at_rest_params(cfg: Any) -> Any:  # an AtRestParams instance (Warp stru
     rest.stick_distance = float(cfg.stick_distance) if sticks else 0.0
     ext = getattr(cfg, "extensions", None)
     rest.footprint_radius = float(ext.footprint_radius) if ext is not None else 0.0
+    rest.loosening_dt = float(ext.dt) if ext is not None and ext.loosening_depth > 0.0 else 0.0
     return rest
 
 
@@ -166,11 +167,12 @@ class ContactModel:
         self.vel_prev = wp.zeros(shape, dtype=wp.vec3, device=device)
         self.anchor = wp.zeros(shape, dtype=wp.vec3, device=device)
         self.footprint = wp.zeros(shape, dtype=wp.vec3, device=device)
+        self.travel = wp.zeros(shape, dtype=float, device=device)
         self.state = ElementState()
         """The memory above as one kernel argument (the same arrays: views, never reallocated)."""
         self.state.depth_max, self.state.ema_tau, self.state.anchor = self.depth_max, self.ema_tau, self.anchor
         self.state.force_prev, self.state.vel_prev = self.force_prev, self.vel_prev
-        self.state.footprint = self.footprint
+        self.state.footprint, self.state.travel = self.footprint, self.travel
         self.nan_count = wp.zeros(1, dtype=int, device=device)
         self._scratch_count = wp.zeros(1, dtype=int, device=device)
 

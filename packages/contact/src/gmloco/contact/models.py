@@ -53,11 +53,6 @@ class ContactRFT3D(ContactModel):
         self, cfg: ContactRFT3DCfg, num_worlds: int, num_feet: int, device: str, terrain: TerrainCfg | None = None
     ) -> None:
         """Build from ``cfg``; see :class:`ContactModel`."""
-        if cfg.extensions.loosening_depth > 0.0:
-            raise NotImplementedError(
-                f"RftExtensionsCfg.loosening_depth={cfg.extensions.loosening_depth}: the loosening term exists in the "
-                "float64 reference only (gmloco.contact.reference.rft3d_extensions); set it to 0 for the Warp model"
-            )
         super().__init__(cfg, num_worlds, num_feet, device, terrain, box_collider(cfg.collider))
         self.coeffs = RFT3DCoeffs(np.asarray(resolve_rft3d_coeffs(cfg.coeffs), dtype=np.float32))
         """The 20 x 3 coefficients as a by-value kernel parameter (constant-bank operands, no loads)."""

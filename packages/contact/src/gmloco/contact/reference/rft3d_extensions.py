@@ -123,8 +123,9 @@ def rft3d_extended_forces(
         raise ValueError(f"reference replay supports at_rest 'none' or 'unloading', not {cfg.at_rest!r}")
     if ext.loosening_depth > 0.0:  # (f): the element meets the sand that much shallower, in loading and at rest
         shift = loosening_shift(state.travel, ext)
-        points = np.asarray(points, dtype=np.float64) + shift[:, None] * np.array([0.0, 0.0, 1.0])
-        state = replace(state, depth_max=np.maximum(state.depth_max - shift, 0.0))
+        up = shift[:, None] * np.array([0.0, 0.0, 1.0])  # stick anchors move with the element: offsets unchanged
+        points = np.asarray(points, dtype=np.float64) + up
+        state = replace(state, depth_max=np.maximum(state.depth_max - shift, 0.0), anchor=state.anchor + up)
     depth = surface_z - np.asarray(points, dtype=np.float64)[:, 2]
     law = None if ext.depth_exponent == 1.0 and ext.depth_saturation == 0.0 else (lambda d: ext_depth_law(d, ext))
     mat = {"rho_c": material.rho_c, "mu_int": material.mu_int, "mu_surf": material.mu_surf}
