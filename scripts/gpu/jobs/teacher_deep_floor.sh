@@ -17,6 +17,10 @@
 # A quarter of the material draws come from 500-800 kg/m^3 (--soft-share 0.25): at 4,414 the teacher walks the deep
 # bed's dry sand and basalt but tips on poppy seed (638 kg/m^3) within 0.3 s, also over a hard floor 12 or 20 cm down
 # (results/training_gate/poppy_probe/), and packing x bulk density puts only ~8 % of the draws below 800.
+# The sand is whatever .devsrc/rft3d_calibrated.json holds: results/sand_calibration/rft3d_calibrated.json (the sole fit)
+# or, to train on the sand whose walks fail where MPM's do (term (f), loosening by horizontal travel;
+# results/sand_calibration/walk_gap_terms/), results/sand_calibration/walk_gap_terms/extensions/refit_loosening.json
+# (this command ran on a CPU with it from 4,414, 8 envs).
 # The entropy coefficient drops from 0.005 to 0.001 (the student PPO's): at 0.005 the action std rose from 0.86 to
 # 1.22 over 2,048 iterations, the entropy bonus outweighing the little the GM-Loco rewards charge for noisy actions.
 set -uo pipefail
