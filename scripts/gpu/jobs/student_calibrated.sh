@@ -11,9 +11,8 @@ end=$1
 run=gm_loco_student_calibrated
 cd ~/src
 source scripts/gpu/env.sh
-mkdir -p ~/chunks/student "artifacts/$run" results/sand_calibration
+stage_calibrated_run "$run" student
 [ -f .devsrc/checkpoint.pt ] && cp .devsrc/checkpoint.pt "artifacts/$run/checkpoint.pt"
-cp .devsrc/rft3d_calibrated.json results/sand_calibration/rft3d_calibrated.json
 nvidia-smi --query-gpu=name,memory.total --format=csv > ~/chunks/gpu.txt 2>&1
 mins=$(python3 -c "import time; print(round(($end - time.time())/60 - 0.3, 2))")
 echo "student chunk: max-minutes $mins" > ~/chunks/job.log

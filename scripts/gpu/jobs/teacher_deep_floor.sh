@@ -28,9 +28,8 @@ end=$1
 run=gm_loco_teacher_calibrated
 cd ~/src
 source scripts/gpu/env.sh
-mkdir -p ~/chunks/teacher "artifacts/$run" results/sand_calibration
+stage_calibrated_run "$run" teacher
 cp .devsrc/checkpoint.pt "artifacts/$run/checkpoint.pt"
-cp .devsrc/rft3d_calibrated.json results/sand_calibration/rft3d_calibrated.json
 nvidia-smi --query-gpu=name,memory.total --format=csv > ~/chunks/gpu.txt 2>&1
 gate=${GATE:-1}
 mins=$(python3 -c "import time; print(round(($end - time.time())/60 - (3.4 if $gate == 1 else 0.3), 2))")
