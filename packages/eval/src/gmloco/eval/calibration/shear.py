@@ -196,6 +196,14 @@ def _probes(paths: list[str], models: dict[str, tuple[RftExtensionsCfg, str]], c
     return rows
 
 
+def _save(fig: Any, path: Path, plt: Any) -> None:
+    """Write the figure through a temporary file and close it (a reader never sees half a PNG)."""
+    tmp = path.with_suffix(".tmp.png")
+    fig.savefig(tmp, dpi=100)
+    plt.close(fig)
+    tmp.replace(path)
+
+
 def _fig_resupport(rows: dict[str, dict[str, Any]], path: Path) -> None:
     """Bars of the extra depth [cm] a re-press needed, per material and probe, for the sand and each model."""
     import matplotlib
@@ -217,10 +225,7 @@ def _fig_resupport(rows: dict[str, dict[str, Any]], path: Path) -> None:
     ax.legend(fontsize=7)
     ax.set_title("A loaded sole slid 5 cm or turned 15 deg, then pressed again", fontsize=10)
     fig.tight_layout()
-    tmp = path.with_suffix(".tmp.png")
-    fig.savefig(tmp, dpi=100)
-    plt.close(fig)
-    tmp.replace(path)
+    _save(fig, path, plt)
 
 
 def _replay(ds: CalibrationDataset, ext: RftExtensionsCfg, cfg: SandFitCfg) -> tuple[dict[str, np.ndarray], float]:
@@ -266,10 +271,7 @@ def _figure(
     axes[0, 0].legend(fontsize=7)
     fig.suptitle(title, fontsize=10)
     fig.tight_layout()
-    tmp = path.with_suffix(".tmp.png")
-    fig.savefig(tmp, dpi=100)
-    plt.close(fig)
-    tmp.replace(path)
+    _save(fig, path, plt)
 
 
 def _series(rec: Any, force: np.ndarray, torque_z: np.ndarray | None = None) -> dict[str, np.ndarray]:
