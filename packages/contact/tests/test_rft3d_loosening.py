@@ -62,6 +62,18 @@ def test_a_slide_costs_support_that_grows_with_travel() -> None:
     assert 0.0 < after_long < after_short < before
 
 
+def test_keep_bounds_the_support_lost() -> None:
+    """With a keep share the slid plate keeps at least that share of its support; keep 0 is the shift alone."""
+    deep = RftExtensionsCfg(loosening_depth=0.05, loosening_length=0.02, dt=0.01)
+    before, after = _support_after_slide(deep, 0.10)
+    assert after == 0.0  # a 5 cm shift empties a 2 cm press
+    keep = RftExtensionsCfg(loosening_depth=0.05, loosening_length=0.02, loosening_keep=0.25, dt=0.01)
+    _, kept = _support_after_slide(keep, 0.10)
+    assert 0.2 * before < kept < 0.35 * before  # ~ keep of the depth, at rest on the elastic branch
+    assert not RftExtensionsCfg(loosening_keep=0.5).stateful  # keep alone is off (no shift to bound)
+    assert RftExtensionsCfg(loosening_keep=0.5).is_off
+
+
 def test_shift_follows_its_law() -> None:
     """Shift = d_l (1 - exp(-u / L)): 0 at no travel, d_l (1 - 1/e) at u = L, below d_l always."""
     u = np.array([0.0, 0.05, 10.0])
@@ -70,7 +82,7 @@ def test_shift_follows_its_law() -> None:
 
 
 def test_bad_values_are_refused() -> None:
-    """A negative depth or a non-positive length is refused, naming the field."""
-    for bad in ({"loosening_depth": -0.01}, {"loosening_length": 0.0}):
+    """A negative depth, a non-positive length or a keep share outside [0, 1) is refused, naming the field."""
+    for bad in ({"loosening_depth": -0.01}, {"loosening_length": 0.0}, {"loosening_keep": 1.0}):
         with pytest.raises(ValueError, match="loosening"):
             RftExtensionsCfg(**bad)

@@ -62,7 +62,7 @@ class RftExtensionsCfg:
     """Candidate terms beyond 3D-RFT (Agarwal, Goldman & Kamrin, PNAS 2023); every default is the published 3D-RFT.
 
     Each term is off at its neutral value and then leaves the force bit for bit unchanged (the kernels skip it).
-    The per-world values (all fields but ``footprint_radius``, the loosening pair and ``dt``) can be domain-randomized through
+    The per-world values (all fields but ``footprint_radius``, the loosening terms and ``dt``) can be domain-randomized through
     ``ContactRFT3D.set_extensions``. Reference: :mod:`gmloco.contact.reference.rft3d_extensions`.
     """
 
@@ -98,6 +98,10 @@ class RftExtensionsCfg:
     the sand. 0 = off. Not domain-randomized per world (one value per model)."""
     loosening_length: float = 0.05
     """(f) Horizontal travel over which the loosening approaches ``loosening_depth`` [m]."""
+    loosening_keep: float = 0.0
+    """(f) Share of an element's depth that the loosening never takes away [-]: the shift is at most
+    (1 - keep) times the depth, so a slid sole keeps at least this share of its support at rest, as MPM's keeps
+    14-29 % (``results/sand_calibration/shear/``); 0 = the shift alone (off)."""
     dt: float = 0.005
     """Physics step of the finite-difference acceleration of ``added_mass`` and of the travel of ``loosening_depth``
     [s] (state update once per step)."""
@@ -115,6 +119,7 @@ class RftExtensionsCfg:
             "added_mass": self.added_mass >= 0.0,
             "loosening_depth": self.loosening_depth >= 0.0,
             "loosening_length": self.loosening_length > 0.0,
+            "loosening_keep": 0.0 <= self.loosening_keep < 1.0,
             "dt": self.dt > 0.0,
         }
         for name, ok in checks.items():
@@ -126,7 +131,8 @@ class RftExtensionsCfg:
     def is_off(self) -> bool:
         """Whether every term is at its neutral value (the model is the published 3D-RFT)."""
         return self == RftExtensionsCfg(depth_ref=self.depth_ref, unloading_tolerance=self.unloading_tolerance,
-                                        loosening_length=self.loosening_length, dt=self.dt)  # fmt: skip
+                                        loosening_length=self.loosening_length, loosening_keep=self.loosening_keep,
+                                        dt=self.dt)  # fmt: skip
 
     @property
     def stateful(self) -> bool:

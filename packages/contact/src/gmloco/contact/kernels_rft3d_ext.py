@@ -60,6 +60,7 @@ class RftExtParams:
     loosening: int
     loosening_depth: float
     loosening_length: float
+    loosening_keep: float
 
 
 @wp.func
@@ -152,4 +153,5 @@ def make_ext_params(cfg: Any, values: wp.array) -> Any:  # an RftExtParams insta
     ext.loosening = int(cfg.loosening_depth > 0.0)
     ext.loosening_depth = float(cfg.loosening_depth)
     ext.loosening_length = float(cfg.loosening_length)
+    ext.loosening_keep = float(cfg.loosening_keep)
     return ext

@@ -123,6 +123,9 @@ def rft3d_extended_forces(
         raise ValueError(f"reference replay supports at_rest 'none' or 'unloading', not {cfg.at_rest!r}")
     if ext.loosening_depth > 0.0:  # (f): the element meets the sand that much shallower, in loading and at rest
         shift = loosening_shift(state.travel, ext)
+        if ext.loosening_keep > 0.0:  # never more than (1 - keep) of the depth
+            below = np.maximum(surface_z - np.asarray(points, dtype=np.float64)[:, 2], 0.0)
+            shift = np.minimum(shift, (1.0 - ext.loosening_keep) * below)
         up = shift[:, None] * np.array([0.0, 0.0, 1.0])  # stick anchors move with the element: offsets unchanged
         points = np.asarray(points, dtype=np.float64) + up
         state = replace(state, depth_max=np.maximum(state.depth_max - shift, 0.0), anchor=state.anchor + up)

@@ -59,6 +59,7 @@ FIT_BOUNDS: dict[str, tuple[float, float, float]] = {
     "added_mass": (0.0, 10.0, 0.0),
     "loosening_depth": (0.0, 0.05, 0.0),
     "loosening_length": (0.005, 0.5, 0.05),
+    "loosening_keep": (0.0, 0.95, 0.0),
 }
 """(lower, upper, neutral start) of each fitted value; ``depth_saturation`` is fitted as 1 / d_s [1/m] (0 = off).
 
