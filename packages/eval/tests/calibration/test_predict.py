@@ -109,7 +109,7 @@ def test_csv_speed_table_reads_as_the_summary(tmp_path: Path) -> None:
         ("policy", "policy 'ppo_sand' has no MPM straight speed rows"),
         ("material", "materials ['basalt'] of the gate have no MPM straight row"),
         ("speed", "no speed in both the gate and MPM"),
-        ("duplicate", "two gate summaries of gm_loco_student_td with contact model 'rft3d'"),
+        ("duplicate", "two gate summaries of gm_loco_student_td with contact model 'rft3d' both cover ['dry_sand']"),
         ("no_success", "has no success table: run the gate with --parts success"),
         ("missing", "not found"),
     ],
@@ -128,6 +128,17 @@ def test_mismatched_input_exits_2(case: str, message: str, tmp_path: Path, capsy
     code, body = _run(tmp_path, gates[case](), _mpm(tmp_path), "--no-figures")
     assert code == 2 and body == {}
     assert message in capsys.readouterr().err
+
+
+def test_gates_of_different_materials_merge(tmp_path: Path) -> None:
+    """One gate per material (terms fitted per material) reads as one gate of the policy and contact model."""
+    dry = _gate(tmp_path, "rft3d_calibrated", {"dry_sand": {"1": 80.0}})
+    poppy = _gate(_folder(tmp_path / "poppy"), "rft3d_calibrated", {"poppy_seed": {"1": 10.0}})
+    code, body = _run(tmp_path, [dry, poppy], _mpm(tmp_path), "--no-figures")
+    assert code == 0
+    cells = body["predicted_vs_mpm_success"][POLICY]
+    assert cells["dry_sand"]["1"]["predicted_success_pct"] == {"rft3d_calibrated": 80.0}
+    assert cells["poppy_seed"]["1"]["difference_points"] == {"rft3d_calibrated": 10.0}
 
 
 def test_only_judged_materials_lists_the_rest(tmp_path: Path) -> None:

@@ -122,16 +122,25 @@ def read_mpm_speeds(path: str | Path, scenario: str = "straight") -> dict[str, d
     return out
 
 
-def _gates(paths: list[str], criterion: Criterion) -> tuple[dict[str, Any], dict[str, dict[str, str]]]:
-    """Return success [%] by policy, contact model, material and speed key, and the file of each (policy, model)."""
+def _gates(paths: list[str], criterion: Criterion) -> tuple[dict[str, Any], dict[str, dict[str, dict[str, str]]]]:
+    """Return success [%] by policy, contact model, material and speed key, and the file of each of those materials.
+
+    Gates of one policy and contact model that cover different materials are merged (a sand with terms fitted per
+    material gates each material on its own terms); two that share a material are refused.
+    """
     out: dict[str, dict[str, dict[str, dict[str, float]]]] = {}
-    files: dict[str, dict[str, str]] = {}
+    files: dict[str, dict[str, dict[str, str]]] = {}
     for path in paths:
         policy, model, table = read_gate(path, criterion)
-        if model in out.get(policy, {}):
-            raise ValueError(f"two gate summaries of {policy} with contact model {model!r}: give one each ({path})")
-        out.setdefault(policy, {})[model] = table
-        files.setdefault(policy, {})[model] = path
+        have = out.setdefault(policy, {}).setdefault(model, {})
+        shared = sorted(set(have) & set(table))
+        if shared:
+            raise ValueError(
+                f"two gate summaries of {policy} with contact model {model!r} both cover {shared}: give one gate per "
+                f"material ({path})"
+            )
+        have.update(table)
+        files.setdefault(policy, {}).setdefault(model, {}).update(dict.fromkeys(table, str(path)))
     return out, files
 
 
@@ -145,16 +154,20 @@ def _mpm_dirs(path: Path) -> dict[str, list[str]]:
     return {p: list(r["dirs"]) for p, r in runs.items() if isinstance(r, dict) and isinstance(r.get("dirs"), list)}
 
 
-def _add_walks(table: dict[str, Any], files: dict[str, str], dirs: list[str], scenario: str) -> None:
+def _add_walks(table: dict[str, Any], files: dict[str, dict[str, str]], dirs: list[str], scenario: str) -> None:
     """Put ``mpm_walk`` and ``gate_walk`` (per model) beside every cell of one policy's table."""
     from gmloco.eval.calibration.walk_gap import gate_walk, mpm_walks
 
     walks = mpm_walks(dirs, scenario)
-    bodies = {model: read_json_object(path, "gate summary") for model, path in files.items()}
+    paths = {path for by_material in files.values() for path in by_material.values()}
+    bodies = {path: read_json_object(path, "gate summary") for path in sorted(paths)}
     for material, cells in table.items():
         for speed, cell in cells.items():
             cell["mpm_walk"] = walks.get(material, {}).get(speed)
-            cell["gate_walk"] = {model: gate_walk(body, material, speed) for model, body in bodies.items()}
+            cell["gate_walk"] = {
+                model: gate_walk(bodies[by_material[material]], material, speed) if material in by_material else None
+                for model, by_material in files.items()
+            }
 
 
 def _cell(mpm: float, predicted: dict[str, float | None], cfg: PredictCfg) -> dict[str, Any]:
