@@ -9,6 +9,7 @@
 #                      MPM needs where 3D-RFT needs none, results/sand_calibration/shear/)
 #   CALIB_TAG          folder under ~/chunks (default: calib_probes; the datasets with the twist were calib_twist,
 #                      CALIB_EXPERIMENTS="press press_fast tilt drag drag_fast liftoff repeat twist")
+#   TRAIN              0: the datasets alone, no teacher chunk (the probes of results/sand_calibration/dataset/probes/)
 # Read the probes with python -m gmloco.eval.calibration.shear --probes ...; refit with gmloco.eval.calibration.fit_cli.
 set -uo pipefail
 end=$1
@@ -24,6 +25,6 @@ for m in dry_sand poppy_seed basalt; do
       --experiments $exps --device cuda:0 --out "$out" > "$out/$m.log" 2>&1
     echo "rc $?" >> "$out/$m.log" ) &
 done
-NESTED=1 bash scripts/gpu/jobs/teacher_deep_floor.sh "$end"
+[ "${TRAIN:-1}" = 0 ] || NESTED=1 bash scripts/gpu/jobs/teacher_deep_floor.sh "$end"
 wait
 touch ~/chunks/DONE
