@@ -205,11 +205,16 @@ def _save(fig: Any, path: Path, plt: Any) -> None:
 
 
 def _fig_resupport(rows: dict[str, dict[str, Any]], path: Path) -> None:
-    """Bars of the extra depth [cm] a re-press needed, per material and probe, for the sand and each model."""
+    """Bars of the extra depth [cm] a re-press needed, per material and probe, for the sand and each model.
+
+    Hatched: the first press never carried the single-stance load (``loaded`` false), so the bar is the depth the
+    probe reached, not a re-press it needed.
+    """
     import matplotlib
 
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
+    from matplotlib.patches import Patch
 
     cells = [(m, n) for m, probes in rows.items() for n in probes]
     labels = [k for k in rows[cells[0][0]][cells[0][1]] if k != "dataset"]
@@ -217,13 +222,23 @@ def _fig_resupport(rows: dict[str, dict[str, Any]], path: Path) -> None:
     width = 0.8 / len(labels)
     for i, label in enumerate(labels):
         xs = [c + (i - (len(labels) - 1) / 2) * width for c in range(len(cells))]
-        ax.bar(xs, [100 * rows[m][n][label]["extra_depth_m"] for m, n in cells], width, label=label,
-               color="k" if i == 0 else f"C{i}")  # fmt: skip
+        runs = [rows[m][n][label] for m, n in cells]
+        bars = ax.bar(xs, [100 * r["extra_depth_m"] for r in runs], width, label=label,
+                      color="k" if i == 0 else f"C{i}")  # fmt: skip
+        for bar, run in zip(bars, runs, strict=True):
+            if not run["loaded"]:
+                bar.set_hatch("//")
+                bar.set_edgecolor("w")
     ax.set_xticks(range(len(cells)), [f"{m}\n{n}" for m, n in cells], fontsize=8)
     ax.set_ylabel("extra depth to carry the load again [cm]")
     ax.grid(axis="y", alpha=0.3)
-    ax.legend(fontsize=7)
-    ax.set_title("A loaded sole slid 5 cm or turned 15 deg, then pressed again", fontsize=10)
+    colors = ["k" if i == 0 else f"C{i}" for i in range(len(labels))]
+    ax.legend([Patch(color=c) for c in colors], labels, fontsize=7)  # plain patches: a hatched first bar is no key
+    ax.set_title(
+        "A loaded sole slid 5 cm or turned 15 deg, then pressed again (hatched: the first press never carried "
+        "the load)",
+        fontsize=10,
+    )
     fig.tight_layout()
     _save(fig, path, plt)
 
