@@ -62,8 +62,8 @@ class RftExtensionsCfg:
     """Candidate terms beyond 3D-RFT (Agarwal, Goldman & Kamrin, PNAS 2023); every default is the published 3D-RFT.
 
     Each term is off at its neutral value and then leaves the force bit for bit unchanged (the kernels skip it).
-    The per-world values (all fields but ``footprint_radius``, the loosening terms and ``dt``) can be domain-randomized through
-    ``ContactRFT3D.set_extensions``. Reference: :mod:`gmloco.contact.reference.rft3d_extensions`.
+    The per-world values (all fields but ``footprint_radius``, the loosening terms and ``dt``) can be
+    domain-randomized through ``ContactRFT3D.set_extensions``. Reference: :mod:`gmloco.contact.reference.rft3d_extensions`.
     """
 
     depth_exponent: float = 1.0

@@ -258,9 +258,7 @@ def rft3d_element_force_ext(
     xi = media_scaling(mat[0], mat[1], m.gravity)
     depth_max = state.depth_max[w, f, p]
     if ext.loosening != 0:  # (f) loosening: the element meets the sand this much shallower, loading and at rest
-        shift = ext_loosening_shift(state.travel[w, f, p], ext)
-        if ext.loosening_keep > 0.0:  # never more than (1 - keep) of the depth
-            shift = wp.min(shift, (1.0 - ext.loosening_keep) * wp.max(depth, 0.0))
+        shift = ext_loosening_shift(state.travel[w, f, p], depth, ext)
         depth = depth - shift
         depth_max = wp.max(depth_max - shift, 0.0)
         if depth <= 0.0:

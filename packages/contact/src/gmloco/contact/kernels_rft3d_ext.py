@@ -125,14 +125,18 @@ def ext_vertical_force(
 
 
 @wp.func
-def ext_loosening_shift(travel: float, ext: RftExtParams) -> float:
-    """Return how much shallower an element meets the sand after ``travel`` [m] sideways while submerged [m].
+def ext_loosening_shift(travel: float, depth: float, ext: RftExtParams) -> float:
+    """Return how much shallower an element ``depth`` [m] deep meets the sand after ``travel`` [m] sideways [m].
 
-    d_l (1 - exp(-u / L)) (term (f), ``RftExtensionsCfg.loosening_depth``); 0 when off.
+    d_l (1 - exp(-u / L)) (term (f), ``RftExtensionsCfg.loosening_depth``), at most (1 - keep) of the depth with a
+    keep share (``loosening_keep``); 0 when off.
     """
     if ext.loosening == 0:
         return 0.0
-    return ext.loosening_depth * (1.0 - wp.exp(-travel / ext.loosening_length))
+    shift = ext.loosening_depth * (1.0 - wp.exp(-travel / ext.loosening_length))
+    if ext.loosening_keep > 0.0:
+        shift = wp.min(shift, (1.0 - ext.loosening_keep) * wp.max(depth, 0.0))
+    return shift
 
 
 def rft_ext_values(cfg: Any) -> np.ndarray:

@@ -95,11 +95,17 @@ class ExtState:
         return cls(np.zeros(num_points), z3.copy(), z3.copy(), z3.copy(), np.zeros(num_points), np.zeros(num_points))
 
 
-def loosening_shift(travel: np.ndarray, ext: RftExtensionsCfg) -> np.ndarray:
-    """Return how much shallower each element meets the sand after its horizontal travel [m], [N] (term (f))."""
+def loosening_shift(travel: np.ndarray, ext: RftExtensionsCfg, depth: np.ndarray | None = None) -> np.ndarray:
+    """Return how much shallower each element meets the sand after its horizontal travel [m], [N] (term (f)).
+
+    With ``depth`` [m], [N], and a keep share, at most (1 - ``loosening_keep``) of each element's depth.
+    """
     if ext.loosening_depth <= 0.0:
         return np.zeros_like(np.asarray(travel, dtype=np.float64))
-    return ext.loosening_depth * (1.0 - np.exp(-np.asarray(travel, dtype=np.float64) / ext.loosening_length))
+    shift = ext.loosening_depth * (1.0 - np.exp(-np.asarray(travel, dtype=np.float64) / ext.loosening_length))
+    if depth is not None and ext.loosening_keep > 0.0:
+        shift = np.minimum(shift, (1.0 - ext.loosening_keep) * np.maximum(depth, 0.0))
+    return shift
 
 
 def rft3d_extended_forces(
@@ -122,10 +128,7 @@ def rft3d_extended_forces(
     if cfg.at_rest not in ("none", "unloading"):
         raise ValueError(f"reference replay supports at_rest 'none' or 'unloading', not {cfg.at_rest!r}")
     if ext.loosening_depth > 0.0:  # (f): the element meets the sand that much shallower, in loading and at rest
-        shift = loosening_shift(state.travel, ext)
-        if ext.loosening_keep > 0.0:  # never more than (1 - keep) of the depth
-            below = np.maximum(surface_z - np.asarray(points, dtype=np.float64)[:, 2], 0.0)
-            shift = np.minimum(shift, (1.0 - ext.loosening_keep) * below)
+        shift = loosening_shift(state.travel, ext, surface_z - np.asarray(points, dtype=np.float64)[:, 2])
         up = shift[:, None] * np.array([0.0, 0.0, 1.0])  # stick anchors move with the element: offsets unchanged
         points = np.asarray(points, dtype=np.float64) + up
         state = replace(state, depth_max=np.maximum(state.depth_max - shift, 0.0), anchor=state.anchor + up)

@@ -220,11 +220,11 @@ def _fig_resupport(rows: dict[str, dict[str, Any]], path: Path) -> None:
     labels = [k for k in rows[cells[0][0]][cells[0][1]] if k != "dataset"]
     fig, ax = plt.subplots(figsize=(1.6 + 1.6 * len(cells), 3.4))
     width = 0.8 / len(labels)
+    colors = ["k" if i == 0 else f"C{i}" for i in range(len(labels))]
     for i, label in enumerate(labels):
         xs = [c + (i - (len(labels) - 1) / 2) * width for c in range(len(cells))]
         runs = [rows[m][n][label] for m, n in cells]
-        bars = ax.bar(xs, [100 * r["extra_depth_m"] for r in runs], width, label=label,
-                      color="k" if i == 0 else f"C{i}")  # fmt: skip
+        bars = ax.bar(xs, [100 * r["extra_depth_m"] for r in runs], width, label=label, color=colors[i])
         for bar, run in zip(bars, runs, strict=True):
             if not run["loaded"]:
                 bar.set_hatch("//")
@@ -232,7 +232,6 @@ def _fig_resupport(rows: dict[str, dict[str, Any]], path: Path) -> None:
     ax.set_xticks(range(len(cells)), [f"{m}\n{n}" for m, n in cells], fontsize=8)
     ax.set_ylabel("extra depth to carry the load again [cm]")
     ax.grid(axis="y", alpha=0.3)
-    colors = ["k" if i == 0 else f"C{i}" for i in range(len(labels))]
     ax.legend([Patch(color=c) for c in colors], labels, fontsize=7)  # plain patches: a hatched first bar is no key
     ax.set_title(
         "A loaded sole slid 5 cm or turned 15 deg, then pressed again (hatched: the first press never carried "
