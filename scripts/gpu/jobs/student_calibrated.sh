@@ -4,8 +4,10 @@
 # to resume, and .devsrc/rft3d_calibrated.json = results/sand_calibration/rft3d_calibrated.json; start it with
 # launch_job.sh SECONDS and poll with jobs/poll_teacher.sh MAX_SECONDS gm_loco_student_calibrated.
 # The TCN student distilled (DAgger + PPO) from the calibrated-sand teacher on the teacher's own sand and floor
-# curriculum (survival rule, floors 0-20 cm in 2 cm steps) and added-mass DR (U[0.5, 10]); the post-training checks
-# export policy.onnx with its deploy metadata and check it against torch.
+# curriculum (survival rule, floors 0-20 cm in 2 cm steps), added-mass DR (U[0.5, 10]) and soft material share (a quarter
+# of the draws from 500-800 kg/m^3, as the teacher from iteration 4,414 on); the post-training checks export
+# policy.onnx with its deploy metadata and check it against torch. This command ran on a CPU with 8 envs for 3
+# iterations from the teacher of iteration 4,638 (export and parity checks included).
 set -uo pipefail
 end=$1
 run=gm_loco_student_calibrated
@@ -19,7 +21,7 @@ echo "student chunk: max-minutes $mins" > ~/chunks/job.log
 python3 scripts/gpu/train_ts_chunk.py --stage student --run "$run" --teacher-checkpoint .devsrc/teacher.pt \
   --contact-model rft3d_calibrated --foot-clearance sinkage --foot-faces box --curriculum-scale 0.1 \
   --reward-weight foot_clearance_l2=-50 --floor-promotion survival --floor-depth-max 0.20 --floor-levels 11 \
-  --rft-extension-range added_mass=0.5,10 \
+  --rft-extension-range added_mass=0.5,10 --soft-share 0.25 \
   --max-iterations 2000 --max-minutes "$mins" --post-minutes 1.5 --full-checkpoint --out ~/chunks/student \
   >> ~/chunks/job.log 2>&1
 echo "train rc $?" >> ~/chunks/job.log
