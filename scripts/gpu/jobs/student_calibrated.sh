@@ -16,7 +16,7 @@ source scripts/gpu/env.sh
 stage_calibrated_run "$run" student
 [ -f .devsrc/checkpoint.pt ] && cp .devsrc/checkpoint.pt "artifacts/$run/checkpoint.pt"
 nvidia-smi --query-gpu=name,memory.total --format=csv > ~/chunks/gpu.txt 2>&1
-mins=$(python3 -c "import time; print(round(($end - time.time())/60 - 0.3, 2))")
+mins=$(python3 -c "import time; print(round(($end - time.time())/60 - 0.3, 2))")  # END: the training's own end
 echo "student chunk: max-minutes $mins" > ~/chunks/job.log
 python3 scripts/gpu/train_ts_chunk.py --stage student --run "$run" --teacher-checkpoint .devsrc/teacher.pt \
   --contact-model rft3d_calibrated --foot-clearance sinkage --foot-faces box --curriculum-scale 0.1 \
@@ -25,4 +25,4 @@ python3 scripts/gpu/train_ts_chunk.py --stage student --run "$run" --teacher-che
   --max-iterations 2000 --max-minutes "$mins" --post-minutes 1.5 --full-checkpoint --out ~/chunks/student \
   >> ~/chunks/job.log 2>&1
 echo "train rc $?" >> ~/chunks/job.log
-touch ~/chunks/DONE
+[ "${NESTED:-0}" = 1 ] || touch ~/chunks/DONE  # a wrapper job (NESTED=1) marks DONE itself
