@@ -40,6 +40,7 @@ TERMS: dict[str, RftExtensionsCfg] = {
     "added_mass": RftExtensionsCfg(added_mass=1.5),
     "loosening": RftExtensionsCfg(loosening_depth=0.01, loosening_length=0.02),
     "loosening_keep": RftExtensionsCfg(loosening_depth=0.03, loosening_length=0.02, loosening_keep=0.3),
+    "erosion": RftExtensionsCfg(erosion_length=0.02, erosion_keep=0.2, erosion_restore=0.005),
     "all": RftExtensionsCfg(
         depth_exponent=0.8,
         depth_saturation=0.04,

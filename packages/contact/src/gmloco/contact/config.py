@@ -62,7 +62,7 @@ class RftExtensionsCfg:
     """Candidate terms beyond 3D-RFT (Agarwal, Goldman & Kamrin, PNAS 2023); every default is the published 3D-RFT.
 
     Each term is off at its neutral value and then leaves the force bit for bit unchanged (the kernels skip it).
-    The per-world values (all fields but ``footprint_radius``, the loosening terms and ``dt``) can be
+    The per-world values (all fields but ``footprint_radius``, the loosening and erosion terms and ``dt``) can be
     domain-randomized through ``ContactRFT3D.set_extensions``. Reference: :mod:`gmloco.contact.reference.rft3d_extensions`.
     """
 
@@ -102,9 +102,22 @@ class RftExtensionsCfg:
     """(f) Share of an element's depth that the loosening never takes away [-]: the shift is at most
     (1 - keep) times the depth, so a slid sole keeps at least this share of its support at rest, as MPM's keeps
     14-29 % (``results/sand_calibration/shear/``); 0 = the shift alone (off)."""
+    erosion_length: float = 0.0
+    """(g) Support erosion by horizontal travel: a submerged element that slides loses a share of its vertical
+    resistive force, s <- s + (1 - s) |v_xy| dt / L_e (about 1 - exp(-u / L_e) after u metres), and the force
+    becomes (1 - (1 - ``erosion_keep``) s) F_z; sinking past its maximum depth z_max by dz gives it back,
+    s <- s exp(-dz / ``erosion_restore``). Unlike (f), the sand is not met shallower, so a re-press regains the
+    support within a centimetre, as MPM's re-press probes do (0.25-1.35 cm, ``results/sand_calibration/shear/``).
+    Shares the per-element travel memory with (f): at most one of the two is on. Out of the sand s = 0. Length [m];
+    0 = off. Not domain-randomized per world (one value per model)."""
+    erosion_keep: float = 0.2
+    """(g) Share of the vertical force that erosion never takes away [-] (MPM keeps 14-29 % of its support at rest
+    after a 10 cm slide)."""
+    erosion_restore: float = 0.005
+    """(g) Depth past z_max over which an eroded element's support comes back (e-folding) [m]."""
     dt: float = 0.005
     """Physics step of the finite-difference acceleration of ``added_mass`` and of the travel of ``loosening_depth``
-    [s] (state update once per step)."""
+    and ``erosion_length`` [s] (state update once per step)."""
 
     def __post_init__(self) -> None:
         """Refuse values outside each term's physical range (a message per field)."""
@@ -120,25 +133,38 @@ class RftExtensionsCfg:
             "loosening_depth": self.loosening_depth >= 0.0,
             "loosening_length": self.loosening_length > 0.0,
             "loosening_keep": 0.0 <= self.loosening_keep < 1.0,
+            "erosion_length": self.erosion_length >= 0.0,
+            "erosion_keep": 0.0 <= self.erosion_keep < 1.0,
+            "erosion_restore": self.erosion_restore > 0.0,
             "dt": self.dt > 0.0,
         }
         for name, ok in checks.items():
             value = getattr(self, name)
             if not (ok and math.isfinite(value)):
                 raise ValueError(f"RftExtensionsCfg.{name}={value}: out of range (see its docstring)")
+        if self.loosening_depth > 0.0 and self.erosion_length > 0.0:
+            raise ValueError(
+                f"RftExtensionsCfg: loosening_depth={self.loosening_depth} and erosion_length={self.erosion_length} "
+                "share one travel memory; set one of them to 0"
+            )
 
     @property
     def is_off(self) -> bool:
         """Whether every term is at its neutral value (the model is the published 3D-RFT)."""
         return self == RftExtensionsCfg(depth_ref=self.depth_ref, unloading_tolerance=self.unloading_tolerance,
                                         loosening_length=self.loosening_length, loosening_keep=self.loosening_keep,
+                                        erosion_keep=self.erosion_keep, erosion_restore=self.erosion_restore,
                                         dt=self.dt)  # fmt: skip
 
     @property
     def stateful(self) -> bool:
         """Whether a term reads per-element memory (z_max, footprint, previous velocity)."""
         return (
-            self.plastic_unloading or self.footprint_radius > 0.0 or self.added_mass > 0.0 or self.loosening_depth > 0.0
+            self.plastic_unloading
+            or self.footprint_radius > 0.0
+            or self.added_mass > 0.0
+            or self.loosening_depth > 0.0
+            or self.erosion_length > 0.0
         )
 
 

@@ -21,6 +21,7 @@ from gmloco.contact.kernels_geometry import (
 from gmloco.contact.kernels_rft3d_ext import (
     RftExtParams,
     ext_depth_law,
+    ext_erosion_factor,
     ext_lateral,
     ext_loosening_shift,
     ext_vertical_force,
@@ -276,6 +277,8 @@ def rft3d_element_force_ext(
         d_law = ext_depth_law(depth, ext, w)  # (a) depth law
         force = rft3d_plastic_force(n, v, d_law, area, xi, mat[2], coeffs, m.v_eps, m.sign_fix)
     force = ext_lateral(force, ext, w)  # (b) lateral scale
+    if ext.erosion != 0:  # (g) support eroded by horizontal travel
+        force = wp.vec3(force[0], force[1], force[2] * ext_erosion_factor(state.travel[w, f, p], ext))
     if ext.overburden != 0 or ext.added_mass != 0:  # (d) overburden at lift-off, (e) added mass
         f_z = ext_vertical_force(n, v, state.vel_prev[w, f, p], depth, area, mat[0], m.gravity, ext, w)
         force = force + wp.vec3(0.0, 0.0, f_z)
@@ -489,9 +492,9 @@ def _rft3d_foot_wrench_kernel(
                 # x and n recomputed with the same function instead of kept live across the force evaluation
                 # (registers, see above); unused for a non-finite foot (depth 0: no anchor update)
                 xn = foot_point_kinematics(pos, rot, lin_vel, ang_vel, model.points_b[p], model.normals_b[p])
-                advance_element_state(state_out, model.rest, 0, w, f, p, xn[0], xn[1], kin[2], depth, force)
                 if wp.static(ext):
-                    advance_travel(state_out, model.rest, w, f, p, kin[2], depth)
+                    advance_travel(state_out, model.rest, w, f, p, kin[2], depth)  # before z_max moves
+                advance_element_state(state_out, model.rest, 0, w, f, p, xn[0], xn[1], kin[2], depth, force)
         wrench = foot_wrench_block_sum(wp.spatial_vector(force_sum, torque_sum), pos, rot, com, lane, nan_count_out)
         if lane == 0:
             wrench_out[w, f] = wrench

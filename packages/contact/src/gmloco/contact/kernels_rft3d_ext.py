@@ -2,7 +2,7 @@
 """Candidate terms beyond 3D-RFT (``RftExtensionsCfg``) as Warp functions.
 
 Depth law, lateral scale, plastic unloading, overburden,
-added mass, loosening by horizontal travel. Each is skipped when off, so the published force is unchanged bit for bit.
+added mass, loosening and support erosion by horizontal travel. Each is skipped when off, so the published force is unchanged bit for bit.
 
 Per-world values live in one array ``values[world % values.shape[0], column]`` (shared or domain-randomized, MuJoCo
 Warp's batch-modulo rule); the on/off flags are by-value struct fields fixed at model build time.
@@ -19,6 +19,7 @@ __all__ = [
     "EXT_COLUMNS",
     "RftExtParams",
     "ext_depth_law",
+    "ext_erosion_factor",
     "ext_lateral",
     "ext_loosening_shift",
     "ext_vertical_force",
@@ -61,6 +62,8 @@ class RftExtParams:
     loosening_depth: float
     loosening_length: float
     loosening_keep: float
+    erosion: int
+    erosion_keep: float
 
 
 @wp.func
@@ -139,6 +142,12 @@ def ext_loosening_shift(travel: float, depth: float, ext: RftExtParams) -> float
     return shift
 
 
+@wp.func
+def ext_erosion_factor(share: float, ext: RftExtParams) -> float:
+    """Return the factor 1 - (1 - keep) s on an element's vertical resistive force for eroded share s [-] (term (g))."""
+    return 1.0 - (1.0 - ext.erosion_keep) * share
+
+
 def rft_ext_values(cfg: Any) -> np.ndarray:
     """Return the per-world value row of an ``RftExtensionsCfg`` in :data:`EXT_COLUMNS` order, [1, 7]."""
     return np.array([[float(getattr(cfg, name)) for name in EXT_COLUMNS]], dtype=np.float64)
@@ -158,4 +167,6 @@ def make_ext_params(cfg: Any, values: wp.array) -> Any:  # an RftExtParams insta
     ext.loosening_depth = float(cfg.loosening_depth)
     ext.loosening_length = float(cfg.loosening_length)
     ext.loosening_keep = float(cfg.loosening_keep)
+    ext.erosion = int(cfg.erosion_length > 0.0)
+    ext.erosion_keep = float(cfg.erosion_keep)
     return ext

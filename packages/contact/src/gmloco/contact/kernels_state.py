@@ -55,6 +55,8 @@ class AtRestParams:
     stick_distance: float
     footprint_radius: float
     loosening_dt: float
+    erosion_rate: float
+    erosion_restore: float
 
 
 @wp.struct
@@ -263,16 +265,28 @@ def advance_element_state(
 
 @wp.func
 def advance_travel(state: ElementState, rest: AtRestParams, w: int, f: int, p: int, vel: wp.vec3, depth: float) -> None:
-    """Add element [w, f, p]'s horizontal travel this substep while submerged, |v_xy| dt [m]; 0 out of the sand.
+    """Advance element [w, f, p]'s travel memory past this substep; 0 out of the sand.
 
-    The memory of ``RftExtensionsCfg.loosening_depth``; nothing is read or written while it is off
-    (``rest.loosening_dt`` 0).
+    Loosening (``RftExtensionsCfg.loosening_depth``, ``rest.loosening_dt`` > 0): the horizontal travel while
+    submerged, + |v_xy| dt [m]. Erosion (``erosion_length``, ``rest.erosion_rate`` = dt / L_e > 0): the eroded share
+    s [-], s + (1 - s) min(|v_xy| dt / L_e, 1), then times exp(-dz / ``rest.erosion_restore``) for a depth dz past
+    z_max. Call it before :func:`advance_element_state` (it reads the old z_max). Nothing is read or written
+    while both are off.
     """
     if rest.loosening_dt > 0.0:
         travel = 0.0
         if depth > 0.0:
             travel = state.travel[w, f, p] + wp.sqrt(vel[0] * vel[0] + vel[1] * vel[1]) * rest.loosening_dt
         state.travel[w, f, p] = travel
+    elif rest.erosion_rate > 0.0:
+        share = 0.0
+        if depth > 0.0:
+            share = state.travel[w, f, p]
+            share += (1.0 - share) * wp.min(wp.sqrt(vel[0] * vel[0] + vel[1] * vel[1]) * rest.erosion_rate, 1.0)
+            sink = depth - state.depth_max[w, f, p]
+            if sink > 0.0:
+                share *= wp.exp(-sink / rest.erosion_restore)
+        state.travel[w, f, p] = share
 
 
 def rft_element_model(model: Any) -> list:
@@ -332,8 +346,8 @@ def state_update_kernel(
     force = wp.vec3(0.0)
     if rest.mode == AT_REST_EMA:
         force = point_force_in[w, f, p]
+    advance_travel(state_out, rest, w, f, p, vel, depth)  # before z_max moves
     advance_element_state(state_out, rest, vertical_only, w, f, p, x, n, vel, depth, force)
-    advance_travel(state_out, rest, w, f, p, vel, depth)
 
 
 def eval_state_update(model: Any, inputs: tuple, vertical_only: int) -> None:

@@ -22,7 +22,9 @@ from gmloco.contact.reference.rft3d import (
 
 __all__ = [
     "ExtState",
+    "advance_erosion",
     "advance_ext_state",
+    "erosion_factor",
     "ext_depth_law",
     "ext_vertical_forces",
     "loosening_shift",
@@ -86,7 +88,8 @@ class ExtState:
     ema_tau: np.ndarray = field(default_factory=lambda: np.zeros(0))
     """Velocity-reversal counter tau_r [-], [N]."""
     travel: np.ndarray = field(default_factory=lambda: np.zeros(0))
-    """Horizontal travel while submerged since the element entered the sand [m], [N] (``loosening_depth``)."""
+    """Horizontal travel while submerged since the element entered the sand [m], [N] (``loosening_depth``), or
+    the eroded share s of its support [-], [N] (``erosion_length``)."""
 
     @classmethod
     def zeros(cls, num_points: int) -> ExtState:
@@ -108,6 +111,28 @@ def loosening_shift(travel: np.ndarray, ext: RftExtensionsCfg, depth: np.ndarray
     return shift
 
 
+def erosion_factor(share: np.ndarray, ext: RftExtensionsCfg) -> np.ndarray:
+    """Return the factor 1 - (1 - keep) s on each element's vertical resistive force [-], [N] (term (g); 1 off)."""
+    s = np.asarray(share, dtype=np.float64)
+    if ext.erosion_length <= 0.0:
+        return np.ones_like(s)
+    return 1.0 - (1.0 - ext.erosion_keep) * s
+
+
+def advance_erosion(
+    share: np.ndarray, velocities: np.ndarray, depth: np.ndarray, depth_max: np.ndarray, ext: RftExtensionsCfg
+) -> np.ndarray:
+    """Return the eroded share after one step [-], [N] (term (g)).
+
+    Grown by the horizontal travel, given back by sinking past z_max (``depth_max``, before this step's update);
+    0 out of the sand.
+    """
+    v = np.asarray(velocities, dtype=np.float64)
+    grown = share + (1.0 - share) * np.minimum(np.hypot(v[:, 0], v[:, 1]) * ext.dt / ext.erosion_length, 1.0)
+    restored = grown * np.exp(-np.maximum(depth - depth_max, 0.0) / ext.erosion_restore)
+    return np.where(depth > 0.0, restored, 0.0)
+
+
 def rft3d_extended_forces(
     points: np.ndarray,
     normals: np.ndarray,
@@ -122,7 +147,7 @@ def rft3d_extended_forces(
 
     Base: plain RFT (``"none"``) or the elastic unloading branch with crater friction (``"unloading"``), both with
     the depth law; plastic unloading zeroes 0 < d < z_max - tolerance; the lateral scale multiplies F_x, F_y; the
-    overburden and added-mass forces are added along z.
+    erosion factor F_z; the overburden and added-mass forces are added along z.
     """
     ext = cfg.extensions
     if cfg.at_rest not in ("none", "unloading"):
@@ -153,6 +178,8 @@ def rft3d_extended_forces(
         crater = (depth > 0.0) & (depth < state.depth_max - ext.unloading_tolerance)
         f = np.where(crater[:, None], 0.0, f)
     f = f * np.array([ext.lateral_scale, ext.lateral_scale, 1.0])
+    if ext.erosion_length > 0.0:  # (g) support lost to horizontal travel
+        f[:, 2] *= erosion_factor(state.travel, ext)
     f[:, 2] += ext_vertical_forces(normals, velocities, state.vel_prev, depth, areas, material.rho_c, ext, cfg.gravity)
     return f
 
@@ -181,6 +208,8 @@ def advance_ext_state(
         v = np.asarray(velocities, dtype=np.float64)
         step = np.hypot(v[:, 0], v[:, 1]) * cfg.extensions.dt
         travel = np.where(depth > 0.0, travel + step, 0.0)
+    elif cfg.extensions.erosion_length > 0.0:
+        travel = advance_erosion(travel, velocities, depth, state.depth_max, cfg.extensions)
     return ExtState(depth_max, footprint, anchor, np.asarray(velocities, dtype=np.float64).copy(), tau, travel)
 
 

@@ -38,6 +38,7 @@ from gmloco.eval.calibration.rft_sand import centred_sole_collider, replay_wrenc
 __all__ = [
     "DATUM_BOUNDS",
     "FIT_BOUNDS",
+    "FIT_INVERTED",
     "SandFitCfg",
     "SandFitResult",
     "dataset_material",
@@ -60,11 +61,18 @@ FIT_BOUNDS: dict[str, tuple[float, float, float]] = {
     "loosening_depth": (0.0, 0.05, 0.0),
     "loosening_length": (0.005, 0.5, 0.05),
     "loosening_keep": (0.0, 0.95, 0.0),
+    "erosion_length": (0.0, 1000.0, 0.0),
+    "erosion_keep": (0.0, 0.95, 0.2),
+    "erosion_restore": (0.0005, 0.05, 0.005),
 }
-"""(lower, upper, neutral start) of each fitted value; ``depth_saturation`` is fitted as 1 / d_s [1/m] (0 = off).
+"""(lower, upper, neutral start) of each fitted value; the lengths of :data:`FIT_INVERTED` are fitted as their
+inverse [1/m] (0 = off).
 
 With the exponent n != 1, the reference depth sets the law's scale: d_ref (d / d_ref)^n = d_ref^(1 - n) d^n, so the
 pair fits a power law C d^n (a stiffer or softer medium than the published one); at n = 1 it has no effect."""
+
+FIT_INVERTED: tuple[str, ...] = ("depth_saturation", "erosion_length")
+"""Terms fitted as 1 / value, so that the neutral start 0 is the term off and the fit moves into it smoothly."""
 
 DATUM_BOUNDS: tuple[float, float, float] = (-0.01, 0.04, 0.0)
 """(lower, upper, start) of the fitted datum: height of the felt sand surface above the nominal bed top [m]."""
@@ -115,7 +123,7 @@ class SandFitCfg:
             if name in self.params:
                 raise ValueError(f"term {name!r} is both fixed and fitted: drop it from params")
             lo, hi, _ = FIT_BOUNDS[name]
-            if name != "depth_saturation" and not lo <= value <= hi:
+            if name not in FIT_INVERTED and not lo <= value <= hi:
                 raise ValueError(f"fixed {name}={value} lies outside its fit bounds [{lo}, {hi}]")
             if not value >= 0.0:
                 raise ValueError(f"fixed {name}={value} must be >= 0")
@@ -165,9 +173,10 @@ def dataset_material(ds: CalibrationDataset) -> Any:
 def _extensions(x: np.ndarray, cfg: SandFitCfg, plastic: bool) -> RftExtensionsCfg:
     """Return the RftExtensionsCfg of parameter vector ``x`` (in ``cfg.params`` order)."""
     values: dict[str, Any] = dict(zip(cfg.params, (float(v) for v in x), strict=True))
-    if "depth_saturation" in values:
-        inv = values.pop("depth_saturation")
-        values["depth_saturation"] = 1.0 / inv if inv > 1e-9 else 0.0
+    for name in FIT_INVERTED:
+        if name in values:
+            inv = values.pop(name)
+            values[name] = 1.0 / inv if inv > 1e-9 else 0.0
     values.update(dict(cfg.fixed))
     if plastic:
         values.update(plastic_unloading=True, footprint_radius=cfg.footprint_radius)

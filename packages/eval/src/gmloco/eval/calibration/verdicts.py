@@ -21,7 +21,7 @@ from typing import Any, Literal
 from gmloco.contact import RftExtensionsCfg
 from gmloco.deploy.atomic_io import atomic_write_json
 from gmloco.eval.calibration.dataset import CalibrationDataset, ContractError, file_sha256, load_dataset
-from gmloco.eval.calibration.fit import FIT_BOUNDS, SandFitCfg, SandFitResult, fit_extensions
+from gmloco.eval.calibration.fit import FIT_BOUNDS, FIT_INVERTED, SandFitCfg, SandFitResult, fit_extensions
 
 __all__ = ["TERMS", "TermVerdictCfg", "term_verdicts"]
 
@@ -61,9 +61,9 @@ def _variant(ds: CalibrationDataset, cfg: TermVerdictCfg, terms: frozenset[str],
 
 
 def _fitted_value(ext: RftExtensionsCfg, param: str) -> float:
-    """Return a fitted value in the coordinates of FIT_BOUNDS (``depth_saturation`` as 1 / d_s [1/m])."""
+    """Return a fitted value in the coordinates of FIT_BOUNDS (the :data:`FIT_INVERTED` lengths as 1 / L [1/m])."""
     value = float(getattr(ext, param))
-    if param == "depth_saturation":
+    if param in FIT_INVERTED:
         return 1.0 / value if value > 0.0 else 0.0
     return value
 
