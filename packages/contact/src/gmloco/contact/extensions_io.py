@@ -16,13 +16,14 @@ __all__ = ["load_rft_extensions", "save_rft_extensions"]
 
 
 def save_rft_extensions(ext: RftExtensionsCfg, path: str | Path, provenance: dict[str, Any]) -> Path:
-    """Write ``{"extensions": ..., "provenance": ...}`` to ``path`` atomically (temporary file, then rename)."""
+    """Write ``{"extensions": ..., "provenance": ...}`` to ``path`` atomically (temporary file, then rename; 0644)."""
     path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
     fd, tmp = tempfile.mkstemp(dir=path.parent, suffix=".json.tmp")
     try:
         with os.fdopen(fd, "w") as fh:
             json.dump({"extensions": asdict(ext), "provenance": provenance}, fh, indent=1)
+        os.chmod(tmp, 0o644)  # readable by all, as any other result file (mkstemp makes it 0600)
         os.replace(tmp, path)
     finally:
         if os.path.exists(tmp):
