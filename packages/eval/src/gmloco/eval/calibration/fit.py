@@ -61,18 +61,20 @@ FIT_BOUNDS: dict[str, tuple[float, float, float]] = {
     "loosening_depth": (0.0, 0.05, 0.0),
     "loosening_length": (0.005, 0.5, 0.05),
     "loosening_keep": (0.0, 0.95, 0.0),
-    "erosion_length": (0.0, 1000.0, 0.0),
+    "erosion_length": (0.0, 1000.0, 50.0),
     "erosion_keep": (0.0, 0.95, 0.2),
     "erosion_restore": (0.0005, 0.05, 0.005),
 }
-"""(lower, upper, neutral start) of each fitted value; the lengths of :data:`FIT_INVERTED` are fitted as their
-inverse [1/m] (0 = off).
+"""(lower, upper, start) of each fitted value, the start neutral (the term off) but for ``erosion_length``; the
+lengths of :data:`FIT_INVERTED` are fitted as their inverse [1/m] (0 = off). Erosion starts at 1 / L = 50 (2 cm):
+from 0 the finite-difference step (L ~ 10 km) changes no force, the gradient vanishes and the fit never turns
+the term on (basalt and poppy seed, ``results/sand_calibration/``).
 
 With the exponent n != 1, the reference depth sets the law's scale: d_ref (d / d_ref)^n = d_ref^(1 - n) d^n, so the
 pair fits a power law C d^n (a stiffer or softer medium than the published one); at n = 1 it has no effect."""
 
 FIT_INVERTED: tuple[str, ...] = ("depth_saturation", "erosion_length")
-"""Terms fitted as 1 / value, so that the neutral start 0 is the term off and the fit moves into it smoothly."""
+"""Terms fitted as 1 / value, so that 0 is the term off and the fit moves into it smoothly."""
 
 DATUM_BOUNDS: tuple[float, float, float] = (-0.01, 0.04, 0.0)
 """(lower, upper, start) of the fitted datum: height of the felt sand surface above the nominal bed top [m]."""

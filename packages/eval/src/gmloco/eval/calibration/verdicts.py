@@ -72,7 +72,8 @@ def _at_bound(ext: RftExtensionsCfg, term: str, tol: float) -> list[str]:
     """Return ``"param = value (bounds lo..hi)"`` for each value of ``term`` at a bound that is not its off value."""
     hits = []
     for p in TERMS[term]:
-        lo, hi, off = FIT_BOUNDS[p]
+        lo, hi, start = FIT_BOUNDS[p]
+        off = 0.0 if p in FIT_INVERTED else start  # an inverted length is off at 0 whatever its start
         v = _fitted_value(ext, p)
         if any(abs(v - b) <= tol * (hi - lo) and b != off for b in (lo, hi)):
             hits.append(f"{p} = {v:.4g} (bounds {lo:g}..{hi:g})")

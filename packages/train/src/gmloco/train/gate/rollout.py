@@ -14,6 +14,7 @@ from typing import Any, Literal
 
 import numpy as np
 import torch
+from tqdm import tqdm
 
 import gmloco.contact as gc
 from gmloco.train.gate.config import GateCfg
@@ -177,8 +178,10 @@ def _start(env: Any, commands: torch.Tensor) -> dict[str, torch.Tensor]:
     return env.observation_manager.compute(update_history=True, env_ids=ids)
 
 
-def _rollout(env: Any, act: Actor, commands: torch.Tensor, steps: int) -> dict[str, np.ndarray]:
-    """Run one batch and return its traces.
+def _rollout(
+    env: Any, act: Actor, commands: torch.Tensor, steps: int, on_step: Callable[[], object] | None = None
+) -> dict[str, np.ndarray]:
+    """Run one batch and return its traces (``on_step`` is called after every policy step: the progress bar).
 
     Returns:
         ``[T, W]`` traces after each step (``x``, ``y`` [m], ``yaw`` [rad], ``wz`` world yaw rate [rad/s],
@@ -197,6 +200,8 @@ def _rollout(env: Any, act: Actor, commands: torch.Tensor, steps: int) -> dict[s
     trace: dict[str, list[torch.Tensor]] = {}
     terms = env.termination_manager
     for _ in range(steps):
+        if on_step is not None:
+            on_step()
         actions, eta = act(obs)
         obs, _, terminated, _, _ = env.step(actions)
         ended = {f"ended_{name}": terms.get_term(name) & alive for name in terms.active_terms}
@@ -300,18 +305,22 @@ def run_cells(cfg: GateCfg, policy: GatePolicy, cells: list[GateCell]) -> list[d
 
     env, act = _onnx_actor(cfg, policy) if policy.kind == "ppo" else _checkpoint_actor(cfg, policy)
     rows: list[dict[str, Any]] = []
+    n = env.num_envs
+    steps = round(cfg.duration_s / env.step_dt)
+    batches = -(-len(cells) // n)
+    bar = tqdm(total=batches * steps, desc=f"gate: {len(cells)} episodes in {batches} batches", unit="step",
+               mininterval=5.0)  # fmt: skip
     try:
-        n = env.num_envs
-        steps = round(cfg.duration_s / env.step_dt)
         for lo in range(0, len(cells), n):
             batch = cells[lo : lo + n]
             padded = batch + [batch[-1]] * (n - len(batch))
             _pin_materials(env, [c.rho_c for c in padded], [c.mu_int for c in padded], [c.mu_surf for c in padded])
             commands = torch.tensor([c.command for c in padded], dtype=torch.float32, device=env.device)
             with torch.no_grad():
-                raw = _rollout(env, act, commands, steps)
+                raw = _rollout(env, act, commands, steps, on_step=bar.update)
             rows += episode_rows(cfg, batch, {k: v[..., : len(batch)] if v.ndim == 1 else v[:, : len(batch)]
                                               for k, v in raw.items()}, float(env.step_dt))  # fmt: skip
     finally:
+        bar.close()
         env.close()
     return rows
