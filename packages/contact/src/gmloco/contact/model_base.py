@@ -68,9 +68,9 @@ def make_at_rest_params(cfg: Any) -> Any:  # an AtRestParams instance (Warp stru
     ext = getattr(cfg, "extensions", None)
     rest.footprint_radius = float(ext.footprint_radius) if ext is not None else 0.0
     rest.loosening_dt = float(ext.dt) if ext is not None and ext.loosening_depth > 0.0 else 0.0
-    eroding = ext is not None and ext.erosion_length > 0.0
-    rest.erosion_rate = float(ext.dt / ext.erosion_length) if eroding else 0.0
-    rest.erosion_restore = float(ext.erosion_restore) if eroding else 1.0
+    rest.erosion_rate, rest.erosion_restore = 0.0, 1.0
+    if ext is not None and ext.erosion_length > 0.0:
+        rest.erosion_rate, rest.erosion_restore = float(ext.dt / ext.erosion_length), float(ext.erosion_restore)
     return rest
 
 
