@@ -51,7 +51,11 @@ def test_every_delivered_role_has_a_policy() -> None:
 
 @pytest.mark.parametrize("path", POLICIES, ids=[p.parent.name for p in POLICIES])
 def test_committed_policy_runs_from_its_metadata_alone(path: Path) -> None:
-    """Metadata validates and equals policy.json; the runner's actions equal onnxruntime on inputs built by hand."""
+    """Metadata validates and equals policy.json; the runner's actions equal onnxruntime on inputs built by hand.
+
+    A ``yaw_target`` policy is stepped with headings that follow its commanded yaw rate exactly, so the observed
+    yaw-rate command is the raw one clipped to the trained range.
+    """
     import onnxruntime as ort
 
     meta = read_policy_metadata(path)
@@ -62,10 +66,20 @@ def test_committed_policy_runs_from_its_metadata_alone(path: Path) -> None:
     runner = OnnxPolicyRunner(path, num_envs=ENVS)
     rng = np.random.default_rng(0)
     frames: list[np.ndarray] = []
+    yaw_target = meta.command.yaw_command == "yaw_target"
+    heading = np.zeros(ENVS)  # robots that turn exactly as commanded: no heading error to correct
     for _ in range(STEPS):
         terms = {t.name: rng.standard_normal((ENVS, t.dim)).astype(np.float32) for t in meta.observation.terms}
-        actions = runner.step(terms)
-        frames.append(_frame(meta, terms))
+        if not yaw_target:
+            actions = runner.step(terms)
+            frames.append(_frame(meta, terms))
+            continue
+        actions = runner.step(terms, heading=heading)
+        lo, hi = meta.command.stages[-1]["ang_vel_z"] if meta.command.stages else meta.command.ang_vel_z
+        seen = terms | {"command": terms["command"].copy()}
+        seen["command"][:, -1] = np.clip(terms["command"][:, -1], lo, hi)  # w_z + k * 0, clipped to the range
+        frames.append(_frame(meta, seen))
+        heading = heading + terms["command"][:, -1] * meta.timing.policy_dt
     assert actions.shape == (ENVS, 29) and np.isfinite(actions).all()
     runtime = ort.InferenceSession(str(path), providers=["CPUExecutionProvider"])
     names = [i.name for i in runtime.get_inputs()]
