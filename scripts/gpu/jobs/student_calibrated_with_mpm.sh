@@ -5,15 +5,17 @@
 # student: straight ten-second walks on the tables' cell setting (3 cm voxels, 500 iterations, 5 ms frames, 30 cm
 # bed, 1.4 x 0.6 m window), time-boxed and resumable, into ~/chunks/g1_eval/<terrain>. MPM_TERRAINS (default
 # dry_sand) and MPM_SPEEDS (default 1.0) pick the cells, MPM_EPISODES (default 20) the episodes of each terrain,
-# all robots of a terrain in one solver. Without an exported policy (the training stopped before its export) the
-# MPM part says so and runs nothing.
+# all robots of a terrain in one solver. MPM_MINUTES=0 trains to the end and skips the MPM part (the student alone).
+# Without an exported policy (the training stopped before its export) the MPM part says so and runs nothing.
 set -uo pipefail
 end=$1
 cd ~/src
 mpm_s=$(python3 -c "print(round(60 * ${MPM_MINUTES:-9}))")
 NESTED=1 bash scripts/gpu/jobs/student_calibrated.sh "$(( end - mpm_s ))"
 policy=~/chunks/student/policy.onnx
-if [ ! -f "$policy" ]; then
+if [ "$mpm_s" -le 0 ]; then
+  echo "MPM_MINUTES=${MPM_MINUTES:-9}: MPM evaluation skipped" >> ~/chunks/job.log
+elif [ ! -f "$policy" ]; then
   echo "no exported student ($policy): MPM evaluation skipped" >> ~/chunks/job.log
 else
   source scripts/gpu/env.sh
