@@ -1,8 +1,8 @@
 # SPDX-License-Identifier: Apache-2.0
 """Candidate terms beyond 3D-RFT (``RftExtensionsCfg``) as Warp functions.
 
-Depth law, lateral scale, plastic unloading, overburden,
-added mass, loosening and support erosion by horizontal travel. Each is skipped when off, so the published force is unchanged bit for bit.
+Depth law, lateral scale, plastic unloading, overburden, added mass, loosening and support erosion by horizontal
+travel. Each is skipped when off, so the published force is unchanged bit for bit.
 
 Per-world values live in one array ``values[world % values.shape[0], column]`` (shared or domain-randomized, MuJoCo
 Warp's batch-modulo rule); the on/off flags are by-value struct fields fixed at model build time.

@@ -181,7 +181,7 @@ def _start(env: Any, commands: torch.Tensor) -> dict[str, torch.Tensor]:
 def _rollout(
     env: Any, act: Actor, commands: torch.Tensor, steps: int, on_step: Callable[[], object] | None = None
 ) -> dict[str, np.ndarray]:
-    """Run one batch and return its traces (``on_step`` is called after every policy step: the progress bar).
+    """Run one batch and return its traces (``on_step``, the progress bar, is called once per policy step).
 
     Returns:
         ``[T, W]`` traces after each step (``x``, ``y`` [m], ``yaw`` [rad], ``wz`` world yaw rate [rad/s],
