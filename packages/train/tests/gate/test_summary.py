@@ -147,3 +147,16 @@ def test_success_by_the_course_rule() -> None:
     assert m["success_course_pct"]["poppy_seed"] == {"0.5": 100.0, "1": 100.0}
     assert m["failures"]["basalt"]["1"] == ["tilt at 3.00 s", "course_unfinished"]
     assert gate_metrics(_cfg(), _rows(0.16))["success_course_pct"]["basalt"] == {"0.5": None, "1": None}
+
+
+@pytest.mark.parametrize(("kind", "failing"), [("yaw", "yaw_rate_ratio"), ("circle", "circle_dtw_m")])
+def test_a_fall_while_turning_fails_its_key(kind: str, failing: str) -> None:
+    """A robot that falls in a yaw or circle cell fails that key even when its alive steps tracked the command."""
+    rows = _rows(0.16)
+    turn = next(i for i, r in enumerate(rows) if r["cell"].kind == kind and r["cell"].material == "poppy_seed")
+    rows[turn]["failed"] = True
+    m = gate_metrics(_cfg(), rows) | {"gpu_minutes": 10.0}
+    falls = m["turn_falls"][kind]["poppy_seed"]
+    assert (falls["0.5"] if kind == "yaw" else falls) == 1
+    verdict = gate_pass(m, GateThresholdsCfg(), ("basalt", "poppy_seed"))
+    assert {k for k, ok in verdict.items() if not ok} == {failing, "all"}

@@ -87,17 +87,38 @@ def _eta_r2(rows: list[dict[str, Any]]) -> float | None:
     return r2 if math.isfinite(r2) else None
 
 
+def _turn_falls(cfg: GateCfg, rows: list[dict[str, Any]]) -> dict[str, Any] | None:
+    """Episodes that fell in the yaw and circle cells: ``{"yaw": {material: {w_z: n}}, "circle": {material: n}}``.
+
+    A turning robot that falls has its yaw rate and path measured over the steps it was alive; the fall itself
+    fails the key (:func:`gate_pass`), so a short turn before a fall never passes. None when neither part ran.
+    """
+    if "yaw" not in cfg.parts and "circle" not in cfg.parts:
+        return None
+    falls: dict[str, Any] = {}
+    if "yaw" in cfg.parts:
+        falls["yaw"] = {
+            m: {_key(w): sum(r["failed"] for r in _rows(rows, "yaw", m, (cfg.yaw_forward_speed, 0.0, w)))
+                for w in cfg.yaw_rates}
+            for m in cfg.materials
+        }  # fmt: skip
+    if "circle" in cfg.parts:
+        falls["circle"] = {m: sum(r["failed"] for r in _rows(rows, "circle", m)) for m in cfg.materials}
+    return falls
+
+
 def gate_metrics(cfg: GateCfg, rows: list[dict[str, Any]]) -> dict[str, Any]:
     """Return the issue's keys from the episode rows of :func:`gmloco.train.gate.rollout.run_cells`.
 
     ``success_pct``, ``vel_error_mps``, ``heading_drift_deg``: ``{material: {v_x: value}}`` over the forward cells
     ([%], [m/s], [deg], means over episodes); ``yaw_rate_ratio``: ``{material: {w_z: mean achieved / commanded}}``;
     ``circle_dtw_m``: ``{material: mean DTW error}`` [m]; ``swing_apex_cm``: ``{material: mean apex}`` [cm] of the
-    ``apex_speed`` forward cells; ``eta_r2_heldout``: pooled R^2 of the held-out cells (None without a decoded eta).
-    The keys of a part not in ``cfg.parts`` are None.
+    ``apex_speed`` forward cells; ``eta_r2_heldout``: pooled R^2 of the held-out cells (None without a decoded eta);
+    ``turn_falls``: the falls of the yaw and circle cells (:func:`_turn_falls`). The keys of a part not in
+    ``cfg.parts`` are None.
     """
     keys = ("success_pct", "vel_error_mps", "yaw_rate_ratio", "heading_drift_deg", "circle_dtw_m", "swing_apex_cm")
-    extra = ("failures", "stance_sink_cm", "stance_sink_peak_cm", "success_course_pct")
+    extra = ("failures", "stance_sink_cm", "stance_sink_peak_cm", "success_course_pct", "turn_falls")
     out: dict[str, Any] = dict.fromkeys((*keys, "eta_r2_heldout", *extra))
     if "success" in cfg.parts:
         _forward(cfg, rows, out)
@@ -109,6 +130,7 @@ def gate_metrics(cfg: GateCfg, rows: list[dict[str, Any]]) -> dict[str, Any]:
         }  # fmt: skip
     if "circle" in cfg.parts:
         out["circle_dtw_m"] = {m: _mean([r["dtw_m"] for r in _rows(rows, "circle", m)]) for m in cfg.materials}
+    out["turn_falls"] = _turn_falls(cfg, rows)
     if "apex" in cfg.parts:
         out["swing_apex_cm"] = {}
         for m in cfg.materials:
@@ -126,17 +148,23 @@ def _all_within(table: dict[str, dict[str, float | None]], ok: Any) -> bool:
 
 
 def _verdicts(metrics: dict[str, Any], t: GateThresholdsCfg, materials: tuple[str, ...]) -> dict[str, bool]:
-    """Compare every key of every part with its threshold (a missing value fails)."""
+    """Compare every key of every part with its threshold (a missing value fails; so does a fall while turning)."""
     apex = metrics["swing_apex_cm"] or {}
     first, last = apex.get(materials[0]), apex.get(materials[-1])
     circles = list((metrics["circle_dtw_m"] or {}).values())
     eta = metrics["eta_r2_heldout"]
+    falls = metrics.get("turn_falls") or {}
+    yaw_falls = sum(n for per in (falls.get("yaw") or {}).values() for n in per.values())
+    circle_falls = sum((falls.get("circle") or {}).values())
     return {
         "success_pct": _all_within(metrics["success_pct"] or {}, lambda v: v >= t.success_pct),
         "vel_error_mps": _all_within(metrics["vel_error_mps"] or {}, lambda v: v <= t.vel_error_mps),
-        "yaw_rate_ratio": _all_within(metrics["yaw_rate_ratio"] or {}, lambda v: abs(v - 1.0) <= t.yaw_rate_tolerance),
+        "yaw_rate_ratio": yaw_falls == 0
+        and _all_within(metrics["yaw_rate_ratio"] or {}, lambda v: abs(v - 1.0) <= t.yaw_rate_tolerance),
         "heading_drift_deg": _all_within(metrics["heading_drift_deg"] or {}, lambda v: v <= t.heading_drift_deg),
-        "circle_dtw_m": bool(circles) and all(v is not None and v <= t.circle_dtw_m for v in circles),
+        "circle_dtw_m": circle_falls == 0
+        and bool(circles)
+        and all(v is not None and v <= t.circle_dtw_m for v in circles),
         "swing_apex_cm": first is not None and last is not None and last - first >= t.swing_apex_rise_cm,
         "eta_r2_heldout": eta is not None and eta >= t.eta_r2_heldout,
     }
