@@ -7,12 +7,18 @@
 # dry_sand) and MPM_SPEEDS (default 1.0) pick the cells, MPM_EPISODES (default 20) the episodes of each terrain,
 # all robots of a terrain in one solver. MPM_MINUTES=0 trains to the end and skips the MPM part (the student alone).
 # Without an exported policy (the training stopped before its export) the MPM part says so and runs nothing.
+# MPM_POLICY=<policy.onnx, its policy.json beside it> skips the training and scores that export on MPM instead.
 set -uo pipefail
 end=$1
 cd ~/src
 mpm_s=$(python3 -c "print(round(60 * ${MPM_MINUTES:-9}))")
-NESTED=1 bash scripts/gpu/jobs/student_calibrated.sh "$(( end - mpm_s ))"
-policy=~/chunks/student/policy.onnx
+if [ -n "${MPM_POLICY:-}" ]; then
+  policy=$MPM_POLICY
+  echo "MPM_POLICY=$policy: training skipped" >> ~/chunks/job.log
+else
+  NESTED=1 bash scripts/gpu/jobs/student_calibrated.sh "$(( end - mpm_s ))"
+  policy=~/chunks/student/policy.onnx
+fi
 if [ "$mpm_s" -le 0 ]; then
   echo "MPM_MINUTES=${MPM_MINUTES:-9}: MPM evaluation skipped" >> ~/chunks/job.log
 elif [ ! -f "$policy" ]; then
