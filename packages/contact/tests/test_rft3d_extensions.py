@@ -41,6 +41,7 @@ TERMS: dict[str, RftExtensionsCfg] = {
     "loosening": RftExtensionsCfg(loosening_depth=0.01, loosening_length=0.02),
     "loosening_keep": RftExtensionsCfg(loosening_depth=0.03, loosening_length=0.02, loosening_keep=0.3),
     "erosion": RftExtensionsCfg(erosion_length=0.02, erosion_keep=0.2, erosion_restore=0.005),
+    "rate_drag": RftExtensionsCfg(rate_drag=3.0),
     "all": RftExtensionsCfg(
         depth_exponent=0.8,
         depth_saturation=0.04,
@@ -163,6 +164,18 @@ def test_overburden_pulls_down_a_rising_sole(device: str) -> None:
     rho_c = MATERIAL_PRESETS["dry_sand"].rho_c
     expected = -2.0 * rho_c * 9.81 * 0.02 * 0.206 * 0.0736
     np.testing.assert_allclose(_wrench(model, _level_sole(0.02, (0.0, 0.0, 0.1)))[2], expected, rtol=1e-5)
+
+
+def test_rate_drag_opposes_a_slide_in_proportion_to_speed(device: str) -> None:
+    """A level sole 20 mm deep sliding at (0.5, 0.2) m/s gets -c_rd rho_c g d A v_xy on top of 3D-RFT (hand value)."""
+    feet = _level_sole(0.02, (0.5, 0.2, -0.1))
+    plain = _wrench(make_contact_model(ContactRFT3DCfg(at_rest="none"), 1, 1, device), feet)
+    cfg = ContactRFT3DCfg(at_rest="none", extensions=TERMS["rate_drag"])
+    dragged = _wrench(make_contact_model(cfg, 1, 1, device), feet)
+    # only the sole face is submerged: A = 0.206 * 0.0736 m^2 at d = 0.02 m
+    k = 3.0 * MATERIAL_PRESETS["dry_sand"].rho_c * 9.81 * 0.02 * 0.206 * 0.0736
+    np.testing.assert_allclose(dragged[:3] - plain[:3], [-k * 0.5, -k * 0.2, 0.0], rtol=1e-4, atol=1e-3)
+    assert k * 0.5 > 1.0
 
 
 def test_lateral_scale_scales_only_horizontal(device: str) -> None:

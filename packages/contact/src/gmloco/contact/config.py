@@ -62,8 +62,9 @@ class RftExtensionsCfg:
     """Candidate terms beyond 3D-RFT (Agarwal, Goldman & Kamrin, PNAS 2023); every default is the published 3D-RFT.
 
     Each term is off at its neutral value and then leaves the force bit for bit unchanged (the kernels skip it).
-    The per-world values (all fields but ``footprint_radius``, the loosening and erosion terms and ``dt``) can be
-    domain-randomized through ``ContactRFT3D.set_extensions``. Reference: :mod:`gmloco.contact.reference.rft3d_extensions`.
+    The per-world values (all fields but ``footprint_radius``, the loosening, erosion and rate-drag terms and ``dt``)
+    can be domain-randomized through ``ContactRFT3D.set_extensions``. Reference:
+    :mod:`gmloco.contact.reference.rft3d_extensions`.
     """
 
     depth_exponent: float = 1.0
@@ -115,6 +116,13 @@ class RftExtensionsCfg:
     after a 10 cm slide)."""
     erosion_restore: float = 0.005
     """(g) Depth past z_max over which an eroded element's support comes back (e-folding) [m]."""
+    rate_drag: float = 0.0
+    """(h) Rate-dependent horizontal drag: a submerged element moving sideways at v_xy gets -c_rd rho_c g d dS v_xy
+    [N], the weight of the grain column over its area times c_rd |v_xy|, opposing the slide. 3D-RFT's resistance
+    does not depend on speed; under MPM's walking soles the horizontal force grows with the sole's speed (about 40 N
+    planted to 100-200 N above 1 m/s at the same depth, ``results/sand_calibration/walk_replay/``). Any face, at
+    the element's depth below the free surface. [s/m]; 0 = off. Not domain-randomized per world (one value per
+    model)."""
     dt: float = 0.005
     """Physics step of the finite-difference acceleration of ``added_mass`` and of the travel of ``loosening_depth``
     and ``erosion_length`` [s] (state update once per step)."""
@@ -136,6 +144,7 @@ class RftExtensionsCfg:
             "erosion_length": self.erosion_length >= 0.0,
             "erosion_keep": 0.0 <= self.erosion_keep < 1.0,
             "erosion_restore": self.erosion_restore > 0.0,
+            "rate_drag": self.rate_drag >= 0.0,
             "dt": self.dt > 0.0,
         }
         for name, ok in checks.items():

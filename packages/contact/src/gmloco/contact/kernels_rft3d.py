@@ -24,6 +24,7 @@ from gmloco.contact.kernels_rft3d_ext import (
     ext_erosion_factor,
     ext_lateral,
     ext_loosening_shift,
+    ext_rate_drag,
     ext_vertical_force,
     ext_within_crater,
 )
@@ -247,7 +248,7 @@ def rft3d_element_force_ext(
     """Return :func:`rft3d_element_force` with the extension terms (:mod:`~gmloco.contact.kernels_rft3d_ext`) [N].
 
     Plastic unloading in place of the crater branches, the depth law on both branches' depth, the lateral scale on
-    the resistive force, then the vertical overburden and added-mass forces; each skipped where its flag is off.
+    the resistive force, the erosion factor and the rate drag, then the vertical overburden and added-mass forces; each skipped where its flag is off.
     Compiled only into the kernels of models with a term on (:func:`rft3d_element_kernel_func`), so the published
     model's kernels carry none of this code (registers).
     """
@@ -279,6 +280,8 @@ def rft3d_element_force_ext(
     force = ext_lateral(force, ext, w)  # (b) lateral scale
     if ext.erosion != 0:  # (g) support eroded by horizontal travel
         force = wp.vec3(force[0], force[1], force[2] * ext_erosion_factor(state.travel[w, f, p], ext))
+    if ext.rate_drag > 0.0:  # (h) drag growing with the sliding speed
+        force = force + ext_rate_drag(v, depth, area, mat[0], m.gravity, ext)
     if ext.overburden != 0 or ext.added_mass != 0:  # (d) overburden at lift-off, (e) added mass
         f_z = ext_vertical_force(n, v, state.vel_prev[w, f, p], depth, area, mat[0], m.gravity, ext, w)
         force = force + wp.vec3(0.0, 0.0, f_z)

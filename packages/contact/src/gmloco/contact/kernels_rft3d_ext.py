@@ -2,7 +2,7 @@
 """Candidate terms beyond 3D-RFT (``RftExtensionsCfg``) as Warp functions.
 
 Depth law, lateral scale, plastic unloading, overburden, added mass, loosening and support erosion by horizontal
-travel. Each is skipped when off, so the published force is unchanged bit for bit.
+travel, rate-dependent horizontal drag. Each is skipped when off, so the published force is unchanged bit for bit.
 
 Per-world values live in one array ``values[world % values.shape[0], column]`` (shared or domain-randomized, MuJoCo
 Warp's batch-modulo rule); the on/off flags are by-value struct fields fixed at model build time.
@@ -22,6 +22,7 @@ __all__ = [
     "ext_erosion_factor",
     "ext_lateral",
     "ext_loosening_shift",
+    "ext_rate_drag",
     "ext_vertical_force",
     "ext_within_crater",
     "make_ext_params",
@@ -49,7 +50,10 @@ COL_TOLERANCE = wp.constant(6)
 
 @wp.struct
 class RftExtParams:
-    """On/off flags of the extension terms (0/1), the per-world values [W or 1, 7] and the physics step [s]."""
+    """On/off flags of the extension terms (0/1), the per-world values [W or 1, 7] and the physics step [s].
+
+    The per-model terms (loosening, erosion, rate drag) carry their values here; ``rate_drag`` > 0 is its own flag.
+    """
 
     depth_law: int
     lateral: int
@@ -64,6 +68,7 @@ class RftExtParams:
     loosening_keep: float
     erosion: int
     erosion_keep: float
+    rate_drag: float
 
 
 @wp.func
@@ -148,6 +153,15 @@ def ext_erosion_factor(share: float, ext: RftExtParams) -> float:
     return 1.0 - (1.0 - ext.erosion_keep) * share
 
 
+@wp.func
+def ext_rate_drag(v: wp.vec3, depth: float, area: float, rho_c: float, gravity: float, ext: RftExtParams) -> wp.vec3:
+    """Return a submerged element's rate-dependent drag -c_rd rho_c g d dS (v_x, v_y, 0) [N] (term (h); 0 above)."""
+    if depth <= 0.0:
+        return wp.vec3(0.0)
+    k = ext.rate_drag * rho_c * gravity * depth * area
+    return wp.vec3(-k * v[0], -k * v[1], 0.0)
+
+
 def rft_ext_values(cfg: Any) -> np.ndarray:
     """Return the per-world value row of an ``RftExtensionsCfg`` in :data:`EXT_COLUMNS` order, [1, 7]."""
     return np.array([[float(getattr(cfg, name)) for name in EXT_COLUMNS]], dtype=np.float64)
@@ -169,4 +183,5 @@ def make_ext_params(cfg: Any, values: wp.array) -> Any:  # an RftExtParams insta
     ext.loosening_keep = float(cfg.loosening_keep)
     ext.erosion = int(cfg.erosion_length > 0.0)
     ext.erosion_keep = float(cfg.erosion_keep)
+    ext.rate_drag = float(cfg.rate_drag)
     return ext

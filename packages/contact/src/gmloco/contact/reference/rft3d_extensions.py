@@ -28,6 +28,7 @@ __all__ = [
     "ext_depth_law",
     "ext_vertical_forces",
     "loosening_shift",
+    "rate_drag_forces",
     "replay_foot_forces",
     "rft3d_extended_forces",
 ]
@@ -133,6 +134,15 @@ def advance_erosion(
     return np.where(depth > 0.0, restored, 0.0)
 
 
+def rate_drag_forces(
+    velocities: np.ndarray, depth: np.ndarray, areas: np.ndarray, rho_c: float, ext: RftExtensionsCfg, g: float
+) -> np.ndarray:
+    """Return each element's rate-dependent horizontal drag -c_rd rho_c g d dS v_xy [N], [N, 2] (term (h); 0 out)."""
+    v = np.asarray(velocities, dtype=np.float64)
+    weight = np.where(depth > 0.0, ext.rate_drag * rho_c * g * depth * np.asarray(areas, dtype=np.float64), 0.0)
+    return -weight[:, None] * v[:, :2]
+
+
 def rft3d_extended_forces(
     points: np.ndarray,
     normals: np.ndarray,
@@ -147,7 +157,7 @@ def rft3d_extended_forces(
 
     Base: plain RFT (``"none"``) or the elastic unloading branch with crater friction (``"unloading"``), both with
     the depth law; plastic unloading zeroes 0 < d < z_max - tolerance; the lateral scale multiplies F_x, F_y; the
-    erosion factor F_z; the overburden and added-mass forces are added along z.
+    erosion factor F_z; the rate drag is added along x, y, the overburden and added-mass forces along z.
     """
     ext = cfg.extensions
     if cfg.at_rest not in ("none", "unloading"):
@@ -180,6 +190,8 @@ def rft3d_extended_forces(
     f = f * np.array([ext.lateral_scale, ext.lateral_scale, 1.0])
     if ext.erosion_length > 0.0:  # (g) support lost to horizontal travel
         f[:, 2] *= erosion_factor(state.travel, ext)
+    if ext.rate_drag > 0.0:  # (h) drag growing with the sliding speed
+        f[:, :2] += rate_drag_forces(velocities, depth, areas, material.rho_c, ext, cfg.gravity)
     f[:, 2] += ext_vertical_forces(normals, velocities, state.vel_prev, depth, areas, material.rho_c, ext, cfg.gravity)
     return f
 
