@@ -196,7 +196,7 @@ def _cfg_dict(cfg: WalkRecordsCfg) -> dict[str, Any]:
 def main(argv: list[str] | None = None) -> int:
     """Command line: write the walk dataset of ``--recordings`` on ``--material`` to ``--out`` (exit 2 on bad input)."""
     p = argparse.ArgumentParser(
-        prog="python -m gmloco.eval.calibration.walk_records", description=__doc__.split("\n")[0]
+        prog="python -m gmloco.eval.calibration.walk_records", description=(__doc__ or "").split("\n")[0]
     )
     p.add_argument("--recordings", nargs="+", required=True, help="MPM evaluation recordings (.mcap)")
     p.add_argument("--material", required=True, help=f"medium of the beds, one of {sorted(MATERIAL_PRESETS)}")

@@ -145,7 +145,7 @@ def _models(specs: list[str]) -> dict[str, RftExtensionsCfg]:
 def main(argv: list[str] | None = None) -> int:
     """Command line of the module docstring (exit 2 on bad input)."""
     p = argparse.ArgumentParser(
-        prog="python -m gmloco.eval.calibration.walk_replay", description=__doc__.split("\n")[0]
+        prog="python -m gmloco.eval.calibration.walk_replay", description=(__doc__ or "").split("\n")[0]
     )
     p.add_argument("--dataset", required=True, help="walk dataset from python -m gmloco.eval.calibration.walk_records")
     p.add_argument("--model", action="append", default=[], help="LABEL=FILE of fitted RftExtensionsCfg (repeatable)")
