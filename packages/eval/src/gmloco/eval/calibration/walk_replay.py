@@ -3,8 +3,10 @@
 
 A walk dataset (:mod:`gmloco.eval.calibration.walk_records`) holds, per foot and 50 Hz frame, where the sole box was,
 how it moved and the force MPM's sand put on it. Every model (the published 3D-RFT always, fitted terms with
-``--model LABEL=FILE``) replays the same kinematics with a fresh memory per foot at datum 0, as the training
-simulator meets the bed. Per model: the RMS force error per split [N]; per bin of the sole's horizontal speed and
+``--model LABEL=FILE``) replays the same kinematics with a fresh memory per foot, at the datum (the height of the
+surface the sole feels above the bed's nominal top) that fits the walks' fit split best with the model's terms held:
+MPM's grid carries a sole up to a voxel above the nominal top, and on a flat bed a datum is only a shift of the
+surface, which the training simulator's flat sand leaves out. Per model: the RMS force error per split [N]; per bin of the sole's horizontal speed and
 depth (submerged frames only), the mean vertical force and horizontal force magnitude of MPM and of each model [N],
 which says where a model is too stiff or too soft::
 
@@ -30,7 +32,7 @@ from gmloco.contact import RftExtensionsCfg
 from gmloco.contact.extensions_io import load_rft_extensions
 from gmloco.deploy.atomic_io import atomic_write_json
 from gmloco.eval.calibration.dataset import CalibrationDataset, load_dataset
-from gmloco.eval.calibration.fit import SandFitCfg, replay_forces, split_error
+from gmloco.eval.calibration.fit import SandFitCfg, fit_datum, replay_forces, split_error
 
 __all__ = ["DEPTH_EDGES_M", "SPEED_EDGES_MPS", "binned_forces", "main", "walk_replay"]
 
@@ -68,17 +70,22 @@ def binned_forces(depth: np.ndarray, speed: np.ndarray, forces: dict[str, np.nda
 
 
 def walk_replay(ds: CalibrationDataset, models: dict[str, RftExtensionsCfg], cfg: SandFitCfg) -> dict[str, Any]:
-    """Return the summary of the module docstring for the walks of ``ds`` and ``models`` (published one added)."""
+    """Return the summary of the module docstring for the walks of ``ds`` and ``models`` (published one added).
+
+    Keys: ``dataset``, ``models`` (their terms), ``datum_m`` (each model's fitted datum [m]), ``rms_force_error_N``
+    (per split, at that datum) and ``bins`` (:func:`binned_forces`).
+    """
     models = {"published": RftExtensionsCfg(), **models}
     names = list(ds.records)
     vel = _stack(ds, "lin_vel", names)
     depth, speed = _stack(ds, "depth", names), np.hypot(vel[:, 0], vel[:, 1])
     forces = {"mpm": _stack(ds, "force", names)}
-    errors = {}
+    errors, datums = {}, {}
     for label, ext in models.items():
-        replay = replay_forces(ds, ext, cfg, names)
+        datums[label] = fit_datum(ds, ext, cfg)
+        replay = replay_forces(ds, ext, cfg, names, datums[label])
         forces[label] = np.concatenate([replay[n] for n in names])
-        errors[label] = split_error(ds, ext, cfg)[0]
+        errors[label] = split_error(ds, ext, cfg, datums[label])[0]
     return {
         "dataset": {
             "material": ds.material,
@@ -89,6 +96,7 @@ def walk_replay(ds: CalibrationDataset, models: dict[str, RftExtensionsCfg], cfg
             "recordings": (ds.extra or {}).get("recordings"),
         },
         "models": {label: asdict(ext) for label, ext in models.items()},
+        "datum_m": datums,
         "rms_force_error_N": errors,
         "bins": binned_forces(depth, speed, forces),
     }
