@@ -329,3 +329,32 @@ def test_policy_reset_of_one_robot_back_fills_its_history_only() -> None:
     for h, s in zip(pol._hist, pol.term_scale, strict=True):
         np.testing.assert_allclose(h[1], 3.0 * s)  # back-filled with the new frame
         np.testing.assert_allclose(h[0, -3:], np.array([[1.0], [2.0], [3.0]]) * s * np.ones_like(h[0, -3:]))
+
+
+def test_foot_force_is_the_mean_over_the_policy_step(monkeypatch: pytest.MonkeyPatch) -> None:
+    """The logged foot force is the mean of the frames' sand wrench since the previous policy step, not one frame's.
+
+    5 ms frames (4 per 50 Hz policy step, the tables' setting): each frame's wrench on the feet is recorded after
+    the frame, and every logged sample after the first equals the mean of the 4 frames before it.
+    """
+    if not POLICY.exists():
+        pytest.skip(f"no exported policy at {POLICY}")
+    spec = MjlabOnnxPolicy(POLICY).spec
+    cfg = G1MpmSceneCfg(window=SandWindowCfg(moving=False, length=0.6, width=0.5, lead=0.0),
+                        solver=MpmSolverCfg(voxel_size=0.05, frame_dt=0.005, rigid_substeps=1))  # fmt: skip
+    scene = G1MpmScene(cfg, spec)
+    frames: list[np.ndarray] = []
+    simulate = scene.simulate
+
+    def recorded() -> None:
+        simulate()
+        frames.append(scene.sand_wrench.numpy()[scene.foot_bodies][..., :3].astype(np.float64))
+
+    monkeypatch.setattr(scene, "simulate", recorded)
+    scene.run(12)
+    per_frame = np.stack(frames)  # [12, R, 2, 3]
+    logged = np.asarray(scene.foot_force)  # samples at frames 0, 4, 8
+    assert scene.frames_per_policy == 4 and len(logged) == 3
+    for k in (1, 2):
+        np.testing.assert_allclose(logged[k], per_frame[4 * (k - 1) : 4 * k].mean(axis=0), rtol=1e-5, atol=1e-3)
+    assert np.abs(per_frame).max() > 1.0  # the sand carries the soles: the means compare real forces

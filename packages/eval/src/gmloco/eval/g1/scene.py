@@ -65,7 +65,9 @@ class G1MpmScene:
     Attributes:
         base_q: Pelvis pose (p, q_xyzw) of every robot at each policy step, list of [R, 7].
         base_qd: Pelvis (linear, angular) world velocity at each policy step, list of [R, 6].
-        foot_force: Sand force on each foot [N], list of [R, 2, 3].
+        foot_force: Sand force on each foot [N], list of [R, 2, 3]: the mean over the frames since the previous policy
+            step (the coupling's force changes from frame to frame; one frame's sample of it need not carry the
+            robot's weight on average).
         sinkage: Depth of each robot's lowest sole point below the local terrain surface [m], list of [R].
         foot_sinkage: The same per foot [m], list of [R, 2].
         joint_q, joint_qd, target: Actuated joints [rad], [rad/s] and PD targets [rad], lists of [R, A].
@@ -269,6 +271,9 @@ class G1MpmScene:
         st = make_coupled_states(newton, wp, self.model, self.sand_model)
         self.state_0, self.state_1, self.control = st.state_0, st.state_1, st.control
         self.sand_state, self.sand_wrench = st.sand_state, st.sand_wrench
+        self.sand_wrench_sum = wp.zeros_like(self.sand_wrench)
+        """Sum of the sand wrench over the frames since the last policy step's read (``foot_force`` is its mean)."""
+        self.frames_summed = 0
         if self.cfg.wall_colliders:  # the sand state's bodies: the robots' then the wall bodies
             nb = self.collider_model.body_count
             self.sand_state.body_q = wp.clone(self.collider_model.body_q)
@@ -298,6 +303,10 @@ class G1MpmScene:
         body_qd = self.state_0.body_qd.numpy()
         pelvis = np.arange(n) * self.bodies_per_robot
         wrench = self.sand_wrench.numpy()
+        if self.frames_summed > 0:  # the mean over the frames since the last read, else this frame's
+            wrench = self.sand_wrench_sum.numpy() / self.frames_summed
+        self.sand_wrench_sum.zero_()
+        self.frames_summed = 0
         return {"body_q": body_q, "base_q": body_q[pelvis].astype(np.float64),
                 "base_qd": body_qd[pelvis].astype(np.float64), "jq": q[:, self.q_idx].astype(np.float64),
                 "jqd": qd[:, self.qd_idx].astype(np.float64),
@@ -367,14 +376,16 @@ class G1MpmScene:
             newton.eval_fk(self.model, st.joint_q, st.joint_qd, st,
                            indices=wp.array(robots, dtype=int, device=self.device))  # fmt: skip
         nb = self.bodies_per_robot
-        wrench = self.sand_wrench.numpy()
+        wrench, summed = self.sand_wrench.numpy(), self.sand_wrench_sum.numpy()
         targets = self.targets.numpy()
         for r, cmd in zip(robots, commands, strict=True):
             wrench[r * nb : (r + 1) * nb] = 0.0
+            summed[r * nb : (r + 1) * nb] = 0.0  # the old episode's frames are not the new one's
             targets[r] = self.spec.default_joint_pos
             self.last_action[r] = 0.0
             self.commands[r] = cmd
         self.sand_wrench.assign(wrench)
+        self.sand_wrench_sum.assign(summed)
         self.targets.assign(targets)
         if self.policy is not None:
             self.policy.reset(robots)
@@ -395,6 +406,7 @@ class G1MpmScene:
         import warp as wp
 
         from gmloco.eval.mpm.kernels_coupling import (
+            accumulate_sand_wrench,
             eval_body_sand_wrench,
             eval_pd_joint_force,
             hand_over_velocity,
@@ -424,6 +436,7 @@ class G1MpmScene:
             self.mpm.collider_body_index, self.model.body_com, self.frame_dt,
             self.mpm.collect_collider_impulses(self.sand_state), self.sand_state.body_q, self.sand_wrench,
         )  # fmt: skip
+        accumulate_sand_wrench(self.sand_wrench, self.sand_wrench_sum)
 
     def _restore_state_parity(self) -> None:
         """After an odd number of substeps, move the newest rigid state back into the frame's first State object.
@@ -455,6 +468,7 @@ class G1MpmScene:
             self.graph = cap.graph
         except Exception as exc:  # a step that cannot be captured still runs eagerly; the reason is kept
             self.graph, self.capture_error = None, repr(exc)
+        self.sand_wrench_sum.zero_()  # the warm-up frame is not a logged frame
 
     def step(self) -> None:
         """Advance one frame; at the policy rate log every robot and set new PD targets first."""
@@ -474,6 +488,7 @@ class G1MpmScene:
             wp.capture_launch(self.graph)
         else:
             self.simulate()
+        self.frames_summed += 1
         self.wall_time += time.perf_counter() - t0
         self.frame += 1
 

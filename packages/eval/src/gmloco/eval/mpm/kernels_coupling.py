@@ -6,6 +6,7 @@ from __future__ import annotations
 import warp as wp
 
 __all__ = [
+    "accumulate_sand_wrench",
     "eval_body_sand_wrench",
     "eval_pd_joint_force",
     "eval_predict_body_velocity",
@@ -69,6 +70,23 @@ def eval_body_sand_wrench(
         outputs=[body_wrench_out],
         device=body_wrench_out.device,
     )
+
+
+@wp.kernel
+def _accumulate_wrench(
+    # Data in:
+    wrench_in: wp.array[wp.spatial_vector],
+    # Data out:
+    total_out: wp.array[wp.spatial_vector],
+) -> None:
+    """Add each body's wrench to its running sum."""
+    b = wp.tid()
+    total_out[b] = total_out[b] + wrench_in[b]
+
+
+def accumulate_sand_wrench(wrench: wp.array, total: wp.array) -> None:
+    """Add this frame's sand wrench [N, N m] to ``total`` (per body, [B]), so a log can read a mean over frames."""
+    wp.launch(_accumulate_wrench, dim=wrench.shape[0], inputs=[wrench], outputs=[total], device=total.device)
 
 
 @wp.kernel
