@@ -8,6 +8,7 @@
 # all robots of a terrain in one solver. MPM_MINUTES=0 trains to the end and skips the MPM part (the student alone).
 # Without an exported policy (the training stopped before its export) the MPM part says so and runs nothing.
 # MPM_POLICY=<policy.onnx, its policy.json beside it> skips the training and scores that export on MPM instead.
+# MPM_EXTRA adds flags to the MPM evaluation, e.g. "--wrench-frames 2" (the two-frame mean of the sand wrench).
 set -uo pipefail
 end=$1
 cd ~/src
@@ -30,9 +31,9 @@ else
   for t in ${MPM_TERRAINS:-dry_sand}; do
     left=$(python3 -c "import time; print(round(($end - time.time()) / 60 - 0.7, 2))")
     echo "MPM $t: $left min from $(date +%T)" >> ~/chunks/job.log
-    # shellcheck disable=SC2086  # the speeds are words
+    # shellcheck disable=SC2086  # the speeds and extra flags are words
     python3 -m gmloco.eval.g1.cli --out ~/chunks/g1_eval/"$t" --policy "$policy" --terrains "$t" \
-      --speeds ${MPM_SPEEDS:-1.0} --num-episodes "$eps" --robots-per-batch "$eps" --max-minutes "$left" \
+      --speeds ${MPM_SPEEDS:-1.0} --num-episodes "$eps" --robots-per-batch "$eps" --max-minutes "$left" ${MPM_EXTRA:-} \
       > ~/chunks/g1_eval/"$t".log 2>&1
     echo "MPM $t rc $? at $(date +%T)" >> ~/chunks/job.log
   done

@@ -332,29 +332,36 @@ def test_policy_reset_of_one_robot_back_fills_its_history_only() -> None:
 
 
 def test_foot_force_is_the_mean_over_the_policy_step(monkeypatch: pytest.MonkeyPatch) -> None:
-    """The logged foot force is the mean of the frames' sand wrench since the previous policy step, not one frame's.
+    """The logged foot force is the mean of the frames' applied sand wrench since the previous policy step.
 
-    5 ms frames (4 per 50 Hz policy step, the tables' setting): each frame's wrench on the feet is recorded after
-    the frame, and every logged sample after the first equals the mean of the 4 frames before it.
+    5 ms frames (4 per 50 Hz policy step, the tables' setting), with the two-frame mean on (``wrench_frames=2``):
+    each frame's applied and raw wrench on the feet are recorded after the frame; the applied one is the mean of
+    this frame's raw wrench and the last one's, and every logged sample after the first is the mean of the 4
+    applied frames before it. A value other than 1 or 2 is refused.
     """
     if not POLICY.exists():
         pytest.skip(f"no exported policy at {POLICY}")
     spec = MjlabOnnxPolicy(POLICY).spec
-    cfg = G1MpmSceneCfg(window=SandWindowCfg(moving=False, length=0.6, width=0.5, lead=0.0),
+    cfg = G1MpmSceneCfg(window=SandWindowCfg(moving=False, length=0.6, width=0.5, lead=0.0), wrench_frames=2,
                         solver=MpmSolverCfg(voxel_size=0.05, frame_dt=0.005, rigid_substeps=1))  # fmt: skip
     scene = G1MpmScene(cfg, spec)
-    frames: list[np.ndarray] = []
+    applied: list[np.ndarray] = []
+    raw: list[np.ndarray] = []
     simulate = scene.simulate
 
     def recorded() -> None:
         simulate()
-        frames.append(scene.sand_wrench.numpy()[scene.foot_bodies][..., :3].astype(np.float64))
+        for out, array in ((applied, scene.sand_wrench), (raw, scene.sand_wrench_raw)):
+            out.append(array.numpy()[scene.foot_bodies][..., :3].astype(np.float64))
 
     monkeypatch.setattr(scene, "simulate", recorded)
     scene.run(12)
-    per_frame = np.stack(frames)  # [12, R, 2, 3]
+    per_frame, per_raw = np.stack(applied), np.stack(raw)  # [12, R, 2, 3]
+    np.testing.assert_allclose(per_frame[1:], 0.5 * (per_raw[1:] + per_raw[:-1]), rtol=1e-5, atol=1e-3)
     logged = np.asarray(scene.foot_force)  # samples at frames 0, 4, 8
     assert scene.frames_per_policy == 4 and len(logged) == 3
     for k in (1, 2):
         np.testing.assert_allclose(logged[k], per_frame[4 * (k - 1) : 4 * k].mean(axis=0), rtol=1e-5, atol=1e-3)
     assert np.abs(per_frame).max() > 1.0  # the sand carries the soles: the means compare real forces
+    with pytest.raises(ValueError, match="wrench_frames=3"):
+        G1MpmScene(G1MpmSceneCfg(wrench_frames=3), spec)

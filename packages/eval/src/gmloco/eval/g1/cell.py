@@ -49,7 +49,8 @@ def build_cell_scene(specs: list[EpisodeSpec], cfg: G1EvalCfg, policy: Any) -> t
         solver = replace(solver, max_active_cell_count=int(cfg.cell_capacity_factor * est / per_cell) + 64)
     scene_cfg = G1MpmSceneCfg(terrain=terrain, window=window, num_robots=n, lane_spacing=lane, solver=solver,
                               commands=tuple(command(s, cfg) for s in specs[:n]),
-                              seed=cfg.seed * 100_003 + specs[0].index, device=cfg.device)  # fmt: skip
+                              seed=cfg.seed * 100_003 + specs[0].index, device=cfg.device,
+                              wrench_frames=cfg.wrench_frames)  # fmt: skip
     if hasattr(policy, "num_robots") and policy.num_robots != n:
         policy = load_policy(cfg.policy_path, n)
     policy.reset()

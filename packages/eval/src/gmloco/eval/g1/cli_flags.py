@@ -47,6 +47,7 @@ FLAGS: tuple[Flag, ...] = (
     Flag("--tolerance", "solver.tolerance"),
     Flag("--rheology-solver", "solver.rheology_solver"),
     Flag("--substeps", "solver.rigid_substeps"),
+    Flag("--wrench-frames", "wrench_frames"),
     Flag("--bed-depth", "bed_depth"),
     Flag("--robots-per-batch", "robots_per_batch"),
     Flag("--no-refill", "refill", off=True),

@@ -90,6 +90,10 @@ class G1EvalCfg:
     against 1.8 m are accepted; 350 iterations, 4 or 5 cm voxels, a 20 cm bed and 10 ms frames are rejected. A 3 cm
     frame of a G1 walk does not reach the 1e-4 tolerance within 1000 iterations, so the cap is the cost. The
     pipeline's smoke scale uses fast, unconverged numerics (``conf/scale/smoke.yaml``)."""
+    wrench_frames: int = field(default=1, metadata={"ge": 1, "le": 2})
+    """Frames of coupled sand wrench the robots receive as one (``G1MpmSceneCfg.wrench_frames``): 1, the last
+    frame's (the lagged coupling, every table so far); 2, the mean of the last two, which stops the force's
+    alternation from frame to frame (``results/mpm_eval/coupling_chatter/``)."""
     failure: FailureCfg = field(default_factory=FailureCfg)
     """Failure rules."""
     record_mcap: bool = True

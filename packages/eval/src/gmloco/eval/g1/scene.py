@@ -271,6 +271,14 @@ class G1MpmScene:
         st = make_coupled_states(newton, wp, self.model, self.sand_model)
         self.state_0, self.state_1, self.control = st.state_0, st.state_1, st.control
         self.sand_state, self.sand_wrench = st.sand_state, st.sand_wrench
+        if self.cfg.wrench_frames not in (1, 2):
+            raise ValueError(
+                f"wrench_frames={self.cfg.wrench_frames}: give 1 (the last frame's) or 2 (two frames' mean)"
+            )
+        self.sand_wrench_raw = wp.zeros_like(self.sand_wrench)
+        """This frame's coupled wrench before the two-frame mean (``wrench_frames=2``)."""
+        self.sand_wrench_last = wp.zeros_like(self.sand_wrench)
+        """The previous frame's coupled wrench (``wrench_frames=2``)."""
         self.sand_wrench_sum = wp.zeros_like(self.sand_wrench)
         """Sum of the sand wrench over the frames since the last policy step's read (``foot_force`` is its mean)."""
         self.frames_summed = 0
@@ -386,6 +394,10 @@ class G1MpmScene:
             self.commands[r] = cmd
         self.sand_wrench.assign(wrench)
         self.sand_wrench_sum.assign(summed)
+        last = self.sand_wrench_last.numpy()
+        for r in robots:
+            last[r * nb : (r + 1) * nb] = 0.0
+        self.sand_wrench_last.assign(last)
         self.targets.assign(targets)
         if self.policy is not None:
             self.policy.reset(robots)
@@ -410,6 +422,7 @@ class G1MpmScene:
             eval_body_sand_wrench,
             eval_pd_joint_force,
             hand_over_velocity,
+            mean_of_two_wrenches,
         )
 
         for _ in range(self.cfg.solver.rigid_substeps):
@@ -432,10 +445,15 @@ class G1MpmScene:
         )  # fmt: skip
         self.mpm.step(self.sand_state, self.sand_state, None, None, self.frame_dt)
         self.window.apply_walls()
+        two = self.cfg.wrench_frames == 2
         eval_body_sand_wrench(
             self.mpm.collider_body_index, self.model.body_com, self.frame_dt,
-            self.mpm.collect_collider_impulses(self.sand_state), self.sand_state.body_q, self.sand_wrench,
+            self.mpm.collect_collider_impulses(self.sand_state), self.sand_state.body_q,
+            self.sand_wrench_raw if two else self.sand_wrench,
         )  # fmt: skip
+        if two:  # the robots receive the mean of this frame's and the last frame's wrench
+            mean_of_two_wrenches(self.sand_wrench_raw, self.sand_wrench_last, self.sand_wrench)
+            wp.copy(self.sand_wrench_last, self.sand_wrench_raw)
         accumulate_sand_wrench(self.sand_wrench, self.sand_wrench_sum)
 
     def _restore_state_parity(self) -> None:

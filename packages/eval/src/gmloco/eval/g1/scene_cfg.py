@@ -43,6 +43,10 @@ class G1MpmSceneCfg:
     """Initial gap between the lowest sole point and the sand surface [m]."""
     commands: tuple[tuple[float, float, float], ...] = ((0.0, 0.0, 0.0),)
     """Velocity command (v_x, v_y, w_z) [m/s, m/s, rad/s] of each robot (cycled over robots)."""
+    wrench_frames: int = 1
+    """Frames of coupled sand wrench the robots receive as one: 1, the last frame's (the lagged coupling); 2, the
+    mean of the last two, which cancels the force's alternation from one frame to the next
+    (``results/mpm_eval/coupling_chatter/``)."""
     natural_frequency_hz: float = 10.0
     """mjlab's actuator natural frequency: joint armature = kp / (2 pi f)^2 [Hz]."""
     seed: int = 0

@@ -12,6 +12,7 @@ __all__ = [
     "eval_predict_body_velocity",
     "eval_rewind_body_velocity",
     "hand_over_velocity",
+    "mean_of_two_wrenches",
 ]
 
 
@@ -87,6 +88,24 @@ def _accumulate_wrench(
 def accumulate_sand_wrench(wrench: wp.array, total: wp.array) -> None:
     """Add this frame's sand wrench [N, N m] to ``total`` (per body, [B]), so a log can read a mean over frames."""
     wp.launch(_accumulate_wrench, dim=wrench.shape[0], inputs=[wrench], outputs=[total], device=total.device)
+
+
+@wp.kernel
+def _mean_of_two_wrenches(
+    # Data in:
+    a_in: wp.array[wp.spatial_vector],
+    b_in: wp.array[wp.spatial_vector],
+    # Data out:
+    mean_out: wp.array[wp.spatial_vector],
+) -> None:
+    """Each body's mean of two wrenches."""
+    i = wp.tid()
+    mean_out[i] = 0.5 * (a_in[i] + b_in[i])
+
+
+def mean_of_two_wrenches(a: wp.array, b: wp.array, mean: wp.array) -> None:
+    """Write the per-body mean of wrenches ``a`` and ``b`` [N, N m] into ``mean``, [B]."""
+    wp.launch(_mean_of_two_wrenches, dim=a.shape[0], inputs=[a, b], outputs=[mean], device=mean.device)
 
 
 @wp.kernel
