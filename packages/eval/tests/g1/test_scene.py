@@ -256,18 +256,22 @@ def test_frame_dt_must_divide_the_policy_step(frame_dt: float, ok: bool) -> None
                 G1MpmScene(G1MpmSceneCfg(solver=MpmSolverCfg(frame_dt=frame_dt)), MjlabOnnxPolicy(POLICY))
 
 
+def _pd_scene(cfg: G1MpmSceneCfg) -> G1MpmScene:
+    """A scene of PD-only G1s (the exported policy's gains and default pose, no policy acting); skipped without it."""
+    if not POLICY.exists():
+        pytest.skip(f"no exported policy at {POLICY}")
+    return G1MpmScene(cfg, MjlabOnnxPolicy(POLICY).spec)
+
+
 def test_reset_robot_restarts_its_lane_on_fresh_sand() -> None:
     """Robot 1 of two standing robots reset after 10 frames: a fresh start on fresh sand, robot 0 untouched.
 
     Start pose at rest, new command, new stress-free grains (another jitter) in its window; robot 0 and its sand
     keep their state; its new stand sinks as its first one did (within a quarter of the particle spacing).
     """
-    if not POLICY.exists():
-        pytest.skip(f"no exported policy at {POLICY}")
-    spec = MjlabOnnxPolicy(POLICY).spec
     cfg = G1MpmSceneCfg(window=SandWindowCfg(moving=True, length=0.9, width=0.6, lead=0.0), num_robots=2,
                         solver=MpmSolverCfg(voxel_size=0.05, frame_dt=0.01, rigid_substeps=2))  # fmt: skip
-    scene = G1MpmScene(cfg, spec)
+    scene = _pd_scene(cfg)
     q_start = scene.state_0.joint_q.numpy().copy()
     scene.run(10)
     nq, nd, p = scene.coords_per_robot, scene.dofs_per_robot, scene.window.particles_per_robot
@@ -339,12 +343,9 @@ def test_foot_force_is_the_mean_over_the_policy_step(monkeypatch: pytest.MonkeyP
     this frame's raw wrench and the last one's, and every logged sample after the first is the mean of the 4
     applied frames before it. A value other than 1 or 2 is refused.
     """
-    if not POLICY.exists():
-        pytest.skip(f"no exported policy at {POLICY}")
-    spec = MjlabOnnxPolicy(POLICY).spec
     cfg = G1MpmSceneCfg(window=SandWindowCfg(moving=False, length=0.6, width=0.5, lead=0.0), wrench_frames=2,
                         solver=MpmSolverCfg(voxel_size=0.05, frame_dt=0.005, rigid_substeps=1))  # fmt: skip
-    scene = G1MpmScene(cfg, spec)
+    scene = _pd_scene(cfg)
     applied: list[np.ndarray] = []
     raw: list[np.ndarray] = []
     simulate = scene.simulate
@@ -364,4 +365,4 @@ def test_foot_force_is_the_mean_over_the_policy_step(monkeypatch: pytest.MonkeyP
         np.testing.assert_allclose(logged[k], per_frame[4 * (k - 1) : 4 * k].mean(axis=0), rtol=1e-5, atol=1e-3)
     assert np.abs(per_frame).max() > 1.0  # the sand carries the soles: the means compare real forces
     with pytest.raises(ValueError, match="wrench_frames=3"):
-        G1MpmScene(G1MpmSceneCfg(wrench_frames=3), spec)
+        G1MpmScene(G1MpmSceneCfg(wrench_frames=3), scene.spec)
