@@ -50,6 +50,9 @@ def test_metrics_of_a_passing_policy() -> None:
     # R^2 = 1 - n 0.01^2 / sum (y - mean)^2, y = linspace(0.1, 0.5, 50): var = 0.4^2 (n+1) / (12 (n-1)).
     var = 0.4**2 * 51 / (12 * 49)
     np.testing.assert_allclose(m["eta_r2_heldout"], 1.0 - 0.01**2 / var, rtol=1e-9)
+    by_material = m["eta_heldout_by_material"]["held_out_rho2100_mu0.700"]
+    np.testing.assert_allclose([by_material["true"], by_material["decoded_mean"]], [0.3, 0.31], rtol=1e-9)
+    np.testing.assert_allclose(by_material["decoded_std"], np.linspace(0.1, 0.5, 50).std(), rtol=1e-9)
     m["gpu_minutes"] = 120.0
     verdict = gate_pass(m, GateThresholdsCfg(), ("basalt", "poppy_seed"))
     assert verdict == dict.fromkeys(verdict, True)

@@ -78,6 +78,25 @@ def _forward(cfg: GateCfg, rows: list[dict[str, Any]], out: dict[str, Any]) -> N
             out["heading_drift_deg"][m][_key(v)] = _mean([r["drift_deg"] for r in sel])
 
 
+def _eta_by_material(rows: list[dict[str, Any]]) -> dict[str, dict[str, float]] | None:
+    """Per held-out material: the true eta and the decoded eta's mean and standard deviation over its steps.
+
+    Tells a biased estimate (the mean off the truth) from a noisy one (a wide spread) where the pooled R^2 alone
+    cannot. None without a decoded eta.
+    """
+    held = [r for r in rows if r["cell"].kind == "held_out" and "eta" in r]
+    if not held:
+        return None
+    out: dict[str, dict[str, float]] = {}
+    for m in dict.fromkeys(r["cell"].material for r in held):
+        decoded = np.concatenate([r["eta"][0] for r in held if r["cell"].material == m])
+        true = np.concatenate([r["eta"][1] for r in held if r["cell"].material == m])
+        if decoded.size:
+            out[m] = {"true": float(true.mean()), "decoded_mean": float(decoded.mean()),
+                      "decoded_std": float(decoded.std())}  # fmt: skip
+    return out
+
+
 def _eta_r2(rows: list[dict[str, Any]]) -> float | None:
     """Pooled R^2 of the decoded eta over the held-out cells (None without a decoded eta)."""
     held = [r for r in rows if r["cell"].kind == "held_out" and "eta" in r]
@@ -114,11 +133,13 @@ def gate_metrics(cfg: GateCfg, rows: list[dict[str, Any]]) -> dict[str, Any]:
     ([%], [m/s], [deg], means over episodes); ``yaw_rate_ratio``: ``{material: {w_z: mean achieved / commanded}}``;
     ``circle_dtw_m``: ``{material: mean DTW error}`` [m]; ``swing_apex_cm``: ``{material: mean apex}`` [cm] of the
     ``apex_speed`` forward cells; ``eta_r2_heldout``: pooled R^2 of the held-out cells (None without a decoded eta);
-    ``turn_falls``: the falls of the yaw and circle cells (:func:`_turn_falls`). The keys of a part not in
-    ``cfg.parts`` are None.
+    ``turn_falls``: the falls of the yaw and circle cells (:func:`_turn_falls`); ``eta_heldout_by_material``: the
+    held-out materials' true and decoded eta (:func:`_eta_by_material`). The keys of a part not in ``cfg.parts`` are
+    None.
     """
     keys = ("success_pct", "vel_error_mps", "yaw_rate_ratio", "heading_drift_deg", "circle_dtw_m", "swing_apex_cm")
-    extra = ("failures", "stance_sink_cm", "stance_sink_peak_cm", "success_course_pct", "turn_falls")
+    extra = ("failures", "stance_sink_cm", "stance_sink_peak_cm", "success_course_pct", "turn_falls",
+             "eta_heldout_by_material")  # fmt: skip
     out: dict[str, Any] = dict.fromkeys((*keys, "eta_r2_heldout", *extra))
     if "success" in cfg.parts:
         _forward(cfg, rows, out)
@@ -138,6 +159,7 @@ def gate_metrics(cfg: GateCfg, rows: list[dict[str, Any]]) -> dict[str, Any]:
             out["swing_apex_cm"][m] = 100.0 * float(np.mean(apex)) if apex else None
     if "eta" in cfg.parts:
         out["eta_r2_heldout"] = _eta_r2(rows)
+        out["eta_heldout_by_material"] = _eta_by_material(rows)
     return out
 
 
