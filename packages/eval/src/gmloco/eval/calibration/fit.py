@@ -47,6 +47,7 @@ __all__ = [
     "held_terms",
     "replay_forces",
     "replay_wrenches",
+    "rms_by_split",
     "split_error",
     "torque_scale",
 ]
@@ -214,7 +215,7 @@ def torque_scale(ds: CalibrationDataset) -> float:
     return ds.protocol.weight * 0.5 * ds.protocol.sole_size[0]
 
 
-def _rms_by_split(ds: CalibrationDataset, sq: dict[str, np.ndarray]) -> dict[str, float]:
+def rms_by_split(ds: CalibrationDataset, sq: dict[str, np.ndarray]) -> dict[str, float]:
     """Return the RMS over each split's frames of per-frame squared errors ``sq`` (NaN for a split without any)."""
     out = {}
     for split in ("fit", "heldout"):
@@ -236,7 +237,7 @@ def _split_errors(
     sq_t = {n: (w[:, 5] - ds.records[n].torque[:, 2]) ** 2 for n, w in wrenches.items() if ds.records[n].has_torque}
     per_f = {n: float(np.sqrt(np.mean(e))) for n, e in sq_f.items()}
     per_t = {n: float(np.sqrt(np.mean(e))) for n, e in sq_t.items()}
-    return _rms_by_split(ds, sq_f), per_f, _rms_by_split(ds, sq_t) if sq_t else None, per_t
+    return rms_by_split(ds, sq_f), per_f, rms_by_split(ds, sq_t) if sq_t else None, per_t
 
 
 def split_error(

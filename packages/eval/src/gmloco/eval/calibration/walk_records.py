@@ -26,15 +26,17 @@ from __future__ import annotations
 import argparse
 import sys
 from dataclasses import dataclass
+from functools import cache
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 
 from gmloco.contact import MATERIAL_PRESETS
-from gmloco.deploy.g1 import G1_SOLE_BOX_CENTER, G1_SOLE_BOX_HALF_EXTENTS
+from gmloco.deploy.g1 import G1_FOOT_BODIES, G1_SOLE_BOX_CENTER, G1_SOLE_BOX_HALF_EXTENTS
 from gmloco.eval.calibration.dataset import CalibrationDataset, assign_split, save_dataset
 from gmloco.eval.calibration.protocol import SoleProtocolCfg, SoleRecord
+from gmloco.eval.g1.soles import SoleCfg, sole_box_corners
 
 __all__ = ["WALK_FRAME_DT", "WalkRecordsCfg", "foot_records", "main", "walk_dataset", "walk_terrain"]
 
@@ -64,10 +66,12 @@ def walk_terrain(path: str | Path) -> str:
     return Path(path).name.split("__")[0]
 
 
-def _corners(cfg: WalkRecordsCfg) -> np.ndarray:
-    """The sole box's 8 corners about its centre [m], [8, 3]."""
-    h = np.asarray(cfg.sole_half_extents)
-    return np.array([[sx, sy, sz] for sx in (-1, 1) for sy in (-1, 1) for sz in (-1, 1)]) * h
+@cache
+def _g1_model() -> Any:
+    """The nominal G1 ``mujoco.MjModel``, compiled once for every file."""
+    from gmloco.deploy.mismatch.g1model import build_model
+
+    return build_model()
 
 
 def _log_arrays(path: Path) -> dict[str, np.ndarray]:
@@ -96,7 +100,6 @@ def foot_records(path: str | Path, cfg: WalkRecordsCfg | None = None) -> dict[st
     import mujoco
 
     from gmloco.deploy.mismatch.frames import quat_rotate
-    from gmloco.deploy.mismatch.g1model import build_model
 
     cfg = cfg or WalkRecordsCfg()
     path = Path(path)
@@ -105,10 +108,11 @@ def foot_records(path: str | Path, cfg: WalkRecordsCfg | None = None) -> dict[st
     n = int(low[0]) if len(low) else len(a["time"])
     if n < cfg.min_frames:
         raise ValueError(f"{path}: {n} frames before the pelvis fell below {cfg.min_pelvis_height} m")
-    model = build_model()
+    model = _g1_model()
     data = mujoco.MjData(model)
-    feet = [model.body(f"{s}_ankle_roll_link").id for s in FEET]
-    centre, corners = np.asarray(cfg.sole_center), _corners(cfg)
+    feet = [model.body(name).id for name in G1_FOOT_BODIES]
+    centre = np.asarray(cfg.sole_center)
+    corners = sole_box_corners(SoleCfg(center=cfg.sole_center, half_extents=cfg.sole_half_extents))  # link frame
     jacp, jacr = np.zeros((3, model.nv)), np.zeros((3, model.nv))
     pos, rot, lin, ang, depth = (np.zeros((2, n, *s)) for s in ((3,), (3, 3), (3,), (3,), ()))
     v_world = quat_rotate(a["odom.orientation"][:n], a["odom.linear_velocity"][:n])
@@ -127,7 +131,7 @@ def foot_records(path: str | Path, cfg: WalkRecordsCfg | None = None) -> dict[st
             rot[f, k] = r
             mujoco.mj_jac(model, data, jacp, jacr, pos[f, k], body)
             lin[f, k], ang[f, k] = jacp @ qvel, jacr @ qvel
-            depth[f, k] = -(pos[f, k, 2] + (corners @ r.T)[:, 2]).min()
+            depth[f, k] = -(data.xpos[body, 2] + (corners @ r.T)[:, 2]).min()
     off = np.abs(depth.T - a["sim.sinkage"][:n]).max()
     if off > cfg.depth_tolerance:
         raise ValueError(f"{path}: the kinematics' sole depth differs from the recorded sinkage by {off:.4f} m")

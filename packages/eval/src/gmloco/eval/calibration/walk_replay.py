@@ -32,7 +32,7 @@ from gmloco.contact import RftExtensionsCfg
 from gmloco.contact.extensions_io import load_rft_extensions
 from gmloco.deploy.atomic_io import atomic_write_json
 from gmloco.eval.calibration.dataset import CalibrationDataset, load_dataset
-from gmloco.eval.calibration.fit import SandFitCfg, fit_datum, replay_forces, split_error
+from gmloco.eval.calibration.fit import SandFitCfg, fit_datum, replay_forces, rms_by_split
 
 __all__ = ["DEPTH_EDGES_M", "SPEED_EDGES_MPS", "binned_forces", "main", "walk_replay"]
 
@@ -85,7 +85,7 @@ def walk_replay(ds: CalibrationDataset, models: dict[str, RftExtensionsCfg], cfg
         datums[label] = fit_datum(ds, ext, cfg)
         replay = replay_forces(ds, ext, cfg, names, datums[label])
         forces[label] = np.concatenate([replay[n] for n in names])
-        errors[label] = split_error(ds, ext, cfg, datums[label])[0]
+        errors[label] = rms_by_split(ds, {n: np.sum((replay[n] - ds.records[n].force) ** 2, -1) for n in names})
     return {
         "dataset": {
             "material": ds.material,

@@ -384,20 +384,17 @@ class G1MpmScene:
             newton.eval_fk(self.model, st.joint_q, st.joint_qd, st,
                            indices=wp.array(robots, dtype=int, device=self.device))  # fmt: skip
         nb = self.bodies_per_robot
-        wrench, summed = self.sand_wrench.numpy(), self.sand_wrench_sum.numpy()
+        wrenches = (self.sand_wrench, self.sand_wrench_sum, self.sand_wrench_last)
+        held = [w.numpy() for w in wrenches]  # the old episode's forces are not the new one's
         targets = self.targets.numpy()
         for r, cmd in zip(robots, commands, strict=True):
-            wrench[r * nb : (r + 1) * nb] = 0.0
-            summed[r * nb : (r + 1) * nb] = 0.0  # the old episode's frames are not the new one's
+            for h in held:
+                h[r * nb : (r + 1) * nb] = 0.0
             targets[r] = self.spec.default_joint_pos
             self.last_action[r] = 0.0
             self.commands[r] = cmd
-        self.sand_wrench.assign(wrench)
-        self.sand_wrench_sum.assign(summed)
-        last = self.sand_wrench_last.numpy()
-        for r in robots:
-            last[r * nb : (r + 1) * nb] = 0.0
-        self.sand_wrench_last.assign(last)
+        for w, h in zip(wrenches, held, strict=True):
+            w.assign(h)
         self.targets.assign(targets)
         if self.policy is not None:
             self.policy.reset(robots)

@@ -78,13 +78,18 @@ def _forward(cfg: GateCfg, rows: list[dict[str, Any]], out: dict[str, Any]) -> N
             out["heading_drift_deg"][m][_key(v)] = _mean([r["drift_deg"] for r in sel])
 
 
+def _held_out(rows: list[dict[str, Any]]) -> list[dict[str, Any]]:
+    """The held-out cells' rows that carry a decoded eta."""
+    return [r for r in rows if r["cell"].kind == "held_out" and "eta" in r]
+
+
 def _eta_by_material(rows: list[dict[str, Any]]) -> dict[str, dict[str, float]] | None:
     """Per held-out material: the true eta and the decoded eta's mean and standard deviation over its steps.
 
     Tells a biased estimate (the mean off the truth) from a noisy one (a wide spread) where the pooled R^2 alone
     cannot. None without a decoded eta.
     """
-    held = [r for r in rows if r["cell"].kind == "held_out" and "eta" in r]
+    held = _held_out(rows)
     if not held:
         return None
     out: dict[str, dict[str, float]] = {}
@@ -99,7 +104,7 @@ def _eta_by_material(rows: list[dict[str, Any]]) -> dict[str, dict[str, float]] 
 
 def _eta_r2(rows: list[dict[str, Any]]) -> float | None:
     """Pooled R^2 of the decoded eta over the held-out cells (None without a decoded eta)."""
-    held = [r for r in rows if r["cell"].kind == "held_out" and "eta" in r]
+    held = _held_out(rows)
     if not held:
         return None
     r2 = r2_score(np.concatenate([r["eta"][0] for r in held]), np.concatenate([r["eta"][1] for r in held]))
