@@ -195,3 +195,17 @@ def test_malformed_or_out_of_range_flags_exit_2(
     assert stop.value.code == 2
     assert message in capsys.readouterr().err
     assert not (tmp_path / "sweep").exists()
+
+
+def test_an_episode_with_stages_records_one_robot_per_stage_and_diagnoses_them_once(tmp_path: Path) -> None:
+    """A gantry chirp and stepping of one robot with 1.5x armature: one row, one key per stage, the oracle energy."""
+    ep = {"name": "staged", "effect": "joint.armature", "params": {"scale": [1.5]}, "strength": "mid", "seed": 5,
+          "stages": [{"support": "gantry", "chirp": True}, {}]}  # fmt: skip
+    row = sweep.run_episode(ep, str(tmp_path), 3.0, effects=("joint.armature", "actuator.delay", "terrain.cohesion"))
+    assert row["verdict"] == "explained" and row["winner"] == "joint.armature", row
+    ((value, lo, hi),) = row["fit"].values()
+    assert abs(value - 1.5) < 0.15 and lo <= value <= hi
+    key = json.loads((tmp_path / "keys" / "staged.json").read_text())
+    assert [k["effect"] for k in key["stages"]] == ["joint.armature"] * 2
+    en = row["energy"]
+    assert en["oracle"] < en["nominal"] and en["fitted"] <= en["nominal"]

@@ -10,6 +10,7 @@ from pathlib import Path
 
 import pytest
 
+from gmloco.deploy.mismatch.benchmark.protocol_cfg import ProtocolRunCfg
 from gmloco.deploy.mismatch.benchmark.v5 import (
     FLAGS,
     NULLS_PER_SUITE,
@@ -20,7 +21,6 @@ from gmloco.deploy.mismatch.benchmark.v5 import (
     main,
     suite_episodes,
 )
-from gmloco.deploy.mismatch.benchmark.v5_cfg import V5RunCfg
 from gmloco.deploy.mismatch.effects import EFFECT_IDS, effect
 
 _PROTOCOL = Path(__file__).parents[4] / "results/mismatch_benchmark/v5/protocol.md"
@@ -101,10 +101,10 @@ def test_recorded_commands_parse() -> None:
 
 
 def test_flags_come_from_the_config() -> None:
-    """Every generated flag sets a field of V5RunCfg and the defaults are the config's."""
-    fields = {f.name for f in dataclasses.fields(V5RunCfg)}
+    """Every generated flag sets a field of ProtocolRunCfg and the defaults are the config's."""
+    fields = {f.name for f in dataclasses.fields(ProtocolRunCfg)}
     assert {flag.path for flag in FLAGS} == fields - {"suite"}
     _, cfg = _parse(["--out", "x", "--suite", "sand"])
-    assert cfg == V5RunCfg(suite="sand")
+    assert cfg == ProtocolRunCfg(suite="sand")
     _, cfg = _parse(["--out", "x", "--suite", "plane", "--only", "plane-none,plane-ool", "--list", "--score-only"])
     assert (cfg.only, cfg.list_episodes, cfg.score_only) == (("plane-none", "plane-ool"), True, True)

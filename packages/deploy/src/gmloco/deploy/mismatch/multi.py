@@ -102,7 +102,8 @@ def analyze_many(
 
     Recordings of another robot, joint order or sample rate are a contract error (``invalid_input``). The
     report's ``recordings`` list says which recording excites which effect; each hypothesis lists the
-    recordings that excite it (``excited_by``).
+    recordings that excite it (``excited_by``). Its arrays are the stacked problem (``problem``, ``held``), the
+    nominal residual (``r0``) and the winning hypothesis (``winner``), as a benchmark's oracle energy needs them.
     """
     from gmloco.deploy.mismatch.report import build_report
 
@@ -157,4 +158,4 @@ def analyze_many(
         if "rank" in h:
             h["excited_by"] = [r["index"] for r in per_rec if h["id"] in r["excites"]]
     say("done", 1.0)
-    return AnalysisResult(report, {})
+    return AnalysisResult(report, {"problem": pb, "r0": att.r0, "winner": winner, "held": pb.held})

@@ -200,11 +200,14 @@ def build_report(
 
 
 def write_report(result: Any, out: Path, plots: bool = True) -> list[Path]:
-    """Write ``report.json``, ``config_patch.json``, ``report.md`` and plots into ``out``; return the paths."""
+    """Write ``report.json``, ``config_patch.json``, ``report.md`` and plots into ``out``; return the paths.
+
+    The plots need one recording's per-channel arrays (``names``); a diagnosis over several recordings has none.
+    """
     out.mkdir(parents=True, exist_ok=True)
     rep = dict(result.report)
     files = []
-    if plots and result.arrays:
+    if plots and "names" in result.arrays:
         from gmloco.deploy.mismatch.plots import make_plots
 
         rep["plots"] = [p.name for p in make_plots(result, out)]

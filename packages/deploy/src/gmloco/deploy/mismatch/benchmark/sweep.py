@@ -19,6 +19,7 @@ import sys
 import time
 from multiprocessing import Pool
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 
@@ -26,6 +27,27 @@ from gmloco.deploy.config_cli import Flag, add_flags, cfg_from_flags, check_flag
 from gmloco.deploy.mismatch.benchmark.sweep_cfg import SweepCfg
 
 __all__ = ["FLAGS", "HASH_SKIP", "in_source_hash", "main", "run_episode", "source_sha256"]
+
+
+def _episode_cfg(ep: dict, duration: float, keep_before_fall: float | None) -> Any:
+    """The generator's ``EpisodeCfg`` of one recording of an episode (the episode's fields, or a stage's)."""
+    from gmloco.deploy.mismatch.benchmark.chirp import ChirpCfg
+    from gmloco.deploy.mismatch.benchmark.generator import EpisodeCfg
+    from gmloco.deploy.mismatch.benchmark.policy_motion import motion_cfg
+    from gmloco.deploy.mismatch.benchmark.truth import TruthEffect
+
+    return EpisodeCfg(
+        effect=TruthEffect(ep["effect"], ep["params"]),
+        duration=duration,
+        seed=ep["seed"],
+        keep_before_fall=keep_before_fall,
+        ground="sand" if ep.get("ground", "plane") == "sand" else "plane",
+        material=ep.get("material", "dry_sand"),
+        policy=motion_cfg(ep.get("motion", "walk")) if ep.get("policy") else None,
+        odometry=bool(ep.get("odometry", False)),
+        support=ep.get("support", "free"),
+        chirp=ChirpCfg() if ep.get("chirp") else None,
+    )
 
 
 def run_episode(
@@ -38,43 +60,35 @@ def run_episode(
     """Generate, analyse and score-prepare one episode; returns a JSON-ready row.
 
     ``effects`` limits the tool's screening to a subset of the library (quick checks); None screens all. An
-    episode with ``support`` gantry or fixed and ``chirp`` true is the in-air chirp stage (pelvis held).
+    episode with ``support`` gantry or fixed and ``chirp`` true is the in-air chirp stage (pelvis held). An
+    episode with ``stages`` (a list of field dicts, e.g. ``[{"support": "gantry", "chirp": True}, {}]``) records
+    one robot (one seed: the same effect, nuisances and noise draw) once per stage and diagnoses the recordings
+    together (:func:`gmloco.deploy.mismatch.multi.analyze_many`).
     """
-    from gmloco.deploy.mismatch.benchmark.chirp import ChirpCfg
-    from gmloco.deploy.mismatch.benchmark.generator import EpisodeCfg, generate
-    from gmloco.deploy.mismatch.benchmark.policy_motion import motion_cfg
-    from gmloco.deploy.mismatch.benchmark.truth import TruthEffect
+    from gmloco.deploy.mismatch.benchmark.generator import generate
     from gmloco.deploy.mismatch.effects import EFFECT_IDS
-    from gmloco.deploy.mismatch.pipeline import AnalysisCfg, analyze
+    from gmloco.deploy.mismatch.multi import analyze_many
+    from gmloco.deploy.mismatch.pipeline import AnalysisCfg
     from gmloco.deploy.mismatch.replay import sand_replay_cfg
 
     t0 = time.time()
-    eff = TruthEffect(ep["effect"], ep["params"])
     sand = ep.get("ground", "plane") == "sand"
+    recs, stage_keys = [], []
     try:
-        rec, key = generate(
-            EpisodeCfg(
-                effect=eff,
-                duration=duration,
-                seed=ep["seed"],
-                keep_before_fall=keep_before_fall,
-                ground="sand" if sand else "plane",
-                material=ep.get("material", "dry_sand"),
-                policy=motion_cfg(ep.get("motion", "walk")) if ep.get("policy") else None,
-                odometry=bool(ep.get("odometry", False)),
-                support=ep.get("support", "free"),
-                chirp=ChirpCfg() if ep.get("chirp") else None,
-            )
-        )
+        for stage in ep.get("stages") or [{}]:
+            rec, stage_key = generate(_episode_cfg({**ep, **stage}, duration, keep_before_fall))
+            recs.append(rec)
+            stage_keys.append(stage_key)
     except RuntimeError as exc:
         return {**ep, "error": str(exc)}
     keys = Path(out) / "keys"
     keys.mkdir(parents=True, exist_ok=True)
+    key = stage_keys[0] if len(stage_keys) == 1 else {"stages": stage_keys}
     (keys / f"{ep['name']}.json").write_text(json.dumps(key))
     # The ground is what the user tells the tool (the robot walked on sand), not part of the hidden truth.
     cfg = AnalysisCfg(replay=sand_replay_cfg(ep.get("material", "dry_sand"))) if sand else AnalysisCfg()
     cfg.attribution.effects = effects
-    res = analyze(rec, cfg)
+    res = analyze_many(recs, cfg)
     rep = res.report
     row = {
         **ep,
@@ -83,8 +97,9 @@ def run_episode(
         "ranked": [h["id"] for h in rep["hypotheses"] if "rank" in h],
         "runtime_s": time.time() - t0,
     }
-    if "kept_s" in key:
-        row["trimmed"] = {"fell_at_s": key["fell_at_s"], "kept_s": key["kept_s"]}
+    trimmed = [{"fell_at_s": k["fell_at_s"], "kept_s": k["kept_s"]} for k in stage_keys if "kept_s" in k]
+    if trimmed:
+        row["trimmed"] = trimmed[0] if len(stage_keys) == 1 else trimmed
     row["untested"] = [u["id"] for u in rep["untested"]]
     row["nominal_energy_ratio"] = rep.get("mismatch", {}).get("nominal_energy_ratio")
     row["residual_ratio"] = rep.get("mismatch", {}).get("residual_ratio")

@@ -1,23 +1,24 @@
 # SPDX-License-Identifier: Apache-2.0
-"""Config of one benchmark-v5 invocation: which suite, which of its episodes, how many workers, what is scored."""
+"""Config of one run of a pre-registered benchmark (v5, v6): which suite, which episodes, how many workers."""
 
 from __future__ import annotations
 
 from dataclasses import dataclass, field
 from typing import Literal
 
-__all__ = ["V5RunCfg", "V5Suite"]
+__all__ = ["ProtocolRunCfg", "Suite"]
 
-V5Suite = Literal["fixed", "plane", "sand"]
-"""A v5 suite: ``fixed`` (gantry chirps), ``plane`` (scripted stepping), ``sand`` (the policy walking on sand)."""
+Suite = Literal["fixed", "plane", "sand", "identification"]
+"""A suite: v5's ``fixed`` (gantry chirps), ``plane`` (scripted stepping) and ``sand`` (the policy walking on
+sand); v6's ``identification`` (one robot on the gantry and stepping on the plane, one diagnosis)."""
 
 
 @dataclass(frozen=True)
-class V5RunCfg:
-    """One v5 run: a suite, the selection of its pre-registered episodes, the workers and the scoring."""
+class ProtocolRunCfg:
+    """One run of a protocol: a suite, the selection of its pre-registered episodes, the workers and the scoring."""
 
-    suite: V5Suite = "fixed"
-    """Suite whose episodes run (rows under ``OUT/<suite>/rows``)."""
+    suite: Suite = "fixed"
+    """Suite whose episodes run (rows under ``OUT/<suite>/rows``); it must be one of the protocol's."""
     workers: int = field(default=2, metadata={"ge": 1})
     """Worker processes, one episode each at a time."""
     part: str | None = None
