@@ -54,6 +54,17 @@ CASES = [
     (["+exp=gm_loco", "analyze_logs.inputs=[/nonexistent/logs]"], "analyze_logs.inputs", ["does not exist"]),
     (["+exp=ppo_rigid", "train_teacher.material.mu_int=[0.6,0.3]"], "train_teacher.material.mu_int", ["not a range"]),
     (["+exp=gm_loco", "train_teacher.gpus=[0,0]"], "train_teacher.gpus", ["[0] are named more than once"]),
+    (
+        ["+exp=gm_loco", "+train_teacher.task.material.mu_intt.0=0.3"],
+        "train_teacher.task.material.mu_intt.0",
+        ["no key 'mu_intt' in train_teacher.task.material", "valid keys"],
+    ),
+    (
+        ["+exp=ppo_rigid", "+train_teacher.task.material.mu_int.0=0.95"],
+        "train_teacher.task.material.mu_int.0",
+        ["low > high"],
+    ),
+    (["+exp=jump_rigid", "+train_teacher.task.episode_length_s=5"], "train_teacher.task", ["train_teacher.jump"]),
     (["+exp=gm_loco", "distill.gpus=[1,-1]"], "distill.gpus", ["element -1", ">= 0"]),
 ]
 

@@ -32,6 +32,7 @@ from workflows.pipeline_report import console
 from workflows.run_guard import run_dir_problem
 from workflows.schemas import PipelineCfg
 from workflows.stage_runner import PipelineConfigError, validate_selection
+from workflows.task_fields import TASK_SECTION
 
 __all__ = ["EXIT_BAD_INPUT", "check_config", "compose_checked", "hydra_entry"]
 
@@ -77,12 +78,15 @@ def _check_missing(cfg: DictConfig, stage_names: Sequence[str]) -> None:
 
 
 def _check_appended(overrides: Sequence[str]) -> None:
-    """Refuse ``+key=value`` for keys that are neither config groups nor schema fields (``+expp=gm_loco``)."""
+    """Refuse ``+key=value`` for keys that are neither config groups nor schema fields (``+expp=gm_loco``).
+
+    Keys under ``train_teacher.task`` are the task's fields, checked against the task by ``input_checks``.
+    """
     for o in overrides:
         if not o.startswith("+") or o.startswith("++") or "=" not in o:
             continue
         key = o[1:].split("=", 1)[0].split("@", 1)[0]
-        if key not in groups():
+        if key not in groups() and not key.startswith(f"{TASK_SECTION}."):
             raise unknown_key_error(key, o)
 
 

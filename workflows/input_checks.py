@@ -1,5 +1,5 @@
 # SPDX-License-Identifier: Apache-2.0
-"""Checks of the selected stages' inputs that need no stage to run: recordings exist, effect ids are known, ranges.
+"""Checks of the selected stages' inputs that need no stage to run: recordings, effect ids, ranges, task paths.
 
 Each check returns ``(dotted key, message)`` for the first problem, or None; the entry point turns it into one
 exit-2 paragraph before anything runs, so a typo never becomes a failed stage or a silent ``unexplained``.
@@ -105,6 +105,25 @@ def _material_problem(section: DictConfig) -> tuple[str, str] | None:
     return None
 
 
+def _task_problem(section: DictConfig) -> tuple[str, str] | None:
+    """``train_teacher.task`` must name fields of the velocity task, leave no range empty, and not meet the jump."""
+    if not section.get("task"):
+        return None
+    if section.get("jump") is not None:
+        return "train_teacher.task", (
+            "bad value for 'train_teacher.task': it sets fields of the velocity task, and train_teacher.jump trains "
+            "the jump task instead; set the jump task's fields at train_teacher.jump.<field>, or drop the jump."
+        )
+    from workflows.policy_training import task_cfg  # builds the task: imports gmloco.train, only when one is set
+    from workflows.stage_runner import PipelineConfigError
+
+    try:
+        task_cfg(section)
+    except PipelineConfigError as exc:
+        return exc.key, f"bad value for '{exc.key}': {str(exc).removeprefix(f'{exc.key}: ')}"
+    return None
+
+
 def _gpus_problem(cfg: DictConfig, name: str) -> tuple[str, str] | None:
     """``<stage>.gpus`` must name distinct CUDA devices this machine has."""
     gpus = [int(g) for g in cfg[name].get("gpus", [])]
@@ -127,6 +146,8 @@ def input_problem(cfg: DictConfig) -> tuple[str, str] | None:
     if "train_teacher" in cfg.stages and (found := _calibrated_problem(cfg.train_teacher)) is not None:
         return found
     if "train_teacher" in cfg.stages and (found := _material_problem(cfg.train_teacher)) is not None:
+        return found
+    if "train_teacher" in cfg.stages and (found := _task_problem(cfg.train_teacher)) is not None:
         return found
     if "mismatch" in cfg.stages and (found := _mismatch_problem(cfg.mismatch)) is not None:
         return found

@@ -20,6 +20,7 @@ from omegaconf import DictConfig, OmegaConf
 from workflows.pipeline_report import say, stage_bar
 from workflows.section_cfg import field_values, section_as
 from workflows.stage_registry import StageIncompleteError
+from workflows.task_fields import apply_task_fields, flat_paths
 
 __all__ = [
     "distill_overrides",
@@ -59,7 +60,10 @@ def newest_checkpoint(folder: str | Path) -> Path:
 
 
 def task_cfg(section: DictConfig) -> Any:
-    """Return the ``GranularTaskCfg`` of a train section: contact model x terrain (x material), stacked actor frames."""
+    """Return the ``GranularTaskCfg`` of a train section: contact model x terrain (x material), stacked actor frames.
+
+    The fields ``section.task`` names are then set by their paths (:func:`workflows.task_fields.apply_task_fields`).
+    """
     from gmloco.train import g1_granular_task
 
     task = g1_granular_task(str(section.contact_model.value), str(section.terrain.value))  # type: ignore[arg-type]
@@ -70,12 +74,13 @@ def task_cfg(section: DictConfig) -> Any:
         from gmloco.train.teacher_student.heldout import with_held_out
 
         task = with_held_out(task)  # the materials eval_ts scores as never seen in training
-    return replace(
+    task = replace(
         task,
         policy_history_length=int(section.policy_history_length),
         curriculum_scale=float(section.get("curriculum_scale", 1.0)),
         foot_clearance=str(getattr(clearance, "value", clearance)),  # type: ignore[arg-type]
     )
+    return apply_task_fields(task, flat_paths(section.get("task") or {}))
 
 
 def material_cfg(node: DictConfig, terrain_material: Any) -> Any:

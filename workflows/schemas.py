@@ -9,8 +9,8 @@ used as it is: the PPO settings (``gmloco.train.teacher_student.PpoCfg``), the t
 (``gmloco.eval.g1.config.G1EvalCfg``) and the sweep's and ablation's evaluation cells
 (``gmloco.train.evaluation_cells.MaterialCellsCfg``) are extended with the stage's fields and defaults, not copied;
 a stage turns its section back into the package dataclass with ``workflows.section_cfg.section_as``. The train
-stage's task fields are still read one by one into ``GranularTaskCfg`` (``policy_training.py``), whose ``Literal``
-fields OmegaConf cannot hold.
+stage builds ``GranularTaskCfg`` (whose ``Literal`` fields OmegaConf cannot hold) from the section's names, then
+sets the fields ``train_teacher.task`` names by their paths (``workflows/task_fields.py``).
 """
 
 from __future__ import annotations
@@ -248,6 +248,11 @@ class TrainTeacherCfg(TeacherCfg, PolicyTrainingCfg):
     ``train_teacher.material.preset=dry_sand``, or ``material=dry_sand`` from ``conf/material/``). A field left at
     its default keeps the terrain's value (the deep bed's mu_int 0.1-0.4); the VAE teacher's held-out rectangle is
     then cut out of the ranges."""
+    task: dict[str, Any] = field(default_factory=dict)
+    """Fields of the velocity task (``gmloco.train.GranularTaskCfg``: domain randomization, curricula, rewards, the
+    sand bed) set over the task the section builds, by their path: ``+train_teacher.task.robot_dr.push_velocity=1``,
+    ``+train_teacher.task.material.mu_int.0=0.2`` (a digit part sets one end of a range). Checked before any stage
+    runs; the distill stage trains on the same task. Empty: the task as built (``workflows/task_fields.py``)."""
 
 
 @dataclass
@@ -397,9 +402,9 @@ class SweepCfg:
     """CUDA devices of this machine, one worker process (one trial at a time) on each; ``device`` and
     ``train_teacher.gpus`` are set per worker. Empty: one worker on ``device``."""
     params: dict[str, Any] = field(default_factory=dict)
-    """Search space: key -> ``{type: float|int|categorical, low, high, log, step, choices}``. Keys are config
-    overrides (``train_teacher.ppo.learning_rate``) or ``task.<field path>`` of ``gmloco.train.GranularTaskCfg``
-    with an index for range ends (``task.material.mu_int.0``)."""
+    """Search space: key -> ``{type: float|int|categorical, low, high, log, step, choices}``. Keys are the train
+    section's config paths (``train_teacher.ppo.learning_rate``), the task's fields among them
+    (``train_teacher.task.robot_dr.push_velocity``, with an index for range ends: ``train_teacher.task.material.mu_int.0``)."""
     study_name: str = _interp("${exp_name}")
     """Study name inside the storage."""
     experiment: str = "gm_loco"
@@ -412,8 +417,8 @@ class SweepCfg:
     """Training iterations of a trial before it may be pruned."""
     report_chunks: int = ranged(4, ge=1)
     """Training of a trial runs in this many resumed chunks; the objective is reported after each (pruning)."""
-    task_overrides: dict[str, Any] = field(default_factory=dict)
-    """Fixed ``task.<field path>`` values applied to every trial (same keys as ``params``)."""
+    fixed: dict[str, Any] = field(default_factory=dict)
+    """Values set in every trial, by the same paths as ``params`` (``train_teacher.task.episode_length_s: 10``)."""
     eval: SweepEvalCfg = field(default_factory=SweepEvalCfg)
     """Evaluation used by ``eval/<key>`` objectives."""
     requeue_interrupted: bool = True
@@ -421,8 +426,8 @@ class SweepCfg:
     retry continues in the same trial folder from its newest checkpoint. Only for one worker per study."""
     smoke_trials: int = ranged(2, ge=1)
     """``n_trials`` at smoke scale."""
-    smoke_task_overrides: dict[str, Any] = field(default_factory=lambda: {"task.episode_length_s": 0.1})
-    """Extra ``task`` overrides at smoke scale, so that episodes finish within the few smoke steps."""
+    smoke_fixed: dict[str, Any] = field(default_factory=lambda: {"train_teacher.task.episode_length_s": 0.1})
+    """Extra ``fixed`` values at smoke scale, so that episodes finish within the few smoke steps."""
     trial_params: dict[str, Any] = field(default_factory=dict)
     """Set by the sweep in each trial's config: the trial number and its sampled values."""
 

@@ -34,12 +34,12 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
-from omegaconf import DictConfig, ListConfig, OmegaConf
+from omegaconf import DictConfig, OmegaConf, open_dict
 
 if not __package__:  # run as ``python workflows/<name>.py``: the checkout root makes ``workflows`` importable
     sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
-from workflows.config_paths import dataclass_from_node, dataclass_node, path_problem
+from workflows.config_paths import path_problem
 from workflows.manifest import StageStatus
 from workflows.pipeline_report import console
 from workflows.pipeline_run import EXIT_FAILED, EXIT_INCOMPLETE, EXIT_OK, run_pipeline
@@ -63,13 +63,14 @@ from workflows.sweep_workers import (
     run_gpu_workers,
     signature,
 )
+from workflows.task_fields import TASK_SECTION, apply_task_fields
 
-__all__ = ["Objective", "SearchParam", "apply_task_overrides", "main", "parse_space", "run_sweep"]
+__all__ = ["Objective", "SearchParam", "main", "parse_space", "run_sweep"]
 
-TASK_PREFIX = "task."
-"""Search keys on ``gmloco.train.GranularTaskCfg`` (DR ranges, curricula); other keys are config overrides."""
 CONFIG_PREFIX = "train_teacher."
-"""The config section a sweep may override (only the train stage runs in a trial)."""
+"""The config section a sweep may set (only the train stage runs in a trial)."""
+TASK_PREFIX = f"{TASK_SECTION}."
+"""Keys on ``gmloco.train.GranularTaskCfg`` (DR ranges, curricula), set by the train stage (``task_fields``)."""
 PARAM_TYPES = ("float", "int", "categorical")
 """Search-space entry types."""
 MIN_TRIALS_FOR_IMPORTANCE = 5
@@ -89,7 +90,7 @@ class SearchParam:
     """One entry of ``sweep.params``."""
 
     key: str
-    """Override key (``train_teacher.ppo.learning_rate``) or task path (``task.material.mu_int.0``)."""
+    """Config path (``train_teacher.ppo.learning_rate``, ``train_teacher.task.material.mu_int.0``)."""
     kind: str
     """``float``, ``int`` or ``categorical``."""
     low: float = 0.0
@@ -123,8 +124,10 @@ def parse_space(params: Mapping[str, Any]) -> list[SearchParam]:
     space = []
     for key, spec in params.items():
         where = f"sweep.params.{key}"
-        if not str(key).startswith((TASK_PREFIX, CONFIG_PREFIX)):
-            raise _bad(where, f"search key must start with '{TASK_PREFIX}' or '{CONFIG_PREFIX}'.")
+        if str(key).startswith("task."):
+            raise _bad(where, f"the task's fields sit at '{TASK_PREFIX}<path>': write '{CONFIG_PREFIX}{key}'.")
+        if not str(key).startswith(CONFIG_PREFIX):
+            raise _bad(where, f"search key must start with '{CONFIG_PREFIX}' (the train stage's section).")
         kind = str(spec.get("type", ""))
         if kind not in PARAM_TYPES:
             raise _bad(where, f"type must be one of {', '.join(PARAM_TYPES)}, got '{kind}'.")
@@ -148,44 +151,26 @@ def _bad_path(node: Any, path: str, key: str, prefix: str = "") -> None:
         raise _bad(key, problem)
 
 
-def _check_ranges(node: DictConfig, keys: Sequence[str]) -> None:
-    """Raise when a range whose end was set has low > high."""
-    for key in keys:
-        parent, _, end = key.removeprefix(TASK_PREFIX).rpartition(".")
-        pair = OmegaConf.select(node, parent) if end.isdigit() else None
-        if isinstance(pair, ListConfig) and len(pair) == 2 and pair[0] > pair[1]:
-            raise _bad(key, f"can make the range {list(pair)} empty (low > high); narrow its bounds.")
-
-
-def apply_task_overrides(task: Any, overrides: Mapping[str, Any]) -> Any:
-    """Return ``task`` (a ``GranularTaskCfg``) with ``task.<path>`` values set; range ends are checked.
-
-    Each path is OmegaConf's (``OmegaConf.update`` on the task as a node), as for the ``train_teacher.*`` keys.
-    """
-    node = dataclass_node(task)
-    for key, value in overrides.items():
-        path = key.removeprefix(TASK_PREFIX)
-        _bad_path(node, path, key, TASK_PREFIX)
-        OmegaConf.update(node, path, value, merge=True)
-    _check_ranges(node, list(overrides))
-    return dataclass_from_node(task, node)
-
-
 def check_space(cfg: DictConfig, space: Sequence[SearchParam], fixed: Mapping[str, Any]) -> None:
     """Check every key before the first trial: config keys exist; task paths exist; no range can become empty."""
-    for p in space:
-        if p.key.startswith(CONFIG_PREFIX):
-            _bad_path(cfg, p.key, f"sweep.params.{p.key}")
+    keys = [(p.key, f"sweep.params.{p.key}") for p in space] + [(str(k), f"sweep.fixed.{k}") for k in fixed]
+    for key, where in keys:
+        if not key.startswith(CONFIG_PREFIX):
+            raise _bad(where, f"key must start with '{CONFIG_PREFIX}' (the train stage's section).")
+        if not key.startswith(TASK_PREFIX):
+            _bad_path(cfg, key, where)
     task_params = [p for p in space if p.key.startswith(TASK_PREFIX)]
-    if not task_params and not fixed:
+    task_fixed = {k.removeprefix(TASK_PREFIX): v for k, v in fixed.items() if k.startswith(TASK_PREFIX)}
+    if not task_params and not task_fixed:
         return
     from workflows.policy_training import task_cfg
 
     base = task_cfg(cfg.train_teacher)
     # Worst case for a range: its low end at its largest value and its high end at its smallest.
-    worst = {p.key: p.extremes()[1 if p.key.endswith(".0") else 0] for p in task_params}
-    apply_task_overrides(base, {**fixed, **worst})
-    apply_task_overrides(base, {**fixed, **{p.key: p.extremes()[1] for p in task_params}})
+    worst = {p.key.removeprefix(TASK_PREFIX): p.extremes()[1 if p.key.endswith(".0") else 0] for p in task_params}
+    high = {p.key.removeprefix(TASK_PREFIX): p.extremes()[1] for p in task_params}
+    apply_task_fields(base, {**task_fixed, **worst})
+    apply_task_fields(base, {**task_fixed, **high})
 
 
 # Objective.
@@ -249,9 +234,9 @@ def chunk_ends(total: int, chunks: int) -> list[int]:
 class TrialStage:
     """The train stage of one trial: chunked, resumed training; the objective goes to the pruner after each chunk."""
 
-    def __init__(self, trial: Any, objective: Objective, task_overrides: Mapping[str, Any]) -> None:
-        """Bind the Optuna trial, the objective and the trial's ``task.*`` values."""
-        self.trial, self.objective, self.task_overrides = trial, objective, dict(task_overrides)
+    def __init__(self, trial: Any, objective: Objective) -> None:
+        """Bind the Optuna trial and the objective."""
+        self.trial, self.objective = trial, objective
         self.pruned = False
         for step, value in trial.user_attrs.get("reports", []):  # reports of the interrupted run it continues
             trial.report(float(value), int(step))
@@ -262,7 +247,7 @@ class TrialStage:
         from workflows.policy_training import newest_checkpoint, task_cfg
 
         section = cfg.train_teacher
-        task = apply_task_overrides(task_cfg(section), self.task_overrides)
+        task = task_cfg(section)  # the trial's train_teacher.task values included
         deadline = None if section.max_minutes is None else time.monotonic() + 60.0 * float(section.max_minutes)
         done = _checkpoint_iteration(newest_checkpoint, section.out_dir) if section.resume else 0
         metrics: dict[str, Any] = {}
@@ -308,28 +293,25 @@ class TrialOutcome:
     """Why it failed or was interrupted."""
 
 
-def _trial_cfg(cfg: DictConfig, trial: Any, trial_dir: Path, deadline: float | None) -> tuple[DictConfig, dict]:
-    """The trial's pipeline config (config overrides applied) and its ``task.*`` overrides."""
+def _trial_cfg(cfg: DictConfig, trial: Any, trial_dir: Path, deadline: float | None) -> DictConfig:
+    """The trial's pipeline config: ``sweep.fixed``, then the trial's values, each set at its config path."""
     tcfg = copy.deepcopy(cfg)
     tcfg.run_name, tcfg.run_dir, tcfg.stages = trial_dir.name, str(trial_dir), ["train_teacher"]
-    task = {**cfg.sweep.task_overrides}
-    for key, value in trial.params.items():
-        if key.startswith(TASK_PREFIX):
-            task[key] = value
-        else:
-            OmegaConf.update(tcfg, key, value, merge=True)
-    tcfg.sweep.trial_params = {"number": trial.number, "params": dict(trial.params), "task_overrides": task}
+    with open_dict(tcfg.train_teacher.task):  # the task's fields: an open mapping, its paths checked by check_space
+        for key, value in {**cfg.sweep.fixed, **trial.params}.items():
+            OmegaConf.update(tcfg, str(key), value, merge=True)
+    tcfg.sweep.trial_params = {"number": trial.number, "params": dict(trial.params)}
     if deadline is not None:
         tcfg.max_minutes = max(0.0, (deadline - time.monotonic()) / 60.0)
-    return tcfg, task
+    return tcfg
 
 
 def run_trial(cfg: DictConfig, trial: Any, objective: Objective, root: Path, deadline: float | None) -> TrialOutcome:
     """Run one trial's train stage through the pipeline in ``trials/<number>`` (or the folder it continues)."""
     trial_dir = root / str(trial.user_attrs.get("run_dir", f"trials/{trial.number:04d}"))
     trial.set_user_attr("run_dir", trial_dir.relative_to(root).as_posix())
-    tcfg, task = _trial_cfg(cfg, trial, trial_dir, deadline)
-    stage = TrialStage(trial, objective, task)
+    tcfg = _trial_cfg(cfg, trial, trial_dir, deadline)
+    stage = TrialStage(trial, objective)
     spec = StageSpec("train_teacher", (4, 6), (), f"sweep trial {trial.number}", fn=stage)
     row = run_pipeline(tcfg, registry=(spec,), run_dir=str(trial_dir))["stages"][0]
     status, metrics = StageStatus(row["status"]), row["metrics"]
@@ -366,12 +348,10 @@ def _prepare(cfg: DictConfig) -> DictConfig:
         cfg = gpu_worker_cfgs(cfg)[0]
     if str(getattr(cfg.scale, "value", cfg.scale)) == "smoke":
         cfg.sweep.n_trials = min(int(cfg.sweep.n_trials), int(cfg.sweep.smoke_trials))
-        cfg.sweep.task_overrides = {**cfg.sweep.task_overrides, **cfg.sweep.smoke_task_overrides}
+        cfg.sweep.fixed = {**cfg.sweep.fixed, **cfg.sweep.smoke_fixed}
         ev = cfg.sweep.eval
         ev.repeats, ev.duration_s = ev.smoke_repeats, ev.smoke_duration_s
-        console.print(
-            f"[yellow]sweep at smoke scale: {cfg.sweep.n_trials} trials, task {cfg.sweep.smoke_task_overrides}"
-        )
+        console.print(f"[yellow]sweep at smoke scale: {cfg.sweep.n_trials} trials, fixed {cfg.sweep.smoke_fixed}")
     return cfg
 
 
@@ -483,7 +463,7 @@ def _setup(cfg: DictConfig) -> tuple[Path, Objective, list[SearchParam], dict[st
             "sweep.metric", "eval/<key> objectives need a policy.onnx: only train_teacher.algorithm=ppo exports one."
         )
     space = _space(cfg)
-    check_space(cfg, space, dict(cfg.sweep.task_overrides))
+    check_space(cfg, space, {str(k): v for k, v in cfg.sweep.fixed.items()})
     seed_everything(int(cfg.seed))
     root = Path(cfg.run_dir)
     atomic_write_yaml(root / "config.yaml", OmegaConf.to_container(cfg, resolve=True, enum_to_str=True))
@@ -660,7 +640,7 @@ def _write_best_config(cfg: DictConfig, root: Path, trials: Sequence[Any], best:
         return None
     trial = next(t for t in trials if t.number == best["number"])
     trial_dir = root / str(trial.user_attrs.get("run_dir", f"trials/{trial.number:04d}"))
-    tcfg, _ = _trial_cfg(cfg, trial, trial_dir, None)
+    tcfg = _trial_cfg(cfg, trial, trial_dir, None)
     atomic_write_yaml(root / "best_config.yaml", OmegaConf.to_container(tcfg, resolve=True, enum_to_str=True))
     return "best_config.yaml"
 
@@ -687,7 +667,7 @@ def write_report(
         "importances": importances,
         "importances_note": why,
         "search_space": OmegaConf.to_container(cfg.sweep.params, resolve=True),
-        "task_overrides": OmegaConf.to_container(cfg.sweep.task_overrides, resolve=True),
+        "fixed": OmegaConf.to_container(cfg.sweep.fixed, resolve=True),
         "scale": str(getattr(cfg.scale, "value", cfg.scale)),
         "device": str(cfg.device),
         "seed": int(cfg.seed),

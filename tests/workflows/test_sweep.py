@@ -1,5 +1,5 @@
 # SPDX-License-Identifier: Apache-2.0
-"""The Optuna sweep workflow (``workflows/sweep.py``): search space, task overrides, study, pruning, resume, report.
+"""The Optuna sweep workflow (``workflows/sweep.py``): search space, task fields, study, pruning, resume, report.
 
 The study machinery runs with the train stage's ``run_training`` replaced by a fake whose metric is a known
 function of the trial's task (seconds); one ``slow`` test runs the real command at smoke scale on the CPU.
@@ -20,7 +20,7 @@ from workflows import policy_training, sweep, train_teacher
 from workflows.stage_registry import StageIncompleteError
 from workflows.stage_runner import PipelineConfigError
 
-MU_KEY = "task.material.mu_int.0"
+MU_KEY = "train_teacher.task.material.mu_int.0"
 """The searched DR range end in the fake-training tests."""
 LR_KEY = "train_teacher.ppo.learning_rate"
 """A searched config override."""
@@ -68,7 +68,7 @@ def fake_training(monkeypatch: pytest.MonkeyPatch) -> Callable[..., FakeTraining
     """Install a :class:`FakeTraining` (and a task factory that does not import mjlab)."""
     from gmloco.train.config import GranularTaskCfg
 
-    monkeypatch.setattr(policy_training, "task_cfg", lambda section: GranularTaskCfg())
+    monkeypatch.setattr(policy_training, "task_cfg", lambda section: _task(GranularTaskCfg(), section))
 
     def install(**kwargs: Any) -> FakeTraining:
         fake = FakeTraining(**kwargs)
@@ -76,6 +76,13 @@ def fake_training(monkeypatch: pytest.MonkeyPatch) -> Callable[..., FakeTraining
         return fake
 
     return install
+
+
+def _task(task: Any, section: DictConfig) -> Any:
+    """``task`` with the section's ``task`` fields set, as ``policy_training.task_cfg`` sets them."""
+    from workflows.task_fields import apply_task_fields, flat_paths
+
+    return apply_task_fields(task, flat_paths(section.get("task") or {}))
 
 
 def _sweep_cfg(compose: Callable[..., DictConfig], run_dir: Path, n_trials: int) -> DictConfig:
@@ -109,67 +116,22 @@ def _load_study(run_dir: Path, storage: str = "") -> Any:
 
 
 def test_parse_space_names_the_bad_entry() -> None:
-    """Keys outside task./train_teacher., unknown types, low >= high and empty choices are refused by name."""
+    """Keys outside train_teacher., unknown types, low >= high and empty choices are refused by name."""
     bad = {
         "seed": {"type": "int", "low": 0, "high": 3},
-        "task.action_scale": {"type": "uniform", "low": 0.1, "high": 0.3},
-        "task.material.mu_int.0": {"type": "float", "low": 0.4, "high": 0.1},
-        "task.command_curriculum": {"type": "categorical", "choices": []},
+        "train_teacher.task.action_scale": {"type": "uniform", "low": 0.1, "high": 0.3},
+        MU_KEY: {"type": "float", "low": 0.4, "high": 0.1},
+        "train_teacher.task.command_curriculum": {"type": "categorical", "choices": []},
     }
     for key, spec in bad.items():
         with pytest.raises(PipelineConfigError) as info:
             sweep.parse_space({key: spec})
         assert info.value.key == f"sweep.params.{key}"
-    space = sweep.parse_space({"task.reward_ramp_steps": {"type": "int", "low": 10, "high": 1000, "log": True}})
+    with pytest.raises(PipelineConfigError, match=r"write 'train_teacher\.task\.robot_dr\.push_velocity'"):
+        sweep.parse_space({"task.robot_dr.push_velocity": {"type": "float", "low": 0, "high": 1}})
+    key = "train_teacher.task.reward_ramp_steps"
+    space = sweep.parse_space({key: {"type": "int", "low": 10, "high": 1000, "log": True}})
     assert space[0].distribution().log and space[0].distribution().low == 10
-
-
-def test_apply_task_overrides_sets_nested_fields_and_range_ends() -> None:
-    """Dotted paths reach nested dataclasses and tuple ends; ints become floats in float fields; input untouched."""
-    from gmloco.train.config import GranularTaskCfg
-
-    base = GranularTaskCfg()
-    task = sweep.apply_task_overrides(
-        base,
-        {
-            "task.material.mu_int.0": 0.3,
-            "task.robot_dr.push_velocity": 0,
-            "task.terrain.floor.depth_range.1": 0.2,
-            "task.terrain.floor.num_levels": 7,
-            "task.command_curriculum": False,
-        },
-    )
-    assert task.material.mu_int == (0.3, base.material.mu_int[1])
-    assert task.robot_dr.push_velocity == 0.0 and isinstance(task.robot_dr.push_velocity, float)
-    assert task.terrain.floor.depth_range == (0.0, 0.2) and task.terrain.floor.num_levels == 7
-    assert task.command_curriculum is False
-    assert base.material.mu_int == (0.2, 0.9) and base.command_curriculum is True
-    assert sweep.apply_task_overrides(base, {}) == base
-
-
-def test_apply_task_overrides_round_trips_the_real_task() -> None:
-    """The mjlab task of an experiment comes back equal, field for field, when no path is set."""
-    from gmloco.train import g1_granular_task
-
-    task = g1_granular_task("rft3d", "deep")
-    assert sweep.apply_task_overrides(task, {}) == task
-    changed = sweep.apply_task_overrides(task, {"task.terrain.floor.num_levels": 7.0})
-    assert changed.terrain.floor.num_levels == 7 and isinstance(changed.terrain.floor.num_levels, int)
-
-
-def test_apply_task_overrides_refuses_unknown_fields_and_empty_ranges() -> None:
-    """A typo names the wrong key, its section and the section's valid keys; a crossing range end is refused."""
-    from gmloco.train.config import GranularTaskCfg
-
-    with pytest.raises(PipelineConfigError, match=r"no key 'mu_intt' in task\.material; valid keys: .*mu_int") as info:
-        sweep.apply_task_overrides(GranularTaskCfg(), {"task.material.mu_intt.0": 0.3})
-    assert info.value.key == "task.material.mu_intt.0"
-    with pytest.raises(PipelineConfigError, match=r"no key '2' in task\.material\.mu_int; valid keys: 0, 1\."):
-        sweep.apply_task_overrides(GranularTaskCfg(), {"task.material.mu_int.2": 0.3})
-    with pytest.raises(PipelineConfigError, match=r"no key 'x' in task\.episode_length_s; valid keys: \(none"):
-        sweep.apply_task_overrides(GranularTaskCfg(), {"task.episode_length_s.x": 0.3})
-    with pytest.raises(PipelineConfigError, match="low > high"):
-        sweep.apply_task_overrides(GranularTaskCfg(), {"task.material.mu_int.0": 0.95})
 
 
 def test_check_space_catches_ranges_that_only_some_samples_empty(compose: Callable[..., DictConfig]) -> None:
@@ -179,7 +141,7 @@ def test_check_space_catches_ranges_that_only_some_samples_empty(compose: Callab
     from gmloco.train.config import GranularTaskCfg
 
     original = policy_training.task_cfg
-    policy_training.task_cfg = lambda section: GranularTaskCfg()  # type: ignore[assignment]
+    policy_training.task_cfg = lambda section: _task(GranularTaskCfg(), section)  # type: ignore[assignment]
     try:
         with pytest.raises(PipelineConfigError, match="low > high"):
             sweep.check_space(cfg, space, {})
@@ -236,7 +198,8 @@ def test_study_runs_trials_in_run_dirs_prunes_and_resumes(
         calls = [c for c in fake.calls if c["trial"] == n]
         assert all(c["mu_low"] == pytest.approx(row["params"][MU_KEY]) for c in calls)
         assert all(c["lr"] == pytest.approx(row["params"][LR_KEY]) for c in calls)
-        assert all(c["episode_length_s"] == 0.1 for c in calls)  # smoke_task_overrides
+        assert all(c["episode_length_s"] == 0.1 for c in calls)  # smoke_fixed
+        assert OmegaConf.select(trial_cfg, MU_KEY) == pytest.approx(row["params"][MU_KEY])
         # Chunks resume: each call starts where the previous one ended (8 iterations in 4 chunks).
         assert [(c["start"], c["end"]) for c in calls] == [(0, 2), (2, 4), (4, 6), (6, 8)][: len(calls)]
         reported = {int(k): v for k, v in row["intermediate"].items()}
@@ -320,7 +283,10 @@ def test_importances_rank_the_parameter_that_matters(compose: Callable[..., Dict
         ([], "sweep"),
         (["+sweep=optuna_teacher", "sweep.storage=study.db"], "sweep.storage"),
         (["+sweep=optuna_teacher", "sweep.gpus=[0]", "device=cpu"], "sweep.gpus"),
-        (["+sweep=optuna_teacher", "sweep.task_overrides={task.material.mu_intt.0: 0.3}"], "task.material.mu_intt.0"),
+        (
+            ["+sweep=optuna_teacher", "sweep.fixed={train_teacher.task.material.mu_intt.0: 0.3}"],
+            "train_teacher.task.material.mu_intt.0",
+        ),
     ],
 )
 def test_bad_sweep_input_exits_2(tmp_path: Path, args: list[str], key: str) -> None:
@@ -375,7 +341,8 @@ def test_workers_join_a_shared_study_and_refuse_another_search(
     )
     assert res.returncode == 2, res.stderr[-3000:]
     assert (
-        "holds a different search" in res.stderr and "'task.robot_dr.push_velocity' only in this config" in res.stderr
+        "holds a different search" in res.stderr
+        and "'train_teacher.task.robot_dr.push_velocity' only in this config" in res.stderr
     )
 
 
@@ -504,7 +471,7 @@ def test_trial_whose_training_finished_before_a_kill_reports_its_saved_metrics(
     (out / "model_8.pt").write_text("checkpoint")
     (out / "metrics.json").write_text(json.dumps({"iteration": 8.0, "mean_reward": 1.5}))
     trial = optuna.create_study().ask()
-    result = sweep.TrialStage(trial, sweep.Objective.parse("train_teacher/mean_reward"), {})(cfg)
+    result = sweep.TrialStage(trial, sweep.Objective.parse("train_teacher/mean_reward"))(cfg)
     assert fake.calls == [] and result["objective"] == 1.5 and result["pruned"] == 0.0
 
 
