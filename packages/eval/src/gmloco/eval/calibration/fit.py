@@ -216,11 +216,15 @@ def torque_scale(ds: CalibrationDataset) -> float:
 
 
 def rms_by_split(ds: CalibrationDataset, sq: dict[str, np.ndarray]) -> dict[str, float]:
-    """Return the RMS over each split's frames of per-frame squared errors ``sq`` (NaN for a split without any)."""
+    """Return the RMS over each split's frames of per-frame squared errors ``sq`` (NaN for a split without any).
+
+    Frames whose error is NaN (a record's force unknown there, e.g. a walk's double support) are left out.
+    """
     out = {}
     for split in ("fit", "heldout"):
         err = [sq[n] for n in sq if ds.split[n] == split]
-        out[split] = float(np.sqrt(np.mean(np.concatenate(err)))) if err else float("nan")
+        known = np.concatenate(err)[np.isfinite(np.concatenate(err))] if err else np.zeros(0)
+        out[split] = float(np.sqrt(np.mean(known))) if known.size else float("nan")
     return out
 
 
@@ -235,7 +239,7 @@ def _split_errors(
     wrenches = replay_wrenches(ds, ext, cfg, list(ds.records), datum)
     sq_f = {n: np.sum((w[:, :3] - ds.records[n].force) ** 2, -1) for n, w in wrenches.items()}
     sq_t = {n: (w[:, 5] - ds.records[n].torque[:, 2]) ** 2 for n, w in wrenches.items() if ds.records[n].has_torque}
-    per_f = {n: float(np.sqrt(np.mean(e))) for n, e in sq_f.items()}
+    per_f = {n: float(np.sqrt(np.nanmean(e))) if np.isfinite(e).any() else float("nan") for n, e in sq_f.items()}
     per_t = {n: float(np.sqrt(np.mean(e))) for n, e in sq_t.items()}
     return rms_by_split(ds, sq_f), per_f, rms_by_split(ds, sq_t) if sq_t else None, per_t
 
@@ -257,6 +261,7 @@ def _fit_one(ds: CalibrationDataset, cfg: SandFitCfg, plastic: bool) -> tuple[Rf
 
     names = [n for n in ds.records if ds.split[n] == "fit"]
     data = np.concatenate([ds.records[n].force for n in names])
+    known = np.isfinite(data)  # a walk's double-support frames carry no per-foot force (NaN): left out
     twisted = [n for n in names if ds.records[n].has_torque] if cfg.torque_weight > 0.0 else []
     data_tz = np.concatenate([ds.records[n].torque[:, 2] for n in twisted]) if twisted else np.zeros(0)
     scale, scale_tz = ds.protocol.weight, torque_scale(ds) / cfg.torque_weight if twisted else 1.0
@@ -266,7 +271,7 @@ def _fit_one(ds: CalibrationDataset, cfg: SandFitCfg, plastic: bool) -> tuple[Rf
         """Force residual of the fit records over W, then the weighted yaw-torque residual over W l [-]."""
         datum = float(x[n_terms]) if cfg.fit_datum else 0.0
         wrenches = replay_wrenches(ds, _extensions(x[:n_terms], cfg, plastic), cfg, names, datum)
-        force = ((np.concatenate([wrenches[n][:, :3] for n in names]) - data) / scale).ravel()
+        force = (np.where(known, np.concatenate([wrenches[n][:, :3] for n in names]) - data, 0.0) / scale).ravel()
         if not twisted:
             return force
         torque = (np.concatenate([wrenches[n][:, 5] for n in twisted]) - data_tz) / scale_tz

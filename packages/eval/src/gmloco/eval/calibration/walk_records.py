@@ -14,8 +14,12 @@ meets the sand with more than its soles. The record's depth is the sole's lowest
 (flat beds only: a rough or transition terrain is refused). The recorded sinkage is the same quantity; forward
 kinematics reproduces it (checked on every file, ``WalkRecordsCfg.depth_tolerance``).
 
-    python -m gmloco.eval.calibration.walk_records --material dry_sand --out walks/dry_sand.npz \
+    python -m gmloco.eval.calibration.walk_records --material dry_sand --out walks/dry_sand.npz [--force momentum] \
         --recordings results/mpm_eval/table_rows/*/runs/table_td_dry_sand*/recordings/dry_sand__straight__v*.mcap
+
+``--force momentum`` takes each foot's force from the robot's momentum instead of the log
+(:mod:`gmloco.eval.calibration.walk_momentum`): single-support frames only, NaN in double support; the force of
+recordings made before the scene logged the policy step's mean is aliased.
 
 Exit codes: 0 written, 2 bad input (no or unreadable recording, a terrain of another material or not flat, a file
 whose kinematics do not reproduce its recorded sinkage).
@@ -25,17 +29,19 @@ from __future__ import annotations
 
 import argparse
 import sys
-from dataclasses import dataclass
+from dataclasses import asdict, dataclass, field
 from functools import cache
 from pathlib import Path
-from typing import Any
+from typing import Any, Literal
 
 import numpy as np
 
 from gmloco.contact import MATERIAL_PRESETS
+from gmloco.deploy.config_cli import field_doc
 from gmloco.deploy.g1 import G1_FOOT_BODIES, G1_SOLE_BOX_CENTER, G1_SOLE_BOX_HALF_EXTENTS
 from gmloco.eval.calibration.dataset import CalibrationDataset, assign_split, save_dataset
 from gmloco.eval.calibration.protocol import SoleProtocolCfg, SoleRecord
+from gmloco.eval.calibration.walk_momentum import MomentumForceCfg, foot_forces, total_force
 from gmloco.eval.g1.soles import SoleCfg, sole_box_corners
 
 __all__ = ["WALK_FRAME_DT", "WalkRecordsCfg", "foot_records", "main", "walk_dataset", "walk_terrain"]
@@ -59,6 +65,12 @@ class WalkRecordsCfg:
     """Largest difference between the kinematics' depth and the recorded sinkage that a file may show [m]."""
     min_frames: int = 10
     """Fewest frames a walk must keep (shorter ones are refused) [-]."""
+    force_source: Literal["logged", "momentum"] = "logged"
+    """The records' sand force: the logged per-foot force (the policy step's mean in recordings made since the MPM
+    evaluation logs it; one aliased 5 ms frame in older ones), or the robot's momentum
+    (:mod:`gmloco.eval.calibration.walk_momentum`: single-support frames only, NaN in double support)."""
+    momentum: MomentumForceCfg = field(default_factory=MomentumForceCfg)
+    """Contact rule of the momentum forces."""
 
 
 def walk_terrain(path: str | Path) -> str:
@@ -116,13 +128,11 @@ def foot_records(path: str | Path, cfg: WalkRecordsCfg | None = None) -> dict[st
     jacp, jacr = np.zeros((3, model.nv)), np.zeros((3, model.nv))
     pos, rot, lin, ang, depth = (np.zeros((2, n, *s)) for s in ((3,), (3, 3), (3,), (3,), ()))
     v_world = quat_rotate(a["odom.orientation"][:n], a["odom.linear_velocity"][:n])
+    qpos_all = np.concatenate([a["odom.position"][:n], a["odom.orientation"][:n], a["lowstate.q"][:n]], axis=1)
+    qvel_all = np.concatenate([v_world, a["odom.angular_velocity"][:n], a["lowstate.dq"][:n]], axis=1)
     for k in range(n):
-        data.qpos[:3], data.qpos[3:7], data.qpos[7:] = (
-            a["odom.position"][k],
-            a["odom.orientation"][k],
-            a["lowstate.q"][k],
-        )
-        qvel = np.concatenate([v_world[k], a["odom.angular_velocity"][k], a["lowstate.dq"][k]])
+        data.qpos[:] = qpos_all[k]
+        qvel = qvel_all[k]
         mujoco.mj_kinematics(model, data)
         mujoco.mj_comPos(model, data)
         for f, body in enumerate(feet):
@@ -137,6 +147,8 @@ def foot_records(path: str | Path, cfg: WalkRecordsCfg | None = None) -> dict[st
         raise ValueError(f"{path}: the kinematics' sole depth differs from the recorded sinkage by {off:.4f} m")
     time = WALK_FRAME_DT * np.arange(n)
     force = a["sim.force"][:n]
+    if cfg.force_source == "momentum":
+        force = foot_forces(total_force(model, qpos_all, qvel_all, WALK_FRAME_DT), force, depth.T, cfg.momentum)
     return {foot: SoleRecord(time, pos[f], rot[f], lin[f], ang[f], force[:, f].copy(), depth[f])
             for f, foot in enumerate(FEET)}  # fmt: skip
 
@@ -194,7 +206,7 @@ def walk_dataset(
 
 def _cfg_dict(cfg: WalkRecordsCfg) -> dict[str, Any]:
     """The settings as JSON values."""
-    return {k: list(v) if isinstance(v, tuple) else v for k, v in cfg.__dict__.items()}
+    return {k: list(v) if isinstance(v, tuple) else v for k, v in asdict(cfg).items()}
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -208,13 +220,16 @@ def main(argv: list[str] | None = None) -> int:
         "--out", required=True, help="dataset file (.npz), e.g. results/sand_calibration/dataset/walks/dry_sand.npz"
     )
     p.add_argument("--split-seed", type=int, default=0, help="seed of the fit / held-out split by walk (default 0)")
+    p.add_argument(
+        "--force", choices=("logged", "momentum"), default="logged", help=field_doc(WalkRecordsCfg, "force_source")
+    )
     args = p.parse_args(argv)
     missing = [r for r in args.recordings if not Path(r).is_file()]
     if missing:
         print(f"error: no recording {missing}; MPM evaluations write them under <run>/recordings/", file=sys.stderr)
         return 2
     try:
-        ds = walk_dataset(args.recordings, args.material, split_seed=args.split_seed)
+        ds = walk_dataset(args.recordings, args.material, WalkRecordsCfg(force_source=args.force), args.split_seed)
     except (ValueError, KeyError) as exc:
         print(f"error: {exc}", file=sys.stderr)
         return 2

@@ -86,11 +86,14 @@ def walk_replay(ds: CalibrationDataset, models: dict[str, RftExtensionsCfg], cfg
         replay = replay_forces(ds, ext, cfg, names, datums[label])
         forces[label] = np.concatenate([replay[n] for n in names])
         errors[label] = rms_by_split(ds, {n: np.sum((replay[n] - ds.records[n].force) ** 2, -1) for n in names})
+    known = np.isfinite(forces["mpm"]).all(axis=1)  # frames with MPM's force (momentum records: single support)
     return {
         "dataset": {
             "material": ds.material,
             "records": len(names),
             "frames": len(depth),
+            "frames_with_force": int(known.sum()),
+            "force_source": (ds.extra or {}).get("walk_records", {}).get("force_source", "logged"),
             "submerged_frames": (depth >= DEPTH_EDGES_M[0]).sum().item(),
             "frame_dt_s": ds.protocol.frame_dt,
             "recordings": (ds.extra or {}).get("recordings"),
@@ -98,7 +101,7 @@ def walk_replay(ds: CalibrationDataset, models: dict[str, RftExtensionsCfg], cfg
         "models": {label: asdict(ext) for label, ext in models.items()},
         "datum_m": datums,
         "rms_force_error_N": errors,
-        "bins": binned_forces(depth, speed, forces),
+        "bins": binned_forces(depth[known], speed[known], {k: f[known] for k, f in forces.items()}),
     }
 
 
