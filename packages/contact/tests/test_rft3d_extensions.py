@@ -42,6 +42,7 @@ TERMS: dict[str, RftExtensionsCfg] = {
     "loosening_keep": RftExtensionsCfg(loosening_depth=0.03, loosening_length=0.02, loosening_keep=0.3),
     "erosion": RftExtensionsCfg(erosion_length=0.02, erosion_keep=0.2, erosion_restore=0.005),
     "rate_drag": RftExtensionsCfg(rate_drag=3.0),
+    "bearing": RftExtensionsCfg(bearing=1.0),
     "all": RftExtensionsCfg(
         depth_exponent=0.8,
         depth_saturation=0.04,
@@ -176,6 +177,22 @@ def test_rate_drag_opposes_a_slide_in_proportion_to_speed(device: str) -> None:
     k = 3.0 * MATERIAL_PRESETS["dry_sand"].rho_c * 9.81 * 0.02 * 0.206 * 0.0736
     np.testing.assert_allclose(dragged[:3] - plain[:3], [-k * 0.5, -k * 0.2, 0.0], rtol=1e-4, atol=1e-3)
     assert k * 0.5 > 1.0
+
+
+def test_bearing_keeps_a_sliding_sole_as_supported_as_a_pressed_one(device: str) -> None:
+    """A level sole 20 mm deep sliding at 1 m/s keeps the F_z of a straight press.
+
+    Its F_x, and a rising sole's whole force, are the published model's.
+    """
+    plain = make_contact_model(ContactRFT3DCfg(at_rest="none"), 1, 1, device)
+    bearing = make_contact_model(ContactRFT3DCfg(at_rest="none", extensions=TERMS["bearing"]), 1, 1, device)
+    slide, press, rise = (_level_sole(0.02, v) for v in ((1.0, 0.0, 0.0), (0.0, 0.0, -0.2), (1.0, 0.0, 0.05)))
+    pressed_z = _wrench(plain, press)[2]
+    slid_plain, slid = _wrench(plain, slide), _wrench(bearing, slide)
+    assert slid_plain[2] < 0.5 * pressed_z  # 3D-RFT's support of a sliding sole falls
+    np.testing.assert_allclose(slid[2], pressed_z, rtol=1e-5)
+    np.testing.assert_allclose(slid[:2], slid_plain[:2], rtol=1e-6, atol=1e-6)
+    np.testing.assert_allclose(_wrench(bearing, rise), _wrench(plain, rise), rtol=1e-6, atol=1e-6)
 
 
 def test_lateral_scale_scales_only_horizontal(device: str) -> None:

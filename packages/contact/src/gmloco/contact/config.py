@@ -123,6 +123,13 @@ class RftExtensionsCfg:
     planted to 100-200 N above 1 m/s at the same depth, ``results/sand_calibration/walk_replay/``). Any face, at
     the element's depth below the free surface. [s/m]; 0 = off. Not domain-randomized per world (one value per
     model)."""
+    bearing: float = 0.0
+    """(i) Bearing under motion: a submerged element on the loading branch that is not withdrawing (v_z <= 0) keeps
+    at least ``bearing`` times the vertical force it would meet pressed straight down at its depth, whatever its
+    horizontal motion. 3D-RFT's element force turns with the velocity, so a sole that rolls or slides at 0.5-2 m/s
+    loses most of its vertical support; MPM's stance sole carries the robot's weight at every sole speed
+    (``results/sand_calibration/walk_replay/``, forces from the robot's momentum). [-]; 0 = off. Not
+    domain-randomized per world (one value per model)."""
     dt: float = 0.005
     """Physics step of the finite-difference acceleration of ``added_mass`` and of the travel of ``loosening_depth``
     and ``erosion_length`` [s] (state update once per step)."""
@@ -145,6 +152,7 @@ class RftExtensionsCfg:
             "erosion_keep": 0.0 <= self.erosion_keep < 1.0,
             "erosion_restore": self.erosion_restore > 0.0,
             "rate_drag": self.rate_drag >= 0.0,
+            "bearing": self.bearing >= 0.0,
             "dt": self.dt > 0.0,
         }
         for name, ok in checks.items():

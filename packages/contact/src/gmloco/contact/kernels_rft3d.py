@@ -248,7 +248,8 @@ def rft3d_element_force_ext(
     """Return :func:`rft3d_element_force` with the extension terms (:mod:`~gmloco.contact.kernels_rft3d_ext`) [N].
 
     Plastic unloading in place of the crater branches, the depth law on both branches' depth, the lateral scale on
-    the resistive force, the erosion factor and the rate drag, then the vertical overburden and added-mass forces; each skipped where its flag is off.
+    the resistive force, the bearing floor of the loading branch, the erosion factor and the rate drag, then the
+    vertical overburden and added-mass forces; each skipped where its flag is off.
     Compiled only into the kernels of models with a term on (:func:`rft3d_element_kernel_func`), so the published
     model's kernels carry none of this code (registers).
     """
@@ -266,6 +267,7 @@ def rft3d_element_force_ext(
         if depth <= 0.0:
             return wp.vec3(0.0)
     force = wp.vec3(0.0)
+    bearing_z = -1.0e30  # (i) no floor unless the loading branch sets one
     if ext_within_crater(depth, depth_max, ext, w):
         force = wp.vec3(0.0)  # (c) plastic unloading: no force until z_max is re-reached
     elif rest.mode == AT_REST_UNLOADING and depth > 0.0 and depth < depth_max:
@@ -277,7 +279,13 @@ def rft3d_element_force_ext(
     else:
         d_law = ext_depth_law(depth, ext, w)  # (a) depth law
         force = rft3d_plastic_force(n, v, d_law, area, xi, mat[2], coeffs, m.v_eps, m.sign_fix)
+        if ext.bearing > 0.0 and v[2] <= 0.0:  # (i) the vertical force of a straight press at this depth
+            down = wp.vec3(0.0, 0.0, -1.0)
+            bearing_z = ext.bearing * rft3d_plastic_force(n, down, d_law, area, xi, mat[2], coeffs, m.v_eps,
+                                                          m.sign_fix)[2]  # fmt: skip
     force = ext_lateral(force, ext, w)  # (b) lateral scale
+    if bearing_z > force[2]:  # (i) bearing under motion
+        force = wp.vec3(force[0], force[1], bearing_z)
     if ext.erosion != 0:  # (g) support eroded by horizontal travel
         force = wp.vec3(force[0], force[1], force[2] * ext_erosion_factor(state.travel[w, f, p], ext))
     if ext.rate_drag > 0.0:  # (h) drag growing with the sliding speed

@@ -52,7 +52,8 @@ COL_TOLERANCE = wp.constant(6)
 class RftExtParams:
     """On/off flags of the extension terms (0/1), the per-world values [W or 1, 7] and the physics step [s].
 
-    The per-model terms (loosening, erosion, rate drag) carry their values here; ``rate_drag`` > 0 is its own flag.
+    The per-model terms (loosening, erosion, rate drag, bearing) carry their values here; ``rate_drag`` > 0 and
+    ``bearing`` > 0 are their own flags.
     """
 
     depth_law: int
@@ -69,6 +70,7 @@ class RftExtParams:
     erosion: int
     erosion_keep: float
     rate_drag: float
+    bearing: float
 
 
 @wp.func
@@ -184,4 +186,5 @@ def make_ext_params(cfg: Any, values: wp.array) -> Any:  # an RftExtParams insta
     ext.erosion = int(cfg.erosion_length > 0.0)
     ext.erosion_keep = float(cfg.erosion_keep)
     ext.rate_drag = float(cfg.rate_drag)
+    ext.bearing = float(cfg.bearing)
     return ext

@@ -157,7 +157,8 @@ def rft3d_extended_forces(
 
     Base: plain RFT (``"none"``) or the elastic unloading branch with crater friction (``"unloading"``), both with
     the depth law; plastic unloading zeroes 0 < d < z_max - tolerance; the lateral scale multiplies F_x, F_y; the
-    erosion factor F_z; the rate drag is added along x, y, the overburden and added-mass forces along z.
+    bearing floor raises F_z on the loading branch; the erosion factor multiplies F_z; the rate drag is added along
+    x, y, the overburden and added-mass forces along z.
     """
     ext = cfg.extensions
     if cfg.at_rest not in ("none", "unloading"):
@@ -188,6 +189,17 @@ def rft3d_extended_forces(
         crater = (depth > 0.0) & (depth < state.depth_max - ext.unloading_tolerance)
         f = np.where(crater[:, None], 0.0, f)
     f = f * np.array([ext.lateral_scale, ext.lateral_scale, 1.0])
+    if ext.bearing > 0.0:  # (i) bearing under motion, on the loading branch of an element not withdrawing
+        v = np.asarray(velocities, dtype=np.float64)
+        down = rft3d_forces(points, normals, np.tile([0.0, 0.0, -1.0], (len(v), 1)), areas, **mat,
+                            surface_z=surface_z, coeffs=cfg.coeffs, v_eps=cfg.v_eps, sign_fix=cfg.sign_fix,
+                            g=cfg.gravity)[:, 2]  # fmt: skip
+        if law is not None:
+            down = down * law(depth) / np.where(depth > 0.0, depth, 1.0)
+        elastic = (cfg.at_rest == "unloading") & (depth > 0.0) & (depth < state.depth_max)
+        crater = (depth > 0.0) & (depth < state.depth_max - ext.unloading_tolerance) if ext.plastic_unloading else False
+        on = (depth > 0.0) & (v[:, 2] <= 0.0) & ~elastic & ~np.asarray(crater)
+        f[:, 2] = np.where(on, np.maximum(f[:, 2], ext.bearing * down), f[:, 2])
     if ext.erosion_length > 0.0:  # (g) support lost to horizontal travel
         f[:, 2] *= erosion_factor(state.travel, ext)
     if ext.rate_drag > 0.0:  # (h) drag growing with the sliding speed

@@ -66,6 +66,7 @@ FIT_BOUNDS: dict[str, tuple[float, float, float]] = {
     "erosion_keep": (0.0, 0.95, 0.2),
     "erosion_restore": (0.0005, 0.05, 0.005),
     "rate_drag": (0.0, 20.0, 0.0),
+    "bearing": (0.0, 2.0, 0.0),
 }
 """(lower, upper, start) of each fitted value, the start neutral (the term off) but for ``erosion_length``; the
 lengths of :data:`FIT_INVERTED` are fitted as their inverse [1/m] (0 = off). Erosion starts at 1 / L = 50 (2 cm):
