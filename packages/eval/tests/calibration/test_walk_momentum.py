@@ -101,6 +101,15 @@ def test_a_recorded_walk_is_carried_by_its_weight() -> None:
     assert (both[single].min(axis=1)[:, 2] == 0.0).all()  # the clear foot carries nothing
 
 
+@pytest.mark.filterwarnings("ignore::UserWarning")
+@pytest.mark.skipif(not WALK.is_file(), reason="committed MPM recording not in this checkout")
+def test_the_aliased_log_reads_part_of_the_stance_force() -> None:
+    """On the committed walk (logged before the step mean) the log reads ~0.8 of the momentum's stance force."""
+    from gmloco.eval.calibration.walk_records import logged_over_momentum
+
+    assert 0.6 < logged_over_momentum(WALK) < 0.95
+
+
 def test_errors_leave_out_frames_without_a_force() -> None:
     """A frame whose force is unknown (NaN) counts in no split's RMS; a split of unknown frames only is NaN."""
     from types import SimpleNamespace

@@ -29,7 +29,7 @@ from __future__ import annotations
 
 import argparse
 import sys
-from dataclasses import asdict, dataclass, field
+from dataclasses import asdict, dataclass, field, replace
 from functools import cache
 from pathlib import Path
 from typing import Any, Literal
@@ -44,7 +44,15 @@ from gmloco.eval.calibration.protocol import SoleProtocolCfg, SoleRecord
 from gmloco.eval.calibration.walk_momentum import MomentumForceCfg, foot_forces, total_force
 from gmloco.eval.g1.soles import SoleCfg, sole_box_corners
 
-__all__ = ["WALK_FRAME_DT", "WalkRecordsCfg", "foot_records", "main", "walk_dataset", "walk_terrain"]
+__all__ = [
+    "WALK_FRAME_DT",
+    "WalkRecordsCfg",
+    "foot_records",
+    "logged_over_momentum",
+    "main",
+    "walk_dataset",
+    "walk_terrain",
+]
 
 WALK_FRAME_DT = 0.02
 """Frame time of the MPM recordings: the 50 Hz policy rate [s]."""
@@ -153,6 +161,23 @@ def foot_records(path: str | Path, cfg: WalkRecordsCfg | None = None) -> dict[st
             for f, foot in enumerate(FEET)}  # fmt: skip
 
 
+def logged_over_momentum(path: str | Path, cfg: WalkRecordsCfg | None = None) -> float:
+    """Return the logged stance force over the momentum's, mean vertical force of the single-support frames [-].
+
+    1 means the recording's per-foot force log is sound (the policy step's mean); the aliased logs of older
+    recordings read 0.5-1.0.
+    """
+    cfg = cfg or WalkRecordsCfg()
+    logged = foot_records(path, replace(cfg, force_source="logged"))
+    momentum = foot_records(path, replace(cfg, force_source="momentum"))
+    f_log = np.stack([logged[f].force[:, 2] for f in FEET], axis=1)
+    f_mom = np.stack([momentum[f].force[:, 2] for f in FEET], axis=1)
+    single = np.isfinite(f_mom).all(axis=1)
+    if not single.any():
+        return float("nan")
+    return float(f_log[single].sum() / f_mom[single].sum())
+
+
 def _record_name(path: Path) -> str:
     """A record-name stem unique per recording (no slash, as the npz keys need).
 
@@ -236,6 +261,9 @@ def main(argv: list[str] | None = None) -> int:
     out = save_dataset(ds, args.out)
     frames = sum(len(r.time) for r in ds.records.values())
     print(f"{len(ds.records)} foot records ({frames} frames) of {len(args.recordings)} walks -> {out}")
+    if args.force == "momentum":  # how the recordings' own force log compares (1: the log is sound)
+        for path in args.recordings:
+            print(f"  {path}: logged / momentum stance force {logged_over_momentum(path):.2f}")
     return 0
 
 
