@@ -223,8 +223,8 @@ def rms_by_split(ds: CalibrationDataset, sq: dict[str, np.ndarray]) -> dict[str,
     """
     out = {}
     for split in ("fit", "heldout"):
-        err = [sq[n] for n in sq if ds.split[n] == split]
-        known = np.concatenate(err)[np.isfinite(np.concatenate(err))] if err else np.zeros(0)
+        err = np.concatenate([sq[n] for n in sq if ds.split[n] == split] or [np.zeros(0)])
+        known = err[np.isfinite(err)]
         out[split] = float(np.sqrt(np.mean(known))) if known.size else float("nan")
     return out
 

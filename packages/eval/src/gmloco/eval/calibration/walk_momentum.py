@@ -26,7 +26,7 @@ from typing import Any
 
 import numpy as np
 
-__all__ = ["MomentumForceCfg", "com_velocity", "foot_forces", "total_force"]
+__all__ = ["MomentumForceCfg", "com_velocity", "foot_forces", "momentum_force", "total_force"]
 
 
 @dataclass(frozen=True)
@@ -62,17 +62,27 @@ def com_velocity(model: Any, qpos: np.ndarray, qvel: np.ndarray) -> np.ndarray:
     return out
 
 
+def momentum_force(com_vel: np.ndarray, mass: float, gravity: np.ndarray, dt: float) -> np.ndarray:
+    """Return ``F_k = M (c_dot[k+1] - c_dot[k-1]) / (2 dt) - M g`` [N], [T, 3] (ends: NaN).
+
+    Args:
+        com_vel: Centre-of-mass velocity per frame [m/s], [T, 3].
+        mass: Robot mass M [kg].
+        gravity: Gravity vector g [m/s^2], [3].
+        dt: Frame time [s].
+    """
+    out = np.full_like(com_vel, np.nan)
+    out[1:-1] = mass * ((com_vel[2:] - com_vel[:-2]) / (2.0 * dt) - np.asarray(gravity))
+    return out
+
+
 def total_force(model: Any, qpos: np.ndarray, qvel: np.ndarray, dt: float) -> np.ndarray:
     """Return the external non-gravity force on the robot [N], [T, 3], centred on each frame (ends: NaN).
 
-    ``F_k = M (c_dot[k+1] - c_dot[k-1]) / (2 dt) - M g`` with M the model's mass and g its gravity; ``dt`` is the
-    frame time [s].
+    :func:`momentum_force` of :func:`com_velocity`, with the model's mass and gravity; ``dt`` is the frame time [s].
     """
-    mass = float(model.body_subtreemass[0])
-    vel = com_velocity(model, qpos, qvel)
-    out = np.full_like(vel, np.nan)
-    out[1:-1] = mass * ((vel[2:] - vel[:-2]) / (2.0 * dt) - np.asarray(model.opt.gravity))
-    return out
+    com_vel = com_velocity(model, qpos, qvel)
+    return momentum_force(com_vel, float(model.body_subtreemass[0]), model.opt.gravity, dt)
 
 
 def foot_forces(

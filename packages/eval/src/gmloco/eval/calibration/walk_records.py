@@ -41,7 +41,7 @@ from gmloco.deploy.config_cli import field_doc
 from gmloco.deploy.g1 import G1_FOOT_BODIES, G1_SOLE_BOX_CENTER, G1_SOLE_BOX_HALF_EXTENTS
 from gmloco.eval.calibration.dataset import CalibrationDataset, assign_split, save_dataset
 from gmloco.eval.calibration.protocol import SoleProtocolCfg, SoleRecord
-from gmloco.eval.calibration.walk_momentum import MomentumForceCfg, foot_forces, total_force
+from gmloco.eval.calibration.walk_momentum import MomentumForceCfg, foot_forces, momentum_force
 from gmloco.eval.g1.soles import SoleCfg, sole_box_corners
 
 __all__ = [
@@ -117,12 +117,15 @@ def foot_records(path: str | Path, cfg: WalkRecordsCfg | None = None) -> dict[st
         ValueError: If the file lacks a signal, keeps fewer than ``cfg.min_frames`` frames, or its kinematics do not
             reproduce its recorded sinkage within ``cfg.depth_tolerance``.
     """
+    return _walk(Path(path), cfg or WalkRecordsCfg())[0]
+
+
+def _walk(path: Path, cfg: WalkRecordsCfg) -> tuple[dict[str, SoleRecord], np.ndarray]:
+    """:func:`foot_records`' records and the logged per-foot force of the kept frames [N], [T, 2, 3]."""
     import mujoco
 
     from gmloco.deploy.mismatch.frames import quat_rotate
 
-    cfg = cfg or WalkRecordsCfg()
-    path = Path(path)
     a = _log_arrays(path)
     low = np.flatnonzero(a["odom.position"][:, 2] < cfg.min_pelvis_height)
     n = int(low[0]) if len(low) else len(a["time"])
@@ -133,16 +136,21 @@ def foot_records(path: str | Path, cfg: WalkRecordsCfg | None = None) -> dict[st
     feet = [model.body(name).id for name in G1_FOOT_BODIES]
     centre = np.asarray(cfg.sole_center)
     corners = sole_box_corners(SoleCfg(center=cfg.sole_center, half_extents=cfg.sole_half_extents))  # link frame
-    jacp, jacr = np.zeros((3, model.nv)), np.zeros((3, model.nv))
+    jacp, jacr, jac_com = np.zeros((3, model.nv)), np.zeros((3, model.nv)), np.zeros((3, model.nv))
     pos, rot, lin, ang, depth = (np.zeros((2, n, *s)) for s in ((3,), (3, 3), (3,), (3,), ()))
+    com_vel = np.zeros((n, 3))
     v_world = quat_rotate(a["odom.orientation"][:n], a["odom.linear_velocity"][:n])
     qpos_all = np.concatenate([a["odom.position"][:n], a["odom.orientation"][:n], a["lowstate.q"][:n]], axis=1)
     qvel_all = np.concatenate([v_world, a["odom.angular_velocity"][:n], a["lowstate.dq"][:n]], axis=1)
+    momentum = cfg.force_source == "momentum"
     for k in range(n):
         data.qpos[:] = qpos_all[k]
         qvel = qvel_all[k]
         mujoco.mj_kinematics(model, data)
         mujoco.mj_comPos(model, data)
+        if momentum:  # the same kinematics give the centre-of-mass velocity (walk_momentum.com_velocity)
+            mujoco.mj_jacSubtreeCom(model, data, jac_com, 0)
+            com_vel[k] = jac_com @ qvel
         for f, body in enumerate(feet):
             r = data.xmat[body].reshape(3, 3)
             pos[f, k] = data.xpos[body] + r @ centre
@@ -154,11 +162,20 @@ def foot_records(path: str | Path, cfg: WalkRecordsCfg | None = None) -> dict[st
     if off > cfg.depth_tolerance:
         raise ValueError(f"{path}: the kinematics' sole depth differs from the recorded sinkage by {off:.4f} m")
     time = WALK_FRAME_DT * np.arange(n)
-    force = a["sim.force"][:n]
-    if cfg.force_source == "momentum":
-        force = foot_forces(total_force(model, qpos_all, qvel_all, WALK_FRAME_DT), force, depth.T, cfg.momentum)
-    return {foot: SoleRecord(time, pos[f], rot[f], lin[f], ang[f], force[:, f].copy(), depth[f])
-            for f, foot in enumerate(FEET)}  # fmt: skip
+    logged = force = a["sim.force"][:n]
+    if momentum:
+        total = momentum_force(com_vel, float(model.body_subtreemass[0]), model.opt.gravity, WALK_FRAME_DT)
+        force = foot_forces(total, logged, depth.T, cfg.momentum)
+    records = {foot: SoleRecord(time, pos[f], rot[f], lin[f], ang[f], force[:, f].copy(), depth[f])
+               for f, foot in enumerate(FEET)}  # fmt: skip
+    return records, logged
+
+
+def _logged_over_stance(logged: np.ndarray, records: dict[str, SoleRecord]) -> float:
+    """Logged over momentum mean vertical force on the single-support frames of momentum ``records`` [-]."""
+    f_mom = np.stack([records[f].force[:, 2] for f in FEET], axis=1)
+    single = np.isfinite(f_mom).all(axis=1)
+    return float(logged[single, :, 2].sum() / f_mom[single].sum()) if single.any() else float("nan")
 
 
 def logged_over_momentum(path: str | Path, cfg: WalkRecordsCfg | None = None) -> float:
@@ -167,15 +184,8 @@ def logged_over_momentum(path: str | Path, cfg: WalkRecordsCfg | None = None) ->
     1 means the recording's per-foot force log is sound (the policy step's mean); the aliased logs of older
     recordings read 0.5-1.0.
     """
-    cfg = cfg or WalkRecordsCfg()
-    logged = foot_records(path, replace(cfg, force_source="logged"))
-    momentum = foot_records(path, replace(cfg, force_source="momentum"))
-    f_log = np.stack([logged[f].force[:, 2] for f in FEET], axis=1)
-    f_mom = np.stack([momentum[f].force[:, 2] for f in FEET], axis=1)
-    single = np.isfinite(f_mom).all(axis=1)
-    if not single.any():
-        return float("nan")
-    return float(f_log[single].sum() / f_mom[single].sum())
+    records, logged = _walk(Path(path), replace(cfg or WalkRecordsCfg(), force_source="momentum"))
+    return _logged_over_stance(logged, records)
 
 
 def _record_name(path: Path) -> str:
@@ -189,9 +199,16 @@ def _record_name(path: Path) -> str:
 
 
 def walk_dataset(
-    paths: list[str | Path], material: str, cfg: WalkRecordsCfg | None = None, split_seed: int = 0
+    paths: list[str | Path],
+    material: str,
+    cfg: WalkRecordsCfg | None = None,
+    split_seed: int = 0,
+    log_check: dict[str, float] | None = None,
 ) -> CalibrationDataset:
     """Return the walks of ``paths`` on ``material`` as a calibration dataset (both feet of a walk share a split).
+
+    ``log_check``, if given, receives each recording's :func:`logged_over_momentum` (momentum records only), from the
+    same pass over the file.
 
     Raises:
         ValueError: If a terrain is not the material's flat bed, a file fails :func:`foot_records`, or two files
@@ -210,7 +227,10 @@ def walk_dataset(
         if stem in walks:
             raise ValueError(f"{p}: a second recording named {stem!r}")
         walks[stem] = []
-        for foot, rec in foot_records(p, cfg).items():
+        feet, logged = _walk(p, cfg)
+        if log_check is not None and cfg.force_source == "momentum":
+            log_check[str(p)] = _logged_over_stance(logged, feet)
+        for foot, rec in feet.items():
             records[f"{stem}__{foot}"] = rec
             walks[stem].append(f"{stem}__{foot}")
     by_walk = assign_split(sorted(walks), split_seed)
@@ -253,17 +273,19 @@ def main(argv: list[str] | None = None) -> int:
     if missing:
         print(f"error: no recording {missing}; MPM evaluations write them under <run>/recordings/", file=sys.stderr)
         return 2
+    check: dict[str, float] = {}
     try:
-        ds = walk_dataset(args.recordings, args.material, WalkRecordsCfg(force_source=args.force), args.split_seed)
+        ds = walk_dataset(
+            args.recordings, args.material, WalkRecordsCfg(force_source=args.force), args.split_seed, check
+        )
     except (ValueError, KeyError) as exc:
         print(f"error: {exc}", file=sys.stderr)
         return 2
     out = save_dataset(ds, args.out)
     frames = sum(len(r.time) for r in ds.records.values())
     print(f"{len(ds.records)} foot records ({frames} frames) of {len(args.recordings)} walks -> {out}")
-    if args.force == "momentum":  # how the recordings' own force log compares (1: the log is sound)
-        for path in args.recordings:
-            print(f"  {path}: logged / momentum stance force {logged_over_momentum(path):.2f}")
+    for path, ratio in check.items():  # momentum records: how each recording's force log compares (1: sound)
+        print(f"  {path}: logged / momentum stance force {ratio:.2f}")
     return 0
 
 
